@@ -1,0 +1,38 @@
+# Two entry points on a fresh machine: `make run` and `make test`.
+PY      ?= python3
+VENV    := .venv
+BIN     := $(VENV)/bin
+STAMP   := $(VENV)/.installed-stamp
+
+.PHONY: install run test test-slow lint format bench clean
+
+$(STAMP): pyproject.toml constraints.txt
+	$(PY) -m venv $(VENV)
+	$(BIN)/pip install --quiet --upgrade pip
+	# torch is pinned (constraints.txt) to the CPU build; an unpinned torch pulls CUDA.
+	$(BIN)/pip install --quiet -c constraints.txt -e ".[dev]"
+	touch $(STAMP)
+
+install: $(STAMP)
+
+## Reproduce the thesis (Table 2, figures) and the benchmark comparison.
+run: $(STAMP)
+	$(BIN)/acld-gym reproduce --json results/table2.json --plots results/figures
+
+## Lint + the test suite (slow tests excluded; see test-slow).
+test: $(STAMP)
+	$(BIN)/ruff check acld_gym baselines train tests benchmarks
+	$(BIN)/python -m pytest -q
+
+test-slow: $(STAMP)
+	$(BIN)/python -m pytest -q -m slow
+
+format: $(STAMP)
+	$(BIN)/ruff format acld_gym baselines train tests benchmarks
+	$(BIN)/ruff check --fix acld_gym baselines train tests benchmarks
+
+bench: $(STAMP)
+	$(BIN)/python benchmarks/bench_reproduce.py
+
+clean:
+	rm -rf $(VENV) results .pytest_cache

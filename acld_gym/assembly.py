@@ -97,7 +97,7 @@ def number_dofs(p: BeamParameters, mesh: Mesh) -> DofMap:
             nxt += 2
 
     elements = []
-    for e, (kind, le) in enumerate(zip(kinds, lengths)):
+    for e, (kind, le) in enumerate(zip(kinds, lengths, strict=True)):
         names = ACLD_NODE_DOFS if kind == "acld" else BEAM_NODE_DOFS
         idx = [node_dofs[e][k] for k in names] + [node_dofs[e + 1][k] for k in names]
         if kind == "acld":

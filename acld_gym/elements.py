@@ -78,7 +78,7 @@ class _Shape:
         """Gauss-Legendre quadrature of ``integrand(x)`` over [0, L_e]."""
         xi, wt = _GAUSS2 if points == 2 else _GAUSS1
         half = 0.5 * self.length
-        return sum(w * half * integrand(half * (1.0 + s)) for s, w in zip(xi, wt))
+        return sum(w * half * integrand(half * (1.0 + s)) for s, w in zip(xi, wt, strict=True))
 
 
 def _outer(row: np.ndarray) -> np.ndarray:
@@ -92,7 +92,8 @@ def _beam_layer(sh: _Shape, E: float, G: float, rho: float, A: float, I: float,
 
     .. math::
 
-        K = E I \\int N_\\theta'^T N_\\theta' + k G A \\int_{1pt} (N_\\theta - N_w')^T(N_\\theta - N_w')
+        K = E I \\int N_\\theta'^T N_\\theta'
+            + k G A \\int_{1pt} (N_\\theta - N_w')^T (N_\\theta - N_w')
             + E A \\int N_u'^T N_u', \\quad
         M = \\rho \\int (A N_w^T N_w + I N_\\theta^T N_\\theta + A N_u^T N_u)
     """

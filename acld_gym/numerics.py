@@ -50,7 +50,8 @@ def lyap_observability(A: np.ndarray, C: np.ndarray) -> np.ndarray:
     return _sym(sla.solve_continuous_lyapunov(A.T, -C.T @ C))
 
 
-def care_gain(A: np.ndarray, B: np.ndarray, Q: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def care_gain(A: np.ndarray, B: np.ndarray, Q: np.ndarray,
+              R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Continuous LQR: ``K = R^-1 B^T X`` with X the stabilizing CARE solution.
 
     Solved in balanced coordinates: with :math:`x = D x_s`,

@@ -60,7 +60,8 @@ def plot_frequency_response(path: Path, d: Design) -> None:
     r = d.reduced
     w = np.logspace(1, 5.5, 1500)
     fig, ax = plt.subplots(2, 1, sharex=True, figsize=(7, 6))
-    for a, (bf, br, lab) in zip(ax, ((B, r.B, "voltage [m/V]"), (E, r.E, "tip load [m/N]")), strict=True):
+    channels = ((B, r.B, "voltage [m/V]"), (E, r.E, "tip load [m/N]"))
+    for a, (bf, br, lab) in zip(ax, channels, strict=True):
         a.loglog(w, np.abs(frequency_response(A, bf, Cy, w)), label="full (38 states)")
         a.loglog(w, np.abs(frequency_response(r.A, br, r.C, w)), "--",
                  label=f"reduced ({r.order} states)")

@@ -159,7 +159,7 @@ def test_global_matrices_symmetric_and_rigid_modes(mesh):
     # gamma = z = 0
     x = np.asarray(d.node_x)
     R = np.zeros((d.n_dofs, 3))
-    for xi, nd in zip(x, d.node_dofs):
+    for xi, nd in zip(x, d.node_dofs, strict=True):
         R[nd["u"], 0] = 1.0
         R[nd["w"], 1] = 1.0
         R[nd["theta"], 2] = 1.0

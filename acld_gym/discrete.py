@@ -68,6 +68,14 @@ class SampledSystem:
         """Response to a load held constant at 1 N over the period (n x 1)."""
         return (self.W0.sum(axis=1) + self.W1.sum(axis=1))[:, None]
 
+    def load_samples(self, load, t0: float) -> tuple[np.ndarray, np.ndarray]:
+        """Right limits at the sub-interval starts and left limits at their ends of
+        ``load(t)`` for the period starting at ``t0`` (evaluated 1e-9 dt inside, so
+        edges on the grid are not misread by rounding)."""
+        tt = t0 + self.times
+        eps = 1e-9 * self.dt
+        return load(tt[:-1] + eps), load(tt[1:] - eps)
+
     def load_increment(self, f0: np.ndarray, f1: np.ndarray) -> np.ndarray:
         """Load contribution for sub-interval start/end samples ``f0, f1``
         (..., substeps) -> (..., n)."""

@@ -7,13 +7,13 @@ and simulates the full 38-state plant with :mod:`acld_gym.simulate`.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from dataclasses import asdict, dataclass
 
 from .design import Design
 from .loads import THESIS_CASES, thesis_load
 from .metrics import max_abs, peak, settling_time
 from .simulate import SimulationResult, simulate
 from .thesis import V_LIMIT, thesis_row
+from .thesis import Table2Row as Row
 
 __all__ = ["Row", "run_cases", "format_table2", "T_END"]
 
@@ -21,19 +21,6 @@ __all__ = ["Row", "run_cases", "format_table2", "T_END"]
 #: do not change with a longer window.
 T_END = 1.0
 CONTROLLERS = ("passive", "lqr", "smc")
-
-
-@dataclass(frozen=True)
-class Row:
-    case: int
-    controller: str
-    saturation: bool
-    peak_mm: float
-    settling_s: float
-    max_voltage_V: float
-
-    def as_dict(self) -> dict:
-        return asdict(self)
 
 
 def run_cases(d: Design, cases: Iterable[int] = THESIS_CASES, observer: str = "thesis",

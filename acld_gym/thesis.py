@@ -6,9 +6,10 @@ from the text of sections 5.3-5.5 (the saturated rows reach the 120 V limit).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 
-__all__ = ["ThesisRow", "TABLE2", "PASSIVE_CASE1_PEAK_MM", "FIRST_RESONANCE_RAD_S", "V_LIMIT"]
+__all__ = ["Table2Row", "ThesisRow", "TABLE2", "PASSIVE_CASE1_PEAK_MM", "FIRST_RESONANCE_RAD_S",
+           "V_LIMIT", "thesis_row"]
 
 #: Voltage limit of the saturated runs [V] (sec. 5.3).
 V_LIMIT = 120.0
@@ -19,13 +20,23 @@ FIRST_RESONANCE_RAD_S = 179.0
 
 
 @dataclass(frozen=True)
-class ThesisRow:
+class Table2Row:
+    """One row of Table 2: load case, controller, voltage limit on/off and the
+    three metrics (peak [mm], 5% settling time [s], max |V| [V])."""
+
     case: int
     controller: str
     saturation: bool
     peak_mm: float
     settling_s: float
     max_voltage_V: float
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+#: The thesis's rows use the same record as ours.
+ThesisRow = Table2Row
 
 
 TABLE2: tuple[ThesisRow, ...] = (

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Pulse", "Harmonic", "TipLoad", "thesis_load", "THESIS_CASES", "LoadPiece"]
+__all__ = ["Pulse", "Harmonic", "Samples", "TipLoad", "thesis_load", "THESIS_CASES", "LoadPiece"]
 
 
 @dataclass(frozen=True)
@@ -62,6 +62,27 @@ class Harmonic:
 
 
 @dataclass(frozen=True)
+class Samples:
+    """Piecewise-linear load through ``values`` [N] at ``start + i * step`` [s], zero
+    outside. Used for band-limited noise; the sampled model integrates it
+    exactly when ``step`` is a multiple of its sub-step (first-order hold)."""
+
+    start: float
+    step: float
+    values: tuple[float, ...]
+
+    def __post_init__(self):
+        if not self.step > 0:
+            raise ValueError(f"Samples.step must be positive [s], got {self.step!r}")
+        if len(self.values) < 2:
+            raise ValueError("Samples.values needs at least two samples")
+
+    @property
+    def end(self) -> float:
+        return self.start + self.step * (len(self.values) - 1)
+
+
+@dataclass(frozen=True)
 class LoadPiece:
     """Load on an interval between breakpoints: ``const + sum_i amp_i sin(w_i t + ph_i)``."""
 
@@ -73,7 +94,7 @@ class LoadPiece:
 class TipLoad:
     """A sum of pulses and harmonics applied transversely at the tip."""
 
-    components: tuple[Pulse | Harmonic, ...] = ()
+    components: tuple[Pulse | Harmonic | Samples, ...] = ()
 
     def __call__(self, t) -> np.ndarray:
         """Load [N] at time(s) ``t`` [s]; intervals are closed on the left."""
@@ -83,6 +104,9 @@ class TipLoad:
             on = (t >= c.start) & (t < c.end)
             if isinstance(c, Pulse):
                 f = f + np.where(on, c.amplitude, 0.0)
+            elif isinstance(c, Samples):
+                grid = c.start + c.step * np.arange(len(c.values))
+                f = f + np.where(on, np.interp(t, grid, c.values), 0.0)
             else:
                 f = f + np.where(on, c.amplitude * np.sin(c.frequency * (t - c.start) + c.phase),
                                  0.0)
@@ -102,6 +126,10 @@ class TipLoad:
                 continue
             if isinstance(c, Pulse):
                 const += c.amplitude
+            elif isinstance(c, Samples):
+                raise NotImplementedError(
+                    "load: the continuous simulator takes pulses and harmonics only; sample "
+                    "Samples loads with acld_gym.discrete")
             else:
                 harms.append((c.amplitude, c.frequency, c.phase - c.frequency * c.start))
         return LoadPiece(const=const, harmonics=tuple(harms))

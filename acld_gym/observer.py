@@ -31,7 +31,8 @@ import scipy.linalg as sla
 from .numerics import care_gain
 from .reduction import ReducedModel
 
-__all__ = ["Observer", "thesis_observer", "kalman_observer", "discrete_kalman_observer"]
+__all__ = ["Observer", "DiscreteObserver", "thesis_observer", "kalman_observer", "discrete_kalman",
+           "discrete_thesis"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -39,8 +40,6 @@ class Observer:
     """Observer matrices; ``T`` maps its state to the reduced state x_r.
 
     ``E`` is the load input; it is zero when the observer is not fed the load.
-    ``discrete`` observers (``dt`` set) are in predictor form
-    :math:`\\hat x_{k+1} = A \\hat x_k + B V_k + L (y_k - C \\hat x_k)`.
     """
 
     A: np.ndarray
@@ -50,7 +49,6 @@ class Observer:
     L: np.ndarray
     T: np.ndarray
     name: str
-    dt: float | None = None
 
     @property
     def n(self) -> int:
@@ -95,15 +93,43 @@ def kalman_observer(red: ReducedModel, load_std: float = 1.0, sensor_std: float 
                     name="kalman")
 
 
-def discrete_kalman_observer(Ad: np.ndarray, Bd: np.ndarray, Ed: np.ndarray, Cr: np.ndarray,
-                             dt: float, load_std: float = 1.0,
-                             sensor_std: float = 1e-6) -> Observer:
-    """Steady-state discrete Kalman predictor for the sampled reduced model.
+@dataclass(frozen=True, eq=False)
+class DiscreteObserver:
+    r"""Sampled observer, one form for both kinds:
 
-    ``Ed`` is the discretized load input (state increment per newton held over
-    a period); the load is white across periods with standard deviation
-    ``load_std`` [N], the tip sensor noise white with ``sensor_std`` [m].
-    Predictor gain :math:`L = A X C^T (C X C^T + V)^{-1}` with X from the DARE.
+    .. math::
+
+        \hat x_{k|k} = \hat x_k + L_c (y_k - C \hat x_k), \qquad
+        \hat x_{k+1} = A \hat x_k + B V_k + L_p (y_k - C \hat x_k) \;[+\ \text{load increment}],
+
+    and :math:`x_{r,k} = T \hat x_{k|k}`. The steady-state Kalman filter has
+    :math:`L_c = M` (measurement update) and :math:`L_p = A M`; the thesis's
+    observer has :math:`L_c = 0` and :math:`L_p = \int_0^{\Delta} e^{As}ds\,L`
+    and, when ``fed_load``, receives the same load increment as the plant.
+    """
+
+    A: np.ndarray
+    B: np.ndarray
+    C: np.ndarray
+    Lc: np.ndarray
+    Lp: np.ndarray
+    T: np.ndarray
+    fed_load: bool
+    name: str
+
+    @property
+    def n(self) -> int:
+        return self.A.shape[0]
+
+
+def discrete_kalman(Ad: np.ndarray, Bd: np.ndarray, Ed: np.ndarray, Cr: np.ndarray,
+                    load_std: float = 1.0, sensor_std: float = 1e-6) -> DiscreteObserver:
+    """Steady-state discrete Kalman filter for the sampled reduced model.
+
+    ``Ed`` is the sampled load input (state increment for 1 N held over a
+    period). The load is white across periods with standard deviation
+    ``load_std`` [N]; the tip sensor noise is white with ``sensor_std`` [m].
+    :math:`M = X C^T (C X C^T + V)^{-1}`, X the prior covariance from the DARE.
     """
     if not load_std > 0:
         raise ValueError(f"load_std must be positive [N], got {load_std!r}")
@@ -111,8 +137,15 @@ def discrete_kalman_observer(Ad: np.ndarray, Bd: np.ndarray, Ed: np.ndarray, Cr:
         raise ValueError(f"sensor_std must be positive [m], got {sensor_std!r}")
     W = Ed @ Ed.T * load_std**2
     V = np.array([[sensor_std**2]])
-    X = sla.solve_discrete_are(Ad.T, Cr.T, W, V)
-    L = Ad @ X @ Cr.T @ np.linalg.inv(Cr @ X @ Cr.T + V)
-    k = Ad.shape[0]
-    return Observer(A=Ad, B=Bd, E=np.zeros_like(Ed), C=Cr, L=L, T=np.eye(k), name="kalman",
-                    dt=dt)
+    X = sla.solve_discrete_are(Ad.T, Cr.T, 0.5 * (W + W.T), V)
+    M = X @ Cr.T @ np.linalg.inv(Cr @ X @ Cr.T + V)
+    return DiscreteObserver(A=Ad, B=Bd, C=Cr, Lc=M, Lp=Ad @ M, T=np.eye(Ad.shape[0]),
+                            fed_load=False, name="kalman")
+
+
+def discrete_thesis(Ad: np.ndarray, Bd_of_L: np.ndarray, Bd: np.ndarray, Cy: np.ndarray,
+                    continuous: Observer) -> DiscreteObserver:
+    """The thesis's observer sampled with the period of ``Ad`` (``Bd_of_L`` is the
+    held-input matrix of the gain, :math:`\\int_0^\\Delta e^{As}ds\\,L`)."""
+    return DiscreteObserver(A=Ad, B=Bd, C=Cy, Lc=np.zeros_like(Bd_of_L), Lp=Bd_of_L,
+                            T=continuous.T, fed_load=continuous.fed_load, name=continuous.name)

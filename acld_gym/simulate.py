@@ -65,8 +65,9 @@ class ClosedLoop:
 
     def __init__(self, A, B, E, Cy, observer: Observer, feedback: Feedback,
                  v_max: float | None, frequencies: tuple[float, ...] = ()):
-        if observer.dt is not None:
-            raise ValueError("observer: the continuous-time simulator needs a continuous observer")
+        if not isinstance(observer, Observer):
+            raise ValueError(f"observer: the continuous-time simulator needs an Observer, got "
+                             f"{type(observer).__name__}")
         if v_max is not None and not v_max > 0:
             raise ValueError(f"v_max must be positive or None, got {v_max!r}")
         n, no, nh = A.shape[0], observer.n, len(frequencies)

@@ -25,7 +25,6 @@ def test_thesis_observer_stable(d, kind):
     obs = d.observer(kind)
     A, B, E, Cy = d.plant
     assert obs.n == A.shape[0]
-    assert obs.dt is None
     assert_array_equal(obs.C, Cy)
     assert_array_equal(obs.T, d.reduced.SL.T)
     assert np.max(np.linalg.eigvals(obs.A - obs.L @ obs.C).real) < 0

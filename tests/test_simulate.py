@@ -158,9 +158,12 @@ def test_bad_args(d, sim, kw):
 
 
 def test_discrete_observer_rejected(d):
-    from dataclasses import replace
+    from acld_gym.discrete import discretize
+    from acld_gym.observer import discrete_kalman
 
     A, B, E, Cy = d.plant
-    obs = replace(d.observer("kalman"), dt=1e-4)
+    r = d.reduced
+    sd = discretize(r.A, r.B, r.E, 1e-3)
+    obs = discrete_kalman(sd.Ad, sd.Bd, sd.Ed, r.C)
     with pytest.raises(ValueError, match="observer"):
         simulate(A, B, E, Cy, obs, d.lqr, thesis_load(1), t_end=0.01)

@@ -1,0 +1,365 @@
+"""``ACLDBeam-v0``: the ACLD cantilever as a Gymnasium environment."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from functools import lru_cache
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from .design import Design, design
+from .discrete import SampledSystem, discretize
+from .loads import Harmonic, Pulse, Samples, TipLoad, thesis_load
+from .model import build_model
+from .observer import DiscreteObserver, discrete_kalman, discrete_thesis
+from .params import BeamParameters
+from .simulate import simulate
+from .thesis import V_LIMIT
+
+__all__ = ["ACLDBeamEnv", "Nominal", "nominal", "random_load", "LOAD_CASES", "OBS_MODES"]
+
+LOAD_CASES = (1, 2, 3, "random")
+OBS_MODES = ("estimate", "measurement", "full")
+OBSERVERS = ("kalman", "thesis")
+#: Parameters perturbed by ``param_noise`` (multiplicative, log-normal, per episode).
+RANDOMIZED = ("ghm_kappa", "ghm_alpha", "ghm_omega", "ghm_zeta", "vem_density",
+              "beam_youngs_modulus", "pzt_youngs_modulus", "d31", "rayleigh_mass",
+              "rayleigh_stiffness")
+
+
+@dataclass(frozen=True, eq=False)
+class Nominal:
+    """The nominal design for one control period: what observers and
+    baselines know. ``xr_scale`` are the fixed observation scales: each
+    reduced state's peak magnitude in the passive response to thesis case 1."""
+
+    design: Design
+    plant: SampledSystem
+    reduced: SampledSystem
+    kalman: DiscreteObserver
+    thesis: DiscreteObserver
+    xr_scale: np.ndarray
+
+
+@lru_cache(maxsize=8)
+def nominal(dt: float = 1e-3, substeps: int = 10, sensor_std: float = 1e-6,
+            load_std: float = 1.0) -> Nominal:
+    """Nominal design sampled at ``dt`` (cached: the env, its vector version and
+    the baselines share it)."""
+    d = design()
+    A, B, E, Cy = d.plant
+    sd = discretize(A, B, E, dt, substeps)
+    r = d.reduced
+    sr = discretize(r.A, r.B, r.E, dt, substeps)
+    kal = discrete_kalman(sr.Ad, sr.Bd, sr.Ed, r.C, load_std=load_std, sensor_std=sensor_std)
+    cont = d.observer("thesis")
+    # Held-input matrix of the thesis gain: int_0^dt e^{As} ds L (columnwise ZOH).
+    sl = discretize(A, cont.L, E, dt, 1)
+    th = discrete_thesis(sd.Ad, sl.Bd, sd.Bd, Cy, cont)
+    res = simulate(A, B, E, Cy, cont, d.passive, thesis_load(1), t_end=0.2, v_max=None)
+    scale = np.abs(res.xr).max(axis=0)
+    return Nominal(design=d, plant=sd, reduced=sr, kalman=kal, thesis=th, xr_scale=scale)
+
+
+def random_load(rng: np.random.Generator, duration: float, grid: float) -> TipLoad:
+    """A bounded random tip load drawn from ``rng``.
+
+    Always one to three pulses (amplitude U(-1.5, 1.5) N, width 0.5-3 ms,
+    start in the first 70 % of the episode); with probability 1/2 a harmonic
+    of amplitude up to 0.08 N within +/-5 % of the first (179 rad/s) or
+    second (1115 rad/s) mode, 0.05-0.3 s long; with probability 1/2
+    band-limited noise (low-pass random samples every 2 ms, std about 0.05 N).
+    Pulse edges lie on ``grid`` [s] (the env's load sub-step), so the
+    sampled model integrates them exactly.
+    """
+    comps: list = []
+    for _ in range(int(rng.integers(1, 4))):
+        start = np.round(rng.uniform(0.0, 0.7 * duration) / grid) * grid
+        width = max(np.round(rng.uniform(5e-4, 3e-3) / grid), 1) * grid
+        comps.append(Pulse(float(start), float(width), float(rng.uniform(-1.5, 1.5))))
+    if rng.uniform() < 0.5:
+        w0 = 179.0 if rng.uniform() < 0.7 else 1115.0
+        comps.append(Harmonic(float(rng.uniform(0.0, 0.08)), float(w0 * rng.uniform(0.95, 1.05)),
+                              float(rng.uniform(0.0, 0.5 * duration)),
+                              float(rng.uniform(0.05, 0.3)), float(rng.uniform(0, 2 * np.pi))))
+    if rng.uniform() < 0.5:
+        step = max(np.round(2e-3 / grid), 1) * grid
+        n = int(duration / step) + 1
+        white = rng.normal(0.0, 1.0, n)
+        smooth = np.convolve(white, np.ones(4) / 2.0, mode="same")  # ~0.25 kHz low-pass
+        comps.append(Samples(0.0, float(step), tuple(0.05 * smooth)))
+    return TipLoad(tuple(comps))
+
+
+class ACLDBeamEnv(gym.Env):
+    """
+    ## Description
+
+    Vibration control of a 300 x 15 x 3 mm aluminium cantilever with an active
+    constrained layer damping (ACLD) patch (Rodriguez 2006). The agent sets the
+    voltage on the piezoelectric constraining layer to suppress the tip
+    deflection caused by a tip load. The plant is the full 38-state
+    finite-element model (Timoshenko beam + GHM viscoelastic layer) sampled
+    exactly with a zero-order hold on the voltage; the tip load is
+    integrated within each period (sub-steps with first-order hold, exact
+    for pulses). The observer runs on the nominal model, never on the
+    (possibly randomized) plant.
+
+    ## Action Space
+
+    ``Box(-120, 120, (1,), float32)``: piezo voltage [V], held for one period.
+    Out-of-range actions are clipped to +/-120 V and reported in
+    ``info["clipped"]``; NaN or inf raise ``ValueError`` and leave the state
+    untouched. (Train with ``gymnasium.wrappers.RescaleAction`` for [-1, 1].)
+
+    ## Observation Space
+
+    ``Box(-inf, inf, (n,), float32)``; ``obs_mode`` selects:
+
+    | obs_mode | n | content | scale |
+    |---|---|---|---|
+    | ``"estimate"`` (default) | 7 | x_r estimate (6), measured tip | see below; y / 1 mm |
+    | ``"measurement"`` | 9 | last 8 tip measurements, last voltage | y / 1 mm; V / 120 V |
+    | ``"full"`` | 38 | true plant state [q; dq/dt] (privileged) | SI (m, rad, m/s, rad/s) |
+
+    Each x_r component is divided by its peak magnitude in the passive response
+    to thesis load case 1 (``Nominal.xr_scale``), so a 1 N x 1 ms pulse gives
+    values of order one.
+
+    ## Rewards
+
+    ``r = -(y / y_ref)^2 - lam * (V / 120)^2`` per step, with ``y`` the true
+    tip deflection [m] at the end of the step and ``V`` the applied voltage.
+
+    ## Starting State
+
+    The beam at rest (all 38 states zero), the observer at zero. The load of
+    the episode is set by ``load_case`` (or ``reset(options={"load_case": ...})``).
+
+    ## Episode End
+
+    * ``terminated``: |tip deflection| > ``deflection_limit`` (20 mm by
+      default, beyond which the linear model is not valid).
+    * ``truncated``: after ``episode_length`` seconds (1 s = 1000 steps).
+
+    ## Arguments
+
+    | kwarg | default | meaning |
+    |---|---|---|
+    | ``load_case`` | 1 | 1, 2, 3 (thesis ch. 5) or ``"random"`` (:func:`random_load`) |
+    | ``dt`` | 1e-3 | control period [s] |
+    | ``episode_length`` | 1.0 | episode duration [s] |
+    | ``observer`` | ``"kalman"`` | ``"kalman"`` (reduced model, not fed the load) or |
+    | | | ``"thesis"`` (full order, fed the load) |
+    | ``obs_mode`` | ``"estimate"`` | see Observation Space |
+    | ``sensor_noise`` | 1e-6 | tip-sensor noise std [m] (seeded; 0 for none) |
+    | ``y_ref`` | 1e-3 | deflection scale of the reward [m] |
+    | ``lam`` | 0.01 | voltage weight of the reward |
+    | ``param_noise`` | 0.0 | relative std of per-episode parameter randomization |
+    | ``deflection_limit`` | 0.02 | termination limit [m] |
+    | ``render_mode`` | None | ``"rgb_array"`` or ``"human"`` |
+
+    ## Version History
+
+    * v0: initial version.
+    """
+
+    metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 30}
+
+    def __init__(self, load_case: int | str = 1, dt: float = 1e-3, episode_length: float = 1.0,
+                 observer: str = "kalman", obs_mode: str = "estimate",
+                 sensor_noise: float = 1e-6, y_ref: float = 1e-3, lam: float = 0.01,
+                 param_noise: float = 0.0, deflection_limit: float = 0.02,
+                 render_mode: str | None = None):
+        _check_choice("load_case", load_case, LOAD_CASES)
+        _check_choice("observer", observer, OBSERVERS)
+        _check_choice("obs_mode", obs_mode, OBS_MODES)
+        for name, value in (("dt", dt), ("episode_length", episode_length), ("y_ref", y_ref),
+                            ("deflection_limit", deflection_limit)):
+            _check_positive(name, value)
+        for name, value in (("sensor_noise", sensor_noise), ("lam", lam),
+                            ("param_noise", param_noise)):
+            _check_positive(name, value, allow_zero=True)
+        if episode_length < dt:
+            raise ValueError(f"episode_length must be at least dt, got {episode_length!r}")
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(f"render_mode must be one of {self.metadata['render_modes']} or "
+                             f"None, got {render_mode!r}")
+        self.load_case = load_case
+        self.dt = float(dt)
+        self.episode_length = float(episode_length)
+        self.max_steps = int(round(episode_length / dt))
+        self.observer_kind = observer
+        self.obs_mode = obs_mode
+        self.sensor_noise = float(sensor_noise)
+        self.y_ref = float(y_ref)
+        self.lam = float(lam)
+        self.param_noise = float(param_noise)
+        self.deflection_limit = float(deflection_limit)
+        self.render_mode = render_mode
+        self.v_max = V_LIMIT
+        self.nom = nominal(self.dt, 10, max(self.sensor_noise, 1e-9))
+        self.obs_hist = 8
+        n_obs = {"estimate": self.nom.design.reduced.order + 1,
+                 "measurement": self.obs_hist + 1, "full": self.nom.plant.Ad.shape[0]}[obs_mode]
+        self.action_space = spaces.Box(-self.v_max, self.v_max, (1,), np.float32)
+        self.observation_space = spaces.Box(-np.inf, np.inf, (n_obs,), np.float32)
+        self._tip = self.nom.design.model.tip_index
+        self._plant = self.nom.plant
+        self._obs = self.nom.thesis if observer == "thesis" else self.nom.kalman
+        self._fig = None
+        self._reset_state(thesis_load(1) if load_case == "random" else thesis_load(load_case))
+
+    # --- composition of a step ----------------------------------------------
+    def _reset_state(self, load: TipLoad) -> None:
+        self.load = load
+        self.k = 0
+        self.x = np.zeros(self._plant.Ad.shape[0])
+        self.xhat = np.zeros(self._obs.n)
+        self.v = 0.0
+        self.y_meas = 0.0
+        self.y_hist = np.zeros(self.obs_hist)
+        self.history: list[tuple[float, float, float]] = []
+
+    def _advance_plant(self, v: float) -> np.ndarray:
+        """Exact ZOH step of the (true) plant; returns the load increment used."""
+        f0, f1 = self._plant.load_samples(self.load, self.k * self.dt)
+        inc = self._plant.load_increment(f0, f1)
+        self.x = self._plant.Ad @ self.x + self._plant.Bd[:, 0] * v + inc
+        return inc
+
+    def _measure(self) -> float:
+        noise = self.np_random.normal(0.0, self.sensor_noise) if self.sensor_noise else 0.0
+        return float(self.x[self._tip] + noise)
+
+    def _update_observer(self, v: float, y_prev: float, plant_inc: np.ndarray) -> None:
+        o = self._obs
+        innov = y_prev - float(o.C[0] @ self.xhat)
+        nxt = o.A @ self.xhat + o.B[:, 0] * v + o.Lp[:, 0] * innov
+        if o.fed_load:
+            f0, f1 = self.nom.plant.load_samples(self.load, self.k * self.dt)
+            nxt = nxt + self.nom.plant.load_increment(f0, f1)
+        self.xhat = nxt
+
+    def _xr_estimate(self) -> np.ndarray:
+        """x_r from the current estimate with the measurement update (L_c)."""
+        o = self._obs
+        innov = self.y_meas - float(o.C[0] @ self.xhat)
+        return o.T @ (self.xhat + o.Lc[:, 0] * innov)
+
+    def _observation(self) -> np.ndarray:
+        if self.obs_mode == "estimate":
+            out = np.concatenate([self._xr_estimate() / self.nom.xr_scale,
+                                  [self.y_meas / 1e-3]])
+        elif self.obs_mode == "measurement":
+            out = np.concatenate([self.y_hist / 1e-3, [self.v / self.v_max]])
+        else:
+            out = self.x
+        return out.astype(np.float32)
+
+    def _reward(self, y: float, v: float) -> float:
+        return -((y / self.y_ref) ** 2) - self.lam * (v / self.v_max) ** 2
+
+    def _info(self, requested: float | None = None) -> dict[str, Any]:
+        y = float(self.x[self._tip])
+        t = self.k * self.dt
+        info = {"tip_deflection": y, "voltage": self.v, "tip_load": float(self.load(t)),
+                "time": t, "xr_true": self.nom.design.reduced.SL.T @ self.x,
+                "clipped": False, "requested_voltage": self.v}
+        if requested is not None:
+            info["clipped"] = bool(requested != self.v)
+            info["requested_voltage"] = requested
+        return info
+
+    # --- Gymnasium API -------------------------------------------------------
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        options = dict(options or {})
+        case = options.pop("load_case", self.load_case)
+        if options:
+            raise ValueError(f"options: unknown key(s) {sorted(options)}; expected 'load_case'")
+        _check_choice("load_case", case, LOAD_CASES)
+        load = (random_load(self.np_random, self.episode_length, self._plant.dt /
+                            self._plant.substeps) if case == "random" else thesis_load(case))
+        self._plant = self._randomized_plant() if self.param_noise > 0 else self.nom.plant
+        self._reset_state(load)
+        self.y_meas = self._measure()
+        self.y_hist[-1] = self.y_meas
+        return self._observation(), self._info()
+
+    def step(self, action):
+        a = np.asarray(action, dtype=np.float64).reshape(-1)
+        if a.size != 1:
+            raise ValueError(f"action must hold one voltage [V], got shape {np.shape(action)}")
+        if not np.isfinite(a[0]):
+            raise ValueError(f"action must be finite, got {a[0]!r}")
+        requested = float(a[0])
+        v = float(np.clip(requested, -self.v_max, self.v_max))
+        y_prev = self.y_meas
+        inc = self._advance_plant(v)              # 1. plant over one period (ZOH)
+        self._update_observer(v, y_prev, inc)     # 2. observer prediction
+        self.k += 1
+        self.v = v
+        self.y_meas = self._measure()             # 3. new measurement
+        self.y_hist = np.roll(self.y_hist, -1)
+        self.y_hist[-1] = self.y_meas
+        y = float(self.x[self._tip])
+        reward = self._reward(y, v)               # 4. reward on the true deflection
+        terminated = bool(abs(y) > self.deflection_limit)  # 5. physical limit
+        truncated = bool(self.k >= self.max_steps)
+        self.history.append((self.k * self.dt, y, v))
+        if self.render_mode == "human":
+            self.render()
+        return self._observation(), float(reward), terminated, truncated, self._info(requested)
+
+    def _randomized_plant(self) -> SampledSystem:
+        p = BeamParameters()
+        noise = self.np_random.normal(0.0, self.param_noise, len(RANDOMIZED))
+        changed = {name: getattr(p, name) * float(np.exp(z))
+                   for name, z in zip(RANDOMIZED, noise, strict=True)}
+        m = build_model(replace(p, **changed))
+        A, B, E, _ = m.state_space()
+        return discretize(A, B, E, self.dt, self.nom.plant.substeps)
+
+    def render(self):
+        if self.render_mode is None:
+            gym.logger.warn("render() called without render_mode; pass render_mode= to make()")
+            return None
+        from .render import render_frame
+
+        frame, self._fig = render_frame(self, self._fig)
+        if self.render_mode == "human":
+            from .render import show
+
+            show(self._fig)
+            return None
+        return frame
+
+    def close(self):
+        if self._fig is not None:
+            from .render import close
+
+            close(self._fig)
+            self._fig = None
+
+    def __getstate__(self):
+        state = self.__dict__.copy()
+        state["_fig"] = None
+        return state
+
+
+def _check_choice(name: str, value, choices) -> None:
+    if isinstance(value, bool) or value not in choices:
+        raise ValueError(f"{name} must be one of {list(choices)}, got {value!r}")
+
+
+def _check_positive(name: str, value, allow_zero: bool = False) -> None:
+    ok = (isinstance(value, (int, float)) and not isinstance(value, bool) and np.isfinite(value)
+          and (value >= 0 if allow_zero else value > 0))
+    if not ok:
+        need = "a non-negative" if allow_zero else "a positive"
+        raise ValueError(f"{name} must be {need} finite number, got {value!r}")
+

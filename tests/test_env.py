@@ -1,0 +1,224 @@
+"""ACLDBeam-v0: Gymnasium conventions, semantics, bad input, determinism, pickling."""
+
+import pickle
+import subprocess
+import sys
+import warnings
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import acld_gym  # noqa: F401  (registers ACLDBeam-v0)
+from acld_gym.env import ACLDBeamEnv, nominal, random_load
+
+# Warnings we chose: the action box is in volts (+/-120, the design card's choice;
+# train with RescaleAction) and observations are unbounded by nature.
+CHOSEN = ("symmetric and normalized", "minimum value is -infinity", "maximum value is infinity")
+
+
+@pytest.mark.parametrize("mode", ["rgb_array", None])
+def test_passes_gymnasium_check_env_with_only_chosen_warnings(mode):
+    env = gym.make("ACLDBeam-v0", render_mode=mode)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        check_env(env.unwrapped, skip_render_check=False)
+    others = [str(w.message) for w in caught if not any(c in str(w.message) for c in CHOSEN)]
+    assert others == []
+
+
+def test_passes_sb3_check_env():
+    from stable_baselines3.common.env_checker import check_env as sb3_check
+
+    sb3_check(ACLDBeamEnv(), warn=False)
+
+
+def test_make_without_import_registers_itself():
+    code = ("import gymnasium as gym; e = gym.make('acld_gym:ACLDBeam-v0'); "
+            "print(e.spec.max_episode_steps)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True)
+    assert out.stdout.strip() == "1000"
+
+
+def _rollout(env, seed, actions):
+    obs, _ = env.reset(seed=seed)
+    traj = [obs]
+    for a in actions:
+        obs, r, term, trunc, info = env.step(a)
+        traj.append(np.r_[obs, r, info["tip_deflection"]])
+    return np.concatenate(traj)
+
+
+def test_same_seed_same_trajectory_random_loads_and_noise():
+    env = ACLDBeamEnv(load_case="random", param_noise=0.05)
+    acts = [np.array([v], np.float32) for v in np.linspace(-150, 150, 60)]
+    a = _rollout(env, 123, acts)
+    b = _rollout(env, 123, acts)
+    c = _rollout(env, 124, acts)
+    np.testing.assert_array_equal(a, b)
+    assert not np.array_equal(a, c)
+
+
+def test_pickle_round_trip_continues_identically():
+    env = ACLDBeamEnv(load_case="random")
+    env.reset(seed=5)
+    for _ in range(10):
+        env.step(np.array([30.0], np.float32))
+    clone = pickle.loads(pickle.dumps(env))
+    for _ in range(20):
+        o1, r1, *_ = env.step(np.array([-40.0], np.float32))
+        o2, r2, *_ = clone.step(np.array([-40.0], np.float32))
+        np.testing.assert_array_equal(o1, o2)
+        assert r1 == r2
+
+
+def test_episode_truncates_after_one_second_never_terminates_for_time():
+    env = ACLDBeamEnv(load_case=1)
+    env.reset(seed=0)
+    for k in range(1000):
+        _, _, term, trunc, info = env.step(np.zeros(1, np.float32))
+        assert not term
+        assert trunc == (k == 999)
+    assert info["time"] == pytest.approx(1.0)
+
+
+def test_physical_limit_terminates():
+    env = ACLDBeamEnv(load_case=3, deflection_limit=1e-3)  # case 3 reaches ~5 mm passively
+    env.reset(seed=0)
+    for _ in range(1000):
+        *_, term, trunc, info = env.step(np.zeros(1, np.float32))
+        if term:
+            break
+    assert term and abs(info["tip_deflection"]) > 1e-3
+
+
+def test_passive_episode_matches_exact_simulation():
+    # The env's plant (ZOH + load sub-steps) against the exact continuous simulator.
+    from acld_gym.loads import thesis_load
+    from acld_gym.simulate import simulate
+
+    env = ACLDBeamEnv(load_case=2, sensor_noise=0.0)
+    env.reset(seed=0)
+    ys = [env.step(np.zeros(1, np.float32))[4]["tip_deflection"] for _ in range(300)]
+    d = nominal().design
+    ref = simulate(*d.plant, d.observer("thesis"), d.passive, thesis_load(2), t_end=0.3,
+                   v_max=None, dt=1e-3)
+    grid = np.isclose(ref.t / 1e-3, np.round(ref.t / 1e-3), atol=1e-6)
+    np.testing.assert_allclose(ys, ref.y[grid][1:], atol=1e-9 * 1e-3 + 1e-12, rtol=1e-6)
+
+
+def test_clipping_is_reported_and_applied():
+    env = ACLDBeamEnv()
+    env.reset(seed=0)
+    _, _, _, _, info = env.step(np.array([500.0], np.float32))
+    assert info["clipped"] and info["voltage"] == 120.0 and info["requested_voltage"] == 500.0
+    _, _, _, _, info = env.step(np.array([50.0], np.float32))
+    assert not info["clipped"] and info["voltage"] == 50.0
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+def test_non_finite_action_raises_and_leaves_state(bad):
+    env = ACLDBeamEnv()
+    env.reset(seed=0)
+    env.step(np.array([10.0], np.float32))
+    x, k, xhat = env.x.copy(), env.k, env.xhat.copy()
+    state = env.np_random.bit_generator.state
+    with pytest.raises(ValueError, match="action"):
+        env.step(np.array([bad], np.float32))
+    np.testing.assert_array_equal(env.x, x)
+    np.testing.assert_array_equal(env.xhat, xhat)
+    assert env.k == k and env.np_random.bit_generator.state == state
+
+
+def test_wrong_action_shape_raises():
+    env = ACLDBeamEnv()
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="action"):
+        env.step(np.array([1.0, 2.0]))
+
+
+@pytest.mark.parametrize("kw, name", [
+    ({"load_case": 4}, "load_case"), ({"observer": "perfect"}, "observer"),
+    ({"obs_mode": "pixels"}, "obs_mode"), ({"dt": 0}, "dt"), ({"dt": float("nan")}, "dt"),
+    ({"y_ref": -1.0}, "y_ref"), ({"lam": -0.1}, "lam"), ({"param_noise": -0.1}, "param_noise"),
+    ({"sensor_noise": -1e-6}, "sensor_noise"), ({"episode_length": 0.0}, "episode_length"),
+    ({"render_mode": "ansi"}, "render_mode"), ({"deflection_limit": 0}, "deflection_limit"),
+])
+def test_bad_kwargs_name_the_argument(kw, name):
+    with pytest.raises(ValueError, match=name):
+        ACLDBeamEnv(**kw)
+
+
+def test_reset_options_select_load_case_and_reject_unknown_keys():
+    env = ACLDBeamEnv(load_case=1)
+    env.reset(seed=0, options={"load_case": 3})
+    assert env.load.components[0].frequency == 179.0
+    with pytest.raises(ValueError, match="load_case"):
+        env.reset(options={"load_case": 7})
+    with pytest.raises(ValueError, match="options"):
+        env.reset(options={"foo": 1})
+
+
+@pytest.mark.parametrize("mode, n", [("estimate", 7), ("measurement", 9), ("full", 38)])
+def test_observation_modes(mode, n):
+    env = ACLDBeamEnv(obs_mode=mode)
+    obs, info = env.reset(seed=0)
+    assert obs.shape == (n,) and obs.dtype == np.float32
+    for _ in range(5):
+        obs, *_ , info = env.step(np.zeros(1, np.float32))
+    assert env.observation_space.contains(obs)
+    assert {"tip_deflection", "voltage", "tip_load", "time", "xr_true"} <= set(info)
+    assert info["xr_true"].shape == (6,)
+
+
+def test_estimate_scales_are_order_one_for_case1():
+    env = ACLDBeamEnv(load_case=1, sensor_noise=0.0)
+    env.reset(seed=0)
+    peaks = np.zeros(7)
+    for _ in range(200):
+        obs, *_ = env.step(np.zeros(1, np.float32))
+        peaks = np.maximum(peaks, np.abs(obs))
+    assert np.all(peaks > 0.2) and np.all(peaks < 5.0)
+
+
+def test_reward_formula():
+    env = ACLDBeamEnv(y_ref=2e-3, lam=0.5)
+    env.reset(seed=0)
+    _, r, _, _, info = env.step(np.array([60.0], np.float32))
+    expected = -(info["tip_deflection"] / 2e-3) ** 2 - 0.5 * (60.0 / 120.0) ** 2
+    assert r == pytest.approx(expected, rel=1e-12)
+
+
+def test_random_loads_are_bounded_and_seeded():
+    rng = np.random.default_rng(0)
+    t = np.linspace(0, 1, 20001)
+    for _ in range(50):
+        f = random_load(rng, 1.0, 1e-4)(t)
+        assert np.all(np.abs(f) < 3.0)
+    a = random_load(np.random.default_rng(3), 1.0, 1e-4)
+    b = random_load(np.random.default_rng(3), 1.0, 1e-4)
+    assert a == b
+
+
+def test_param_noise_randomizes_plant_not_observer():
+    env = ACLDBeamEnv(param_noise=0.1)
+    env.reset(seed=1)
+    ad1 = env._plant.Ad.copy()
+    env.reset(seed=2)
+    assert not np.allclose(env._plant.Ad, ad1)
+    assert env._obs is env.nom.kalman  # the observer keeps the nominal design
+    assert env._plant is not env.nom.plant
+
+
+def test_render_rgb_array():
+    env = ACLDBeamEnv(render_mode="rgb_array")
+    env.reset(seed=0)
+    for _ in range(5):
+        env.step(np.array([20.0], np.float32))
+    frame = env.render()
+    assert frame.ndim == 3 and frame.shape[2] == 3 and frame.dtype == np.uint8
+    assert frame.std() > 0
+    env.close()
+    env.close()

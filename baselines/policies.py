@@ -11,11 +11,11 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg as sla
 
-from acld_gym.control import THESIS_LQR_WEIGHT
+from acld_gym.control import THESIS_LQR_WEIGHT, THESIS_SMC_WEIGHT
 from acld_gym.env import Nominal, nominal
 from acld_gym.thesis import V_LIMIT
 
-__all__ = ["PassivePolicy", "LQRPolicy", "MPCPolicy", "discrete_lqr_gain"]
+__all__ = ["PassivePolicy", "LQRPolicy", "SMCPolicy", "MPCPolicy", "discrete_lqr_gain"]
 
 
 def discrete_lqr_gain(A: np.ndarray, B: np.ndarray, Q: np.ndarray,
@@ -75,6 +75,48 @@ class LQRPolicy(_Policy):
 
     def voltage(self, xr):
         return -(xr @ self.K[0])
+
+
+class SMCPolicy(_Policy):
+    r"""Discrete sliding-mode control with the thesis's weights (eqs. 68-72, sampled).
+
+    * Surface :math:`\sigma = s x_r` with :math:`s = (1 + B_d^T X B_d)^{-1} B_d^T X`,
+      X from the DARE with :math:`Q = 10^6 S_R^T S_R`, R = 1 (sigma in volts). The
+      thesis's choice -- the LQR gain itself as the surface -- has unstable
+      sliding dynamics once sampled (the discrete gain contains :math:`A_d`;
+      its zero dynamics have |z| = 1.01), while :math:`B_d^T X` gives
+      |z| = 0.975.
+    * Equivalent control (deadbeat on sigma):
+      :math:`u_{eq} = -(s B_d)^{-1} s A_d x_r`.
+    * Switching term :math:`-\operatorname{sign}(s B_d)\,\eta\,
+      \operatorname{sat}(\sigma/\varepsilon)` with
+      :math:`\eta = 1.5 |s E_d / s B_d|` (the thesis's 1.5 margin over one
+      period of 1 N load, ``MixedBeamModel.m``).
+    * Boundary layer :math:`\varepsilon` = 1000 V (default). In discrete time
+      the voltage limit bounds the change of sigma per step to about
+      :math:`2 |s B_d| \cdot 120` V = 235 V; a layer thinner than that
+      band makes the switching term a relay on sigma that never settles
+      (with the thesis's eps = 1 the beam does not settle within 1 s).
+    """
+
+    name = "smc"
+
+    def __init__(self, dt: float = 1e-3, weight: float = THESIS_SMC_WEIGHT,
+                 eta_factor: float = 1.5, eps: float = 1000.0, nom=None):
+        super().__init__(dt, nom)
+        if not eps > 0:
+            raise ValueError(f"eps must be positive [V], got {eps!r}")
+        r, sr = self.nom.design.reduced, self.nom.reduced
+        _, X = discrete_lqr_gain(sr.Ad, sr.Bd, weight * r.SR.T @ r.SR, np.eye(1))
+        B = sr.Bd[:, 0]
+        self.s = (B @ X) / (1.0 + B @ X @ B)
+        self.sb = float(self.s @ B)
+        self.a = (self.s @ sr.Ad) / self.sb
+        self.c = float(np.sign(self.sb)) * eta_factor * abs(float(self.s @ sr.Ed[:, 0]) / self.sb)
+        self.eps = float(eps)
+
+    def voltage(self, xr):
+        return -(xr @ self.a) - self.c * np.clip((xr @ self.s) / self.eps, -1.0, 1.0)
 
 
 class MPCPolicy(_Policy):

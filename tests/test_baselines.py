@@ -8,7 +8,7 @@ from acld_gym.loads import thesis_load
 from acld_gym.metrics import peak, settling_time
 from acld_gym.thesis import thesis_row
 from baselines.bound import clairvoyant_bound
-from baselines.policies import LQRPolicy, MPCPolicy, PassivePolicy
+from baselines.policies import LQRPolicy, MPCPolicy, PassivePolicy, SMCPolicy
 
 SENSOR = 1e-7  # tip-sensor noise [m]: a laser sensor's resolution
 
@@ -30,7 +30,8 @@ def rollout(policy, case, seed=0):
 @pytest.fixture(scope="module")
 def results():
     nom = nominal()
-    pols = {"passive": PassivePolicy(), "lqr": LQRPolicy(), "mpc": MPCPolicy()}
+    pols = {"passive": PassivePolicy(), "lqr": LQRPolicy(), "smc": SMCPolicy(),
+            "mpc": MPCPolicy()}
     out = {}
     for case in (1, 2, 3):
         b = clairvoyant_bound(nom.plant, nom.design.model.tip_index, thesis_load(case), 1000)
@@ -48,7 +49,7 @@ def ise(y):
 def test_bound_is_below_every_policy(results, case):
     # No causal policy can beat the clairvoyant optimum on the same episode.
     b = ise(results[case, "bound"][0])
-    for name in ("passive", "lqr", "mpc"):
+    for name in ("passive", "lqr", "smc", "mpc"):
         assert b <= ise(results[case, name][0]) * (1 + 1e-9), name
     assert np.all(np.abs(results[case, "bound"][1]) <= 120.0 + 1e-9)
 
@@ -62,11 +63,12 @@ def test_mpc_within_1p2_of_bound_and_lqr_ratios(results, case, lqr_ratio):
 
 
 @pytest.mark.parametrize("case", [1, 2, 3])
-def test_lqr_through_env_matches_thesis_saturated_rows(results, case):
-    # Thesis Table 2, saturated LQR rows: peak within 7 %, settling within 10 %.
-    y, v = results[case, "lqr"]
+@pytest.mark.parametrize("name", ["lqr", "smc"])
+def test_through_env_matches_thesis_saturated_rows(results, case, name):
+    # Thesis Table 2, saturated rows: peak within 7 %, settling within 10 %.
+    y, v = results[case, name]
     t = np.arange(1, y.size + 1) * 1e-3
-    ref = thesis_row(case, "lqr", True)
+    ref = thesis_row(case, name, True)
     assert peak(y) * 1e3 == pytest.approx(ref.peak_mm, rel=0.07)
     assert settling_time(t, y) == pytest.approx(ref.settling_s, rel=0.10)
     assert np.max(np.abs(v)) <= 120.0
@@ -83,6 +85,17 @@ def test_predict_protocol_single_and_batched():
     assert ab.shape == (3, 1)
     np.testing.assert_allclose(ab[0], a)
     assert np.all(np.abs(ab) <= 120.0)
+
+
+def test_smc_sliding_dynamics_stable_and_switching_sign():
+    # Zero dynamics of the sampled surface must be stable; sign(s B) c > 0 gives
+    # sigma_{k+1} = -|s B| c sat(.) + ... (reaching condition).
+    pol = SMCPolicy()
+    sr = pol.nom.reduced
+    B = sr.Bd[:, 0]
+    Acl = sr.Ad - np.outer(B, pol.s @ sr.Ad) / pol.sb
+    assert np.max(np.abs(np.linalg.eigvals(Acl))) < 1.0
+    assert pol.sb * pol.c > 0
 
 
 def test_predict_rejects_wrong_observation():
@@ -102,6 +115,8 @@ def test_sb3_evaluate_policy_accepts_baselines():
 
 def test_bad_arguments():
     nom = nominal()
+    with pytest.raises(ValueError, match="eps"):
+        SMCPolicy(eps=0.0)
     with pytest.raises(ValueError, match="horizon"):
         MPCPolicy(horizon=0)
     with pytest.raises(ValueError, match="n_steps"):

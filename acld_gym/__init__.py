@@ -9,4 +9,5 @@ from gymnasium.envs.registration import register, registry
 __version__ = "0.1.0"
 
 if "ACLDBeam-v0" not in registry:
-    register(id="ACLDBeam-v0", entry_point="acld_gym.env:ACLDBeamEnv", max_episode_steps=1000)
+    register(id="ACLDBeam-v0", entry_point="acld_gym.env:ACLDBeamEnv",
+             vector_entry_point="acld_gym.vector_env:ACLDBeamVectorEnv", max_episode_steps=1000)

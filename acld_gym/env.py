@@ -19,11 +19,19 @@ from .params import BeamParameters
 from .simulate import simulate
 from .thesis import V_LIMIT
 
-__all__ = ["ACLDBeamEnv", "Nominal", "nominal", "random_load", "LOAD_CASES", "OBS_MODES"]
+__all__ = ["ACLDBeamEnv", "Nominal", "nominal", "random_load", "LOAD_CASES", "OBS_MODES",
+           "check_config", "check_actions", "observation_size", "estimate_map", "step_matrix",
+           "load_schedule", "draw_episode", "randomized_plant", "reward_of"]
 
 LOAD_CASES = (1, 2, 3, "random")
+#: Default tip-sensor noise std [m]: 0.1 um, the resolution of a laser displacement
+#: sensor. (With 1 um the high-gain LQR turns the noise into voltage jitter and the
+#: thesis's settling times are not reached.)
+SENSOR_NOISE_M = 1e-7
 OBS_MODES = ("estimate", "measurement", "full")
 OBSERVERS = ("kalman", "thesis")
+#: Deflection scale of the observations [m].
+Y_SCALE = 1e-3
 #: Parameters perturbed by ``param_noise`` (multiplicative, log-normal, per episode).
 RANDOMIZED = ("ghm_kappa", "ghm_alpha", "ghm_omega", "ghm_zeta", "vem_density",
               "beam_youngs_modulus", "pzt_youngs_modulus", "d31", "rayleigh_mass",
@@ -45,7 +53,7 @@ class Nominal:
 
 
 @lru_cache(maxsize=8)
-def nominal(dt: float = 1e-3, substeps: int = 10, sensor_std: float = 1e-6,
+def nominal(dt: float = 1e-3, substeps: int = 10, sensor_std: float = SENSOR_NOISE_M,
             load_std: float = 1.0) -> Nominal:
     """Nominal design sampled at ``dt`` (cached: the env, its vector version and
     the baselines share it)."""
@@ -155,7 +163,7 @@ class ACLDBeamEnv(gym.Env):
     | ``observer`` | ``"kalman"`` | ``"kalman"`` (reduced model, not fed the load) or |
     | | | ``"thesis"`` (full order, fed the load) |
     | ``obs_mode`` | ``"estimate"`` | see Observation Space |
-    | ``sensor_noise`` | 1e-6 | tip-sensor noise std [m] (seeded; 0 for none) |
+    | ``sensor_noise`` | 1e-7 | tip-sensor noise std [m] (seeded; 0 for none) |
     | ``y_ref`` | 1e-3 | deflection scale of the reward [m] |
     | ``lam`` | 0.01 | voltage weight of the reward |
     | ``param_noise`` | 0.0 | relative std of per-episode parameter randomization |
@@ -171,23 +179,14 @@ class ACLDBeamEnv(gym.Env):
 
     def __init__(self, load_case: int | str = 1, dt: float = 1e-3, episode_length: float = 1.0,
                  observer: str = "kalman", obs_mode: str = "estimate",
-                 sensor_noise: float = 1e-6, y_ref: float = 1e-3, lam: float = 0.01,
+                 sensor_noise: float = SENSOR_NOISE_M, y_ref: float = 1e-3, lam: float = 0.01,
                  param_noise: float = 0.0, deflection_limit: float = 0.02,
                  render_mode: str | None = None):
-        _check_choice("load_case", load_case, LOAD_CASES)
-        _check_choice("observer", observer, OBSERVERS)
-        _check_choice("obs_mode", obs_mode, OBS_MODES)
-        for name, value in (("dt", dt), ("episode_length", episode_length), ("y_ref", y_ref),
-                            ("deflection_limit", deflection_limit)):
-            _check_positive(name, value)
-        for name, value in (("sensor_noise", sensor_noise), ("lam", lam),
-                            ("param_noise", param_noise)):
-            _check_positive(name, value, allow_zero=True)
-        if episode_length < dt:
-            raise ValueError(f"episode_length must be at least dt, got {episode_length!r}")
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ValueError(f"render_mode must be one of {self.metadata['render_modes']} or "
-                             f"None, got {render_mode!r}")
+        check_config(load_case=load_case, dt=dt, episode_length=episode_length,
+                     observer=observer, obs_mode=obs_mode, sensor_noise=sensor_noise,
+                     y_ref=y_ref, lam=lam, param_noise=param_noise,
+                     deflection_limit=deflection_limit, render_mode=render_mode,
+                     render_modes=self.metadata["render_modes"])
         self.load_case = load_case
         self.dt = float(dt)
         self.episode_length = float(episode_length)
@@ -203,13 +202,13 @@ class ACLDBeamEnv(gym.Env):
         self.v_max = V_LIMIT
         self.nom = nominal(self.dt, 10, max(self.sensor_noise, 1e-9))
         self.obs_hist = 8
-        n_obs = {"estimate": self.nom.design.reduced.order + 1,
-                 "measurement": self.obs_hist + 1, "full": self.nom.plant.Ad.shape[0]}[obs_mode]
+        n_obs = observation_size(self.nom, obs_mode, self.obs_hist)
         self.action_space = spaces.Box(-self.v_max, self.v_max, (1,), np.float32)
         self.observation_space = spaces.Box(-np.inf, np.inf, (n_obs,), np.float32)
         self._tip = self.nom.design.model.tip_index
         self._plant = self.nom.plant
         self._obs = self.nom.thesis if observer == "thesis" else self.nom.kalman
+        self._est = estimate_map(self._obs, self.nom.xr_scale)
         self._fig = None
         self._reset_state(thesis_load(1) if load_case == "random" else thesis_load(load_case))
 
@@ -223,50 +222,35 @@ class ACLDBeamEnv(gym.Env):
         self.y_meas = 0.0
         self.y_hist = np.zeros(self.obs_hist)
         self.history: list[tuple[float, float, float]] = []
+        self._F, self._tipf = load_schedule(self.nom.plant, load, 0, self.max_steps)
+        self._big = step_matrix(self._plant, self.nom.plant, self._obs)
 
-    def _advance_plant(self, v: float) -> np.ndarray:
-        """Exact ZOH step of the (true) plant; returns the load increment used."""
-        f0, f1 = self._plant.load_samples(self.load, self.k * self.dt)
-        inc = self._plant.load_increment(f0, f1)
-        self.x = self._plant.Ad @ self.x + self._plant.Bd[:, 0] * v + inc
-        return inc
+    def _load_row(self, k: int) -> tuple[np.ndarray, float]:
+        """Load samples of period k (precomputed for the episode, computed beyond it)."""
+        if k < self.max_steps:
+            return self._F[k], float(self._tipf[k])
+        F, tip = load_schedule(self.nom.plant, self.load, k, k + 1)
+        return F[0], float(tip[0])
 
     def _measure(self) -> float:
         noise = self.np_random.normal(0.0, self.sensor_noise) if self.sensor_noise else 0.0
         return float(self.x[self._tip] + noise)
 
-    def _update_observer(self, v: float, y_prev: float, plant_inc: np.ndarray) -> None:
-        o = self._obs
-        innov = y_prev - float(o.C[0] @ self.xhat)
-        nxt = o.A @ self.xhat + o.B[:, 0] * v + o.Lp[:, 0] * innov
-        if o.fed_load:
-            f0, f1 = self.nom.plant.load_samples(self.load, self.k * self.dt)
-            nxt = nxt + self.nom.plant.load_increment(f0, f1)
-        self.xhat = nxt
-
-    def _xr_estimate(self) -> np.ndarray:
-        """x_r from the current estimate with the measurement update (L_c)."""
-        o = self._obs
-        innov = self.y_meas - float(o.C[0] @ self.xhat)
-        return o.T @ (self.xhat + o.Lc[:, 0] * innov)
-
     def _observation(self) -> np.ndarray:
         if self.obs_mode == "estimate":
-            out = np.concatenate([self._xr_estimate() / self.nom.xr_scale,
-                                  [self.y_meas / 1e-3]])
+            z = np.concatenate([self.xhat, (self.y_meas,)])
+            out = np.concatenate([z @ self._est, (self.y_meas / Y_SCALE,)])
         elif self.obs_mode == "measurement":
-            out = np.concatenate([self.y_hist / 1e-3, [self.v / self.v_max]])
+            out = np.concatenate([self.y_hist / Y_SCALE, [self.v / self.v_max]])
         else:
             out = self.x
         return out.astype(np.float32)
 
-    def _reward(self, y: float, v: float) -> float:
-        return -((y / self.y_ref) ** 2) - self.lam * (v / self.v_max) ** 2
-
     def _info(self, requested: float | None = None) -> dict[str, Any]:
         y = float(self.x[self._tip])
         t = self.k * self.dt
-        info = {"tip_deflection": y, "voltage": self.v, "tip_load": float(self.load(t)),
+        tip_load = float(self._tipf[self.k]) if self.k <= self.max_steps else float(self.load(t))
+        info = {"tip_deflection": y, "voltage": self.v, "tip_load": tip_load,
                 "time": t, "xr_true": self.nom.design.reduced.SL.T @ self.x,
                 "clipped": False, "requested_voltage": self.v}
         if requested is not None:
@@ -281,48 +265,34 @@ class ACLDBeamEnv(gym.Env):
         case = options.pop("load_case", self.load_case)
         if options:
             raise ValueError(f"options: unknown key(s) {sorted(options)}; expected 'load_case'")
-        _check_choice("load_case", case, LOAD_CASES)
-        load = (random_load(self.np_random, self.episode_length, self._plant.dt /
-                            self._plant.substeps) if case == "random" else thesis_load(case))
-        self._plant = self._randomized_plant() if self.param_noise > 0 else self.nom.plant
+        load, self._plant = draw_episode(self.np_random, case, self.nom, self.episode_length,
+                                         self.param_noise)
         self._reset_state(load)
         self.y_meas = self._measure()
         self.y_hist[-1] = self.y_meas
         return self._observation(), self._info()
 
     def step(self, action):
-        a = np.asarray(action, dtype=np.float64).reshape(-1)
-        if a.size != 1:
-            raise ValueError(f"action must hold one voltage [V], got shape {np.shape(action)}")
-        if not np.isfinite(a[0]):
-            raise ValueError(f"action must be finite, got {a[0]!r}")
-        requested = float(a[0])
-        v = float(np.clip(requested, -self.v_max, self.v_max))
-        y_prev = self.y_meas
-        inc = self._advance_plant(v)              # 1. plant over one period (ZOH)
-        self._update_observer(v, y_prev, inc)     # 2. observer prediction
+        requested_a, v_a = check_actions(action, 1, self.v_max)
+        requested, v = float(requested_a[0]), float(v_a[0])
+        # 1. plant over one period (ZOH) and 2. observer prediction, one product
+        n = self.x.shape[0]
+        f, _ = self._load_row(self.k)
+        s = self._big @ np.concatenate([self.x, self.xhat, (self.y_meas, v), f])
+        self.x, self.xhat = s[:n], s[n:]
         self.k += 1
         self.v = v
         self.y_meas = self._measure()             # 3. new measurement
-        self.y_hist = np.roll(self.y_hist, -1)
+        self.y_hist[:-1] = self.y_hist[1:]
         self.y_hist[-1] = self.y_meas
         y = float(self.x[self._tip])
-        reward = self._reward(y, v)               # 4. reward on the true deflection
+        reward = reward_of(y, v, self.y_ref, self.lam, self.v_max)  # 4. on the true deflection
         terminated = bool(abs(y) > self.deflection_limit)  # 5. physical limit
         truncated = bool(self.k >= self.max_steps)
         self.history.append((self.k * self.dt, y, v))
         if self.render_mode == "human":
             self.render()
         return self._observation(), float(reward), terminated, truncated, self._info(requested)
-
-    def _randomized_plant(self) -> SampledSystem:
-        p = BeamParameters()
-        noise = self.np_random.normal(0.0, self.param_noise, len(RANDOMIZED))
-        changed = {name: getattr(p, name) * float(np.exp(z))
-                   for name, z in zip(RANDOMIZED, noise, strict=True)}
-        m = build_model(replace(p, **changed))
-        A, B, E, _ = m.state_space()
-        return discretize(A, B, E, self.dt, self.nom.plant.substeps)
 
     def render(self):
         if self.render_mode is None:
@@ -363,3 +333,108 @@ def _check_positive(name: str, value, allow_zero: bool = False) -> None:
         need = "a non-negative" if allow_zero else "a positive"
         raise ValueError(f"{name} must be {need} finite number, got {value!r}")
 
+
+
+# --- pieces shared by ACLDBeamEnv and ACLDBeamVectorEnv ------------------------
+def check_config(*, load_case, dt, episode_length, observer, obs_mode, sensor_noise, y_ref, lam,
+                 param_noise, deflection_limit, render_mode, render_modes) -> None:
+    """Validate the environment's keyword arguments (``ValueError`` on a bad one)."""
+    _check_choice("load_case", load_case, LOAD_CASES)
+    _check_choice("observer", observer, OBSERVERS)
+    _check_choice("obs_mode", obs_mode, OBS_MODES)
+    for name, value in (("dt", dt), ("episode_length", episode_length), ("y_ref", y_ref),
+                        ("deflection_limit", deflection_limit)):
+        _check_positive(name, value)
+    for name, value in (("sensor_noise", sensor_noise), ("lam", lam),
+                        ("param_noise", param_noise)):
+        _check_positive(name, value, allow_zero=True)
+    if episode_length < dt:
+        raise ValueError(f"episode_length must be at least dt, got {episode_length!r}")
+    if render_mode is not None and render_mode not in render_modes:
+        raise ValueError(f"render_mode must be one of {list(render_modes)} or "
+                         f"None, got {render_mode!r}")
+
+
+def check_actions(action, n: int, v_max: float) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` requested voltages as float64 and their clipped values; ``ValueError``
+    on a wrong size or a non-finite voltage (before any state changes)."""
+    a = np.asarray(action, dtype=np.float64).reshape(-1)
+    if a.size != n:
+        raise ValueError(f"action must hold {n} voltage(s) [V], got shape {np.shape(action)}")
+    if not np.isfinite(a).all():
+        raise ValueError(f"action must be finite, got {a[~np.isfinite(a)][0]!r}")
+    return a, np.clip(a, -v_max, v_max)
+
+
+def observation_size(nom: Nominal, obs_mode: str, hist: int) -> int:
+    return {"estimate": nom.design.reduced.order + 1, "measurement": hist + 1,
+            "full": nom.plant.Ad.shape[0]}[obs_mode]
+
+
+def estimate_map(obs: DiscreteObserver, xr_scale: np.ndarray) -> np.ndarray:
+    """Matrix M with ``[xhat, y] @ M`` = the scaled x_r estimate after the measurement
+    update, ``T (xhat + L_c (y - C xhat)) / xr_scale``."""
+    lc = obs.Lc[:, 0]
+    M = np.vstack([(obs.T @ (np.eye(obs.n) - np.outer(lc, obs.C[0]))).T, (obs.T @ lc)[None, :]])
+    return M / xr_scale
+
+
+def step_matrix(plant: SampledSystem, nom_plant: SampledSystem,
+                obs: DiscreteObserver) -> np.ndarray:
+    """One period of plant and observer as one matrix S:
+    ``[x', xhat'] = S [x, xhat, y_prev, V, f0, f1]`` with ``y_prev`` the last
+    measurement, ``f0, f1`` the period's load samples (:func:`load_schedule`).
+    The plant may be randomized; the observer uses the nominal load weights."""
+    n, k, s = plant.Ad.shape[0], obs.n, plant.substeps
+    S = np.zeros((n + k, n + k + 2 + 2 * s))
+    S[:n, :n] = plant.Ad
+    S[:n, n + k + 1] = plant.Bd[:, 0]
+    S[:n, n + k + 2:] = np.hstack([plant.W0, plant.W1])
+    lp = obs.Lp[:, 0]
+    S[n:, n:n + k] = obs.A - np.outer(lp, obs.C[0])
+    S[n:, n + k] = lp
+    S[n:, n + k + 1] = obs.B[:, 0]
+    if obs.fed_load:
+        S[n:, n + k + 2:] = np.hstack([nom_plant.W0, nom_plant.W1])
+    return S
+
+
+def load_schedule(plant: SampledSystem, load: TipLoad, start: int,
+                  stop: int) -> tuple[np.ndarray, np.ndarray]:
+    """Load samples of periods ``start .. stop-1``: ``(F, tip)`` with F (steps, 2 substeps)
+    ``[f0, f1]`` as :meth:`SampledSystem.load_samples` and tip (steps + 1,) the load at
+    the period starts ``k dt`` (for ``info``)."""
+    k = np.arange(start, stop + 1)
+    tt = (k[:-1] * plant.dt)[:, None] + plant.times
+    eps = 1e-9 * plant.dt
+    F = np.hstack([load(tt[:, :-1] + eps), load(tt[:, 1:] - eps)])
+    return F, load(k * plant.dt)
+
+
+def draw_episode(rng: np.random.Generator, case, nom: Nominal, episode_length: float,
+                 param_noise: float) -> tuple[TipLoad, SampledSystem]:
+    """The load and the (possibly randomized) plant of an episode, drawn from ``rng``
+    in a fixed order: load first, then parameters."""
+    _check_choice("load_case", case, LOAD_CASES)
+    plant = nom.plant
+    load = (random_load(rng, episode_length, plant.dt / plant.substeps) if case == "random"
+            else thesis_load(case))
+    if param_noise > 0:
+        plant = randomized_plant(rng, param_noise, plant.dt, plant.substeps)
+    return load, plant
+
+
+def randomized_plant(rng: np.random.Generator, param_noise: float, dt: float,
+                     substeps: int) -> SampledSystem:
+    p = BeamParameters()
+    noise = rng.normal(0.0, param_noise, len(RANDOMIZED))
+    changed = {name: getattr(p, name) * float(np.exp(z))
+               for name, z in zip(RANDOMIZED, noise, strict=True)}
+    m = build_model(replace(p, **changed))
+    A, B, E, _ = m.state_space()
+    return discretize(A, B, E, dt, substeps)
+
+
+def reward_of(y, v, y_ref: float, lam: float, v_max: float):
+    """``-(y / y_ref)^2 - lam (V / v_max)^2`` (scalars or arrays)."""
+    return -((y / y_ref) ** 2) - lam * (v / v_max) ** 2

@@ -76,7 +76,7 @@ def _noise_covariances(red: ReducedModel, load_std: float, sensor_std: float):
     return W, np.array([[sensor_std**2]])
 
 
-def kalman_observer(red: ReducedModel, load_std: float = 1.0, sensor_std: float = 1e-6,
+def kalman_observer(red: ReducedModel, load_std: float = 1.0, sensor_std: float = 1e-7,
                     bandwidth_s: float = 1e-3) -> Observer:
     """Continuous steady-state Kalman filter on the reduced model.
 
@@ -123,7 +123,7 @@ class DiscreteObserver:
 
 
 def discrete_kalman(Ad: np.ndarray, Bd: np.ndarray, Ed: np.ndarray, Cr: np.ndarray,
-                    load_std: float = 1.0, sensor_std: float = 1e-6) -> DiscreteObserver:
+                    load_std: float = 1.0, sensor_std: float = 1e-7) -> DiscreteObserver:
     """Steady-state discrete Kalman filter for the sampled reduced model.
 
     ``Ed`` is the sampled load input (state increment for 1 N held over a

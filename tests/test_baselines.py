@@ -10,7 +10,7 @@ from acld_gym.thesis import thesis_row
 from baselines.bound import clairvoyant_bound
 from baselines.policies import LQRPolicy, MPCPolicy, PassivePolicy, SMCPolicy
 
-SENSOR = 1e-7  # tip-sensor noise [m]: a laser sensor's resolution
+SENSOR = 1e-7  # tip-sensor noise [m], the env default
 
 
 def rollout(policy, case, seed=0):

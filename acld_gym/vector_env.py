@@ -1,0 +1,297 @@
+"""``ACLDBeam-v0`` as a native batched :class:`gymnasium.vector.VectorEnv`.
+
+``gym.make_vec("ACLDBeam-v0", num_envs=N)`` builds :class:`ACLDBeamVectorEnv`
+(the spec's ``vector_entry_point``; gymnasium picks it by default when the spec
+has one, ``vectorization_mode="sync"`` still gives N single envs). All N beams
+and observers advance in one matrix product per step; per env the semantics
+are those of :class:`acld_gym.env.ACLDBeamEnv` (same shared building blocks,
+equal trajectories up to floating-point rounding).
+
+Randomness: sub-env i has its own generator, seeded ``seed + i`` by
+``reset(seed=seed)`` as gymnasium seeds the sub-envs of a sync vector env, and
+draws in the single env's order (load, parameters, sensor noise). The sensor
+noise of a whole episode is drawn at its reset (same numbers as the single
+env's per-step draws); after an episode that terminates early the generator
+is therefore further along than a single env's.
+
+Autoreset is ``NEXT_STEP`` (like ``CartPoleVectorEnv``): the step after a
+sub-env terminated or truncated resets it, ignores its action and returns its
+reset observation with reward 0 and both flags False.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+from gymnasium.utils import seeding
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import batch_space
+
+from .env import (
+    LOAD_CASES,
+    SENSOR_NOISE_M,
+    Y_SCALE,
+    _check_choice,
+    check_actions,
+    check_config,
+    draw_episode,
+    estimate_map,
+    load_schedule,
+    nominal,
+    observation_size,
+    reward_of,
+    step_matrix,
+)
+from .loads import thesis_load
+from .thesis import V_LIMIT
+
+__all__ = ["ACLDBeamVectorEnv"]
+
+INFO_KEYS = ("tip_deflection", "voltage", "tip_load", "time", "clipped")
+
+
+class ACLDBeamVectorEnv(VectorEnv):
+    """N independent ACLD beams (see :class:`acld_gym.env.ACLDBeamEnv` for the
+    physics, spaces, reward and keyword arguments).
+
+    ``max_episode_steps`` truncates episodes (as ``TimeLimit`` does for the single
+    env); the episode also ends after ``episode_length / dt`` steps.
+    ``info`` holds arrays ``tip_deflection``, ``voltage``, ``tip_load``, ``time``,
+    ``clipped`` and their ``_key`` masks. ``render()`` draws sub-env 0
+    (``render_mode="rgb_array"``).
+    """
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 30,
+                "autoreset_mode": AutoresetMode.NEXT_STEP}
+
+    def __init__(self, num_envs: int = 1, max_episode_steps: int | None = None,
+                 load_case: int | str = 1, dt: float = 1e-3, episode_length: float = 1.0,
+                 observer: str = "kalman", obs_mode: str = "estimate",
+                 sensor_noise: float = SENSOR_NOISE_M, y_ref: float = 1e-3, lam: float = 0.01,
+                 param_noise: float = 0.0, deflection_limit: float = 0.02,
+                 render_mode: str | None = None):
+        if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) \
+                or num_envs < 1:
+            raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
+        check_config(load_case=load_case, dt=dt, episode_length=episode_length,
+                     observer=observer, obs_mode=obs_mode, sensor_noise=sensor_noise,
+                     y_ref=y_ref, lam=lam, param_noise=param_noise,
+                     deflection_limit=deflection_limit, render_mode=render_mode,
+                     render_modes=self.metadata["render_modes"])
+        steps = int(round(episode_length / dt))
+        if max_episode_steps is not None:
+            if isinstance(max_episode_steps, bool) or not isinstance(
+                    max_episode_steps, (int, np.integer)) or max_episode_steps < 1:
+                raise ValueError("max_episode_steps must be a positive integer or None, got "
+                                 f"{max_episode_steps!r}")
+            steps = min(steps, int(max_episode_steps))
+        self.num_envs = int(num_envs)
+        self.max_episode_steps = max_episode_steps
+        self.horizon = steps
+        self.load_case = load_case
+        self.dt = float(dt)
+        self.episode_length = float(episode_length)
+        self.observer_kind = observer
+        self.obs_mode = obs_mode
+        self.sensor_noise = float(sensor_noise)
+        self.y_ref = float(y_ref)
+        self.lam = float(lam)
+        self.param_noise = float(param_noise)
+        self.deflection_limit = float(deflection_limit)
+        self.render_mode = render_mode
+        self.v_max = V_LIMIT
+        self.obs_hist = 8
+        self.nom = nominal(self.dt, 10, max(self.sensor_noise, 1e-9))
+        self._obs = self.nom.thesis if observer == "thesis" else self.nom.kalman
+        self._est = estimate_map(self._obs, self.nom.xr_scale)
+        self._tip = self.nom.design.model.tip_index
+        n_obs = observation_size(self.nom, obs_mode, self.obs_hist)
+        self.single_action_space = spaces.Box(-self.v_max, self.v_max, (1,), np.float32)
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+        self.single_observation_space = spaces.Box(-np.inf, np.inf, (n_obs,), np.float32)
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+
+        N, n, k = self.num_envs, self.nom.plant.Ad.shape[0], self._obs.n
+        self._n, self._k = n, k
+        self._S_nom = step_matrix(self.nom.plant, self.nom.plant, self._obs)
+        self._ST = np.ascontiguousarray(self._S_nom.T)
+        # Per-env step matrices only with parameter noise (batched einsum).
+        self._S = (np.repeat(self._S_nom[None], N, axis=0) if self.param_noise > 0 else None)
+        # Z = [x, xhat, y_meas, V, f0, f1]: the step is new[:, :n+k] = Z @ S.T.
+        self._Z = np.zeros((N, self._S_nom.shape[1]))
+        self._ycol, self._vcol, self._fcol = n + k, n + k + 1, n + k + 2
+        # Load tables: rows 0..2 thesis cases 1..3, rows 3.. one per sub-env (random loads).
+        self._pool_F = np.zeros((3, steps, 2 * self.nom.plant.substeps))
+        self._pool_tip = np.zeros((3, steps + 1))
+        for c in (1, 2, 3):
+            self._pool_F[c - 1], self._pool_tip[c - 1] = load_schedule(
+                self.nom.plant, thesis_load(c), 0, steps)
+        if load_case == "random":
+            self._grow_pool()
+        self._slot = np.zeros(N, dtype=np.intp)
+        self._steps = np.zeros(N, dtype=np.intp)
+        self._noise = np.zeros((N, steps + 1))
+        self._y_hist = np.zeros((N, self.obs_hist))
+        self._clipped = np.zeros(N, dtype=bool)
+        self._prev_done = np.zeros(N, dtype=bool)
+        self._idx = np.arange(N)
+        self._rngs: list[np.random.Generator] = [seeding.np_random(None)[0] for _ in range(N)]
+        self._loads: list = [thesis_load(1)] * N
+        self._fig = None
+        self._viewer = None
+
+    # --- helpers -------------------------------------------------------------
+    def _grow_pool(self) -> None:
+        if self._pool_F.shape[0] == 3:
+            N = self.num_envs
+            self._pool_F = np.concatenate(
+                [self._pool_F, np.zeros((N,) + self._pool_F.shape[1:])])
+            self._pool_tip = np.concatenate(
+                [self._pool_tip, np.zeros((N, self._pool_tip.shape[1]))])
+
+    def _reset_env(self, i: int, case) -> None:
+        """Reset sub-env i from its own generator (same draws as the single env)."""
+        rng = self._rngs[i]
+        load, plant = draw_episode(rng, case, self.nom, self.episode_length, self.param_noise)
+        self._loads[i] = load
+        if case == "random":
+            self._grow_pool()
+            slot = 3 + i
+            self._pool_F[slot], self._pool_tip[slot] = load_schedule(
+                self.nom.plant, load, 0, self.horizon)
+        else:
+            slot = case - 1
+        self._slot[i] = slot
+        if self._S is not None:
+            self._S[i] = step_matrix(plant, self.nom.plant, self._obs)
+        self._steps[i] = 0
+        if self.sensor_noise:
+            self._noise[i] = rng.normal(0.0, self.sensor_noise, self.horizon + 1)
+        self._Z[i] = 0.0
+        y = self._noise[i, 0]
+        self._Z[i, self._ycol] = y
+        self._y_hist[i] = 0.0
+        self._y_hist[i, -1] = y
+        self._clipped[i] = False
+
+    def _observations(self) -> np.ndarray:
+        Z, n, k = self._Z, self._n, self._k
+        y = Z[:, self._ycol]
+        if self.obs_mode == "estimate":
+            out = np.empty((self.num_envs, self._est.shape[1] + 1))
+            np.matmul(Z[:, n:n + k + 1], self._est, out=out[:, :-1])
+            out[:, -1] = y / Y_SCALE
+        elif self.obs_mode == "measurement":
+            out = np.empty((self.num_envs, self.obs_hist + 1))
+            out[:, :-1] = self._y_hist / Y_SCALE
+            out[:, -1] = Z[:, self._vcol] / self.v_max
+        else:
+            out = Z[:, :n]
+        return out.astype(np.float32)
+
+    def _infos(self) -> dict[str, Any]:
+        N = self.num_envs
+        ones = np.ones(N, dtype=bool)
+        vals = {"tip_deflection": self._Z[:, self._tip].copy(),
+                "voltage": self._Z[:, self._vcol].copy(),
+                "tip_load": self._pool_tip[self._slot, self._steps],
+                "time": self._steps * self.dt,
+                "clipped": self._clipped.copy()}
+        info: dict[str, Any] = {}
+        for key in INFO_KEYS:
+            info[key] = vals[key]
+            info["_" + key] = ones
+        return info
+
+    # --- Gymnasium API -------------------------------------------------------
+    def reset(self, *, seed: int | list[int | None] | None = None,
+              options: dict | None = None):
+        super().reset(seed=seed if isinstance(seed, (int, np.integer)) else None)
+        N = self.num_envs
+        if seed is not None:
+            seeds = ([int(seed) + i for i in range(N)] if isinstance(seed, (int, np.integer))
+                     else list(seed))
+            if len(seeds) != N:
+                raise ValueError(f"seed: expected an int or {N} seeds, got {len(seeds)}")
+            self._rngs = [seeding.np_random(s)[0] for s in seeds]
+        options = dict(options or {})
+        case = options.pop("load_case", self.load_case)
+        if options:
+            raise ValueError(f"options: unknown key(s) {sorted(options)}; expected 'load_case'")
+        _check_choice("load_case", case, LOAD_CASES)
+        for i in range(N):
+            self._reset_env(i, case)
+        self._prev_done[:] = False
+        return self._observations(), self._infos()
+
+    def step(self, actions):
+        requested, v = check_actions(actions, self.num_envs, self.v_max)
+        Z, n, k, idx = self._Z, self._n, self._k, self._idx
+        reset = self._prev_done
+        Z[:, self._vcol] = v
+        Z[:, self._fcol:] = self._pool_F[self._slot, np.minimum(self._steps, self.horizon - 1)]
+        if self._S is None:
+            Z[:, :n + k] = Z @ self._ST
+        else:
+            Z[:, :n + k] = np.einsum("nij,nj->ni", self._S, Z)
+        self._steps += 1
+        y_true = Z[:, self._tip]
+        y = y_true + self._noise[idx, np.minimum(self._steps, self.horizon)]
+        Z[:, self._ycol] = y
+        self._y_hist[:, :-1] = self._y_hist[:, 1:]
+        self._y_hist[:, -1] = y
+        self._clipped = requested != v
+        rewards = reward_of(y_true, v, self.y_ref, self.lam, self.v_max)
+        terminated = np.abs(y_true) > self.deflection_limit
+        truncated = self._steps >= self.horizon
+        if reset.any():  # NEXT_STEP autoreset: these sub-envs ignore their action
+            for i in np.flatnonzero(reset):
+                self._reset_env(int(i), self.load_case)
+            rewards[reset] = 0.0
+            terminated[reset] = False
+            truncated[reset] = False
+        self._prev_done = terminated | truncated
+        return self._observations(), rewards, terminated, truncated, self._infos()
+
+    def render(self):
+        if self.render_mode is None:
+            gym.logger.warn("render() called without render_mode; pass render_mode= to "
+                            "make_vec()")
+            return None
+        from .render import render_frame
+
+        frame, self._fig = render_frame(_EnvView(self, 0), self._fig)
+        return frame
+
+    def close_extras(self, **kwargs):
+        if self._fig is not None:
+            from .render import close
+
+            close(self._fig)
+            self._fig = None
+
+    def __getstate__(self):
+        state = self.__dict__.copy()
+        state["_fig"] = None
+        return state
+
+
+class _EnvView:
+    """Sub-env i seen as a single env by :func:`acld_gym.render.render_frame`."""
+
+    def __init__(self, venv: ACLDBeamVectorEnv, i: int):
+        self.nom = venv.nom
+        self.render_mode = venv.render_mode
+        self.x = venv._Z[i, :venv._n]
+        self.v = float(venv._Z[i, venv._vcol])
+        self.k = int(venv._steps[i])
+        self.dt = venv.dt
+        self.load = venv._loads[i]
+        self.v_max = venv.v_max
+        self.deflection_limit = venv.deflection_limit
+        self.history: list = []
+
+

@@ -1,0 +1,189 @@
+"""Evaluate the reference policies on the thesis's three load cases in ``ACLDBeam-v0``.
+
+``python -m baselines.evaluate [--json PATH] [--plots DIR]`` prints a table per case
+(peak [mm], 5 % settling [s], ISE [m^2 s], max |V| [V], return) for passive, LQR,
+SMC, MPC and the clairvoyant bound, all with the +/-120 V limit, 1 ms control and
+the default Kalman observer. Any object with SB3's ``predict`` can be evaluated
+with :func:`rollout`, so trained agents use the same code.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+
+from acld_gym.env import ACLDBeamEnv, nominal, reward_of
+from acld_gym.metrics import max_abs, peak, settling_time
+
+__all__ = ["EvalRow", "Episode", "rollout", "bound_episode", "evaluate", "format_tables"]
+
+
+@dataclass(frozen=True)
+class Episode:
+    """Per-step record of one episode: t [s], y [m], voltage [V], reward."""
+
+    t: np.ndarray
+    y: np.ndarray
+    voltage: np.ndarray
+    reward: np.ndarray
+    seconds_per_step: float
+
+
+@dataclass(frozen=True)
+class EvalRow:
+    case: int | str
+    policy: str
+    peak_mm: float
+    settling_s: float
+    ise: float
+    max_voltage_V: float
+    # ``return`` is a keyword; stored as ``ret`` and written as "return".
+    ret: float
+    ms_per_step: float
+
+    def as_dict(self) -> dict:
+        d = asdict(self)
+        d["return"] = d.pop("ret")
+        return d
+
+
+def rollout(policy, env: ACLDBeamEnv, seed: int = 0, options: dict | None = None) -> Episode:
+    """Run one deterministic episode of ``policy`` (SB3 ``predict``) in ``env``."""
+    obs, _ = env.reset(seed=seed, options=options)
+    t, y, v, r = [], [], [], []
+    spent = 0.0
+    done = False
+    while not done:
+        t0 = time.perf_counter()
+        action, _ = policy.predict(obs, deterministic=True)
+        spent += time.perf_counter() - t0
+        obs, reward, term, trunc, info = env.step(action)
+        t.append(info["time"])
+        y.append(info["tip_deflection"])
+        v.append(info["voltage"])
+        r.append(reward)
+        done = term or trunc
+    return Episode(np.array(t), np.array(y), np.array(v), np.array(r), spent / len(t))
+
+
+def bound_episode(env: ACLDBeamEnv) -> Episode:
+    """The clairvoyant bound for ``env``'s current load and (nominal) plant."""
+    from .bound import clairvoyant_bound
+
+    t0 = time.perf_counter()
+    sol = clairvoyant_bound(env._plant, env.nom.design.model.tip_index, env.load, env.max_steps)
+    spent = time.perf_counter() - t0
+    t = np.arange(1, env.max_steps + 1) * env.dt
+    reward = reward_of(sol.y, sol.voltage, env.y_ref, env.lam, env.v_max)
+    return Episode(t, sol.y, sol.voltage, reward, spent / env.max_steps)
+
+
+def metrics_row(case, name: str, ep: Episode) -> EvalRow:
+    dt = float(ep.t[1] - ep.t[0]) if ep.t.size > 1 else float(ep.t[0])
+    return EvalRow(case=case, policy=name, peak_mm=peak(ep.y) * 1e3,
+                   settling_s=settling_time(ep.t, ep.y), ise=float(np.sum(ep.y**2) * dt),
+                   max_voltage_V=max_abs(ep.voltage), ret=float(np.sum(ep.reward)),
+                   ms_per_step=1e3 * ep.seconds_per_step)
+
+
+def default_policies() -> dict:
+    from .policies import LQRPolicy, MPCPolicy, PassivePolicy, SMCPolicy
+
+    return {"passive": PassivePolicy(), "lqr": LQRPolicy(), "smc": SMCPolicy(),
+            "mpc": MPCPolicy()}
+
+
+def evaluate(policies: dict | None = None, cases=(1, 2, 3), seed: int = 0,
+             env_kwargs: dict | None = None, episodes: dict | None = None) -> list[EvalRow]:
+    """Rows for every (case, policy) plus the bound; fills ``episodes`` if given."""
+    policies = default_policies() if policies is None else policies
+    rows = []
+    for case in cases:
+        env = ACLDBeamEnv(load_case=case, **(env_kwargs or {}))
+        for name, pol in policies.items():
+            ep = rollout(pol, env, seed=seed)
+            rows.append(metrics_row(case, name, ep))
+            if episodes is not None:
+                episodes[case, name] = ep
+        env.reset(seed=seed)
+        ep = bound_episode(env)
+        rows.append(metrics_row(case, "bound", ep))
+        if episodes is not None:
+            episodes[case, "bound"] = ep
+    return rows
+
+
+def format_tables(rows: list[EvalRow]) -> str:
+    out = []
+    for case in dict.fromkeys(r.case for r in rows):
+        sub = [r for r in rows if r.case == case]
+        bound = next((r.ise for r in sub if r.policy == "bound"), None)
+        lqr = next((r.ise for r in sub if r.policy == "lqr"), None)
+        out.append(f"\nload case {case}")
+        out.append(f"{'policy':>8} {'peak [mm]':>10} {'settle [s]':>10} {'ISE [m^2 s]':>12} "
+                   f"{'/LQR':>6} {'/bound':>7} {'max|V|':>7} {'return':>10} {'ms/step':>8}")
+        for r in sub:
+            rel_l = f"{r.ise / lqr:6.2f}" if lqr else "     -"
+            rel_b = f"{r.ise / bound:7.2f}" if bound else "      -"
+            out.append(f"{r.policy:>8} {r.peak_mm:10.3f} {r.settling_s:10.3f} {r.ise:12.3e} "
+                       f"{rel_l} {rel_b} {r.max_voltage_V:7.1f} {r.ret:10.1f} "
+                       f"{r.ms_per_step:8.3f}")
+    return "\n".join(out)
+
+
+def plot_episodes(episodes: dict, directory: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    directory.mkdir(parents=True, exist_ok=True)
+    for case in dict.fromkeys(c for c, _ in episodes):
+        fig, ax = plt.subplots(2, 1, sharex=True, figsize=(8, 6))
+        for (c, name), ep in episodes.items():
+            if c != case:
+                continue
+            ax[0].plot(ep.t, ep.y * 1e3, lw=0.8, label=name)
+            ax[1].plot(ep.t, ep.voltage, lw=0.8, label=name)
+        ax[0].set_ylabel("tip deflection [mm]")
+        ax[1].set_ylabel("voltage [V]")
+        ax[1].set_xlabel("time [s]")
+        ax[0].set_title(f"Load case {case}: all policies, +/-120 V, 1 ms, Kalman observer")
+        ax[0].legend(ncol=5, fontsize=8)
+        for a in ax:
+            a.grid(alpha=0.3)
+        fig.tight_layout()
+        fig.savefig(directory / f"policies_case{case}.png", dpi=110)
+        plt.close(fig)
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(prog="python -m baselines.evaluate", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--json", metavar="PATH", help="write the rows as JSON")
+    p.add_argument("--plots", metavar="DIR", help="write one figure per case to DIR")
+    p.add_argument("--seed", type=int, default=0, help="episode seed (sensor noise)")
+    args = p.parse_args(argv)
+    nominal()  # build the design once before timing anything
+    episodes: dict = {}
+    rows = evaluate(seed=args.seed, episodes=episodes)
+    print(format_tables(rows))
+    if args.json:
+        path = Path(args.json)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps([r.as_dict() for r in rows], indent=2) + "\n")
+        print(f"\nwrote {path}")
+    if args.plots:
+        plot_episodes(episodes, Path(args.plots))
+        print(f"wrote figures to {args.plots}/")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -15,9 +15,10 @@ $(STAMP): pyproject.toml constraints.txt
 
 install: $(STAMP)
 
-## Reproduce the thesis (Table 2, figures) and the benchmark comparison.
+## Reproduce the thesis (Table 2, figures), then evaluate the reference policies in the env.
 run: $(STAMP)
 	$(BIN)/acld-gym reproduce --json results/table2.json --plots results/figures
+	$(BIN)/python -m baselines.evaluate --json results/baselines.json --plots results/figures
 
 ## Lint + the test suite (slow tests excluded; see test-slow).
 test: $(STAMP)
@@ -33,6 +34,7 @@ format: $(STAMP)
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_reproduce.py
+	$(BIN)/python benchmarks/bench_env.py
 
 clean:
 	rm -rf $(VENV) results .pytest_cache

@@ -222,3 +222,21 @@ def test_render_rgb_array():
     assert frame.std() > 0
     env.close()
     env.close()
+
+
+def test_works_in_sb3_subprocvecenv():
+    from stable_baselines3.common.env_util import make_vec_env
+    from stable_baselines3.common.vec_env import SubprocVecEnv
+
+    venv = make_vec_env(ACLDBeamEnv, n_envs=2, seed=0, vec_env_cls=SubprocVecEnv,
+                        vec_env_kwargs={"start_method": "fork"},
+                        env_kwargs={"load_case": "random"})
+    try:
+        obs = venv.reset()
+        assert obs.shape == (2, 7)
+        for _ in range(5):
+            obs, rew, done, infos = venv.step(np.array([[10.0], [-10.0]], np.float32))
+        assert obs.shape == (2, 7) and rew.shape == (2,) and not done.any()
+        assert all("tip_deflection" in i for i in infos)
+    finally:
+        venv.close()

@@ -1,0 +1,43 @@
+"""baselines.evaluate: the rows, the JSON schema and the CLI."""
+
+import json
+
+import numpy as np
+import pytest
+
+from baselines.evaluate import evaluate, format_tables, main
+from baselines.policies import LQRPolicy, PassivePolicy
+
+KEYS = {"case", "policy", "peak_mm", "settling_s", "ise", "max_voltage_V", "return"}
+
+
+def test_rows_and_relative_figures():
+    rows = evaluate({"passive": PassivePolicy(), "lqr": LQRPolicy()}, cases=(1,))
+    names = [r.policy for r in rows]
+    assert names == ["passive", "lqr", "bound"]
+    ise = {r.policy: r.ise for r in rows}
+    assert ise["bound"] < ise["lqr"] < ise["passive"]
+    text = format_tables(rows)
+    assert "load case 1" in text and "bound" in text
+    # ISE / bound of the bound row is exactly 1.
+    bound_line = [line for line in text.splitlines() if line.strip().startswith("bound")][0]
+    assert " 1.00 " in bound_line
+
+
+def test_cli_writes_json_with_issue_keys(tmp_path):
+    path = tmp_path / "b.json"
+    assert main(["--json", str(path)]) == 0
+    rows = json.loads(path.read_text())
+    assert len(rows) == 15  # 3 cases x (passive, lqr, smc, mpc, bound)
+    for r in rows:
+        assert KEYS <= set(r)
+        assert r["policy"] in {"passive", "lqr", "smc", "mpc", "bound"}
+        assert r["case"] in (1, 2, 3)
+        assert np.isfinite(r["ise"]) and r["max_voltage_V"] <= 120.0 + 1e-9
+
+
+def test_cli_bad_argument_exits_2(capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["--seed", "abc"])
+    assert e.value.code == 2
+    assert "--seed" in capsys.readouterr().err

@@ -16,6 +16,7 @@ from .loads import Harmonic, Pulse, Samples, TipLoad, thesis_load
 from .model import build_model
 from .observer import DiscreteObserver, discrete_kalman, discrete_thesis
 from .params import BeamParameters
+from .render import FigureOwner
 from .simulate import simulate
 from .thesis import V_LIMIT
 
@@ -102,7 +103,7 @@ def random_load(rng: np.random.Generator, duration: float, grid: float) -> TipLo
     return TipLoad(tuple(comps))
 
 
-class ACLDBeamEnv(gym.Env):
+class ACLDBeamEnv(FigureOwner, gym.Env):
     """
     ## Description
 
@@ -309,16 +310,7 @@ class ACLDBeamEnv(gym.Env):
         return frame
 
     def close(self):
-        if self._fig is not None:
-            from .render import close
-
-            close(self._fig)
-            self._fig = None
-
-    def __getstate__(self):
-        state = self.__dict__.copy()
-        state["_fig"] = None
-        return state
+        self._close_figure()
 
 
 def _check_choice(name: str, value, choices) -> None:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["render_frame", "show", "close"]
+__all__ = ["render_frame", "show", "close", "FigureOwner"]
 
 
 def _beam_shape(env) -> tuple[np.ndarray, np.ndarray]:
@@ -66,3 +66,20 @@ def close(fig) -> None:
     import matplotlib.pyplot as plt
 
     plt.close(fig)
+
+
+class FigureOwner:
+    """Mixin for envs that keep a matplotlib figure: closes it once and leaves it
+    out of pickles (figures do not pickle; a new one is made on the next render)."""
+
+    _fig = None
+
+    def _close_figure(self) -> None:
+        if self._fig is not None:
+            close(self._fig)
+            self._fig = None
+
+    def __getstate__(self):
+        state = self.__dict__.copy()
+        state["_fig"] = None
+        return state

@@ -46,6 +46,7 @@ from .env import (
     step_matrix,
 )
 from .loads import thesis_load
+from .render import FigureOwner
 from .thesis import V_LIMIT
 
 __all__ = ["ACLDBeamVectorEnv"]
@@ -53,7 +54,7 @@ __all__ = ["ACLDBeamVectorEnv"]
 INFO_KEYS = ("tip_deflection", "voltage", "tip_load", "time", "clipped")
 
 
-class ACLDBeamVectorEnv(VectorEnv):
+class ACLDBeamVectorEnv(FigureOwner, VectorEnv):
     """N independent ACLD beams (see :class:`acld_gym.env.ACLDBeamEnv` for the
     physics, spaces, reward and keyword arguments).
 
@@ -267,16 +268,7 @@ class ACLDBeamVectorEnv(VectorEnv):
         return frame
 
     def close_extras(self, **kwargs):
-        if self._fig is not None:
-            from .render import close
-
-            close(self._fig)
-            self._fig = None
-
-    def __getstate__(self):
-        state = self.__dict__.copy()
-        state["_fig"] = None
-        return state
+        self._close_figure()
 
 
 class _EnvView:

@@ -21,8 +21,8 @@ from .simulate import simulate
 from .thesis import V_LIMIT
 
 __all__ = ["ACLDBeamEnv", "Nominal", "nominal", "random_load", "LOAD_CASES", "OBS_MODES",
-           "check_config", "check_actions", "observation_size", "estimate_map", "step_matrix",
-           "load_schedule", "draw_episode", "randomized_plant", "reward_of"]
+           "configure", "check_config", "check_actions", "observation_size", "estimate_map",
+           "step_matrix", "load_schedule", "draw_episode", "randomized_plant", "reward_of"]
 
 LOAD_CASES = (1, 2, 3, "random")
 #: Default tip-sensor noise std [m]: 0.1 um, the resolution of a laser displacement
@@ -183,26 +183,11 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
                  sensor_noise: float = SENSOR_NOISE_M, y_ref: float = 1e-3, lam: float = 0.01,
                  param_noise: float = 0.0, deflection_limit: float = 0.02,
                  render_mode: str | None = None):
-        check_config(load_case=load_case, dt=dt, episode_length=episode_length,
-                     observer=observer, obs_mode=obs_mode, sensor_noise=sensor_noise,
-                     y_ref=y_ref, lam=lam, param_noise=param_noise,
-                     deflection_limit=deflection_limit, render_mode=render_mode,
-                     render_modes=self.metadata["render_modes"])
-        self.load_case = load_case
-        self.dt = float(dt)
-        self.episode_length = float(episode_length)
+        configure(self, load_case=load_case, dt=dt, episode_length=episode_length,
+                  observer=observer, obs_mode=obs_mode, sensor_noise=sensor_noise,
+                  y_ref=y_ref, lam=lam, param_noise=param_noise,
+                  deflection_limit=deflection_limit, render_mode=render_mode)
         self.max_steps = int(round(episode_length / dt))
-        self.observer_kind = observer
-        self.obs_mode = obs_mode
-        self.sensor_noise = float(sensor_noise)
-        self.y_ref = float(y_ref)
-        self.lam = float(lam)
-        self.param_noise = float(param_noise)
-        self.deflection_limit = float(deflection_limit)
-        self.render_mode = render_mode
-        self.v_max = V_LIMIT
-        self.nom = nominal(self.dt, 10, max(self.sensor_noise, 1e-9))
-        self.obs_hist = 8
         n_obs = observation_size(self.nom, obs_mode, self.obs_hist)
         self.action_space = spaces.Box(-self.v_max, self.v_max, (1,), np.float32)
         self.observation_space = spaces.Box(-np.inf, np.inf, (n_obs,), np.float32)
@@ -328,6 +313,30 @@ def _check_positive(name: str, value, allow_zero: bool = False) -> None:
 
 
 # --- pieces shared by ACLDBeamEnv and ACLDBeamVectorEnv ------------------------
+def configure(env, *, load_case, dt, episode_length, observer, obs_mode, sensor_noise, y_ref,
+              lam, param_noise, deflection_limit, render_mode) -> None:
+    """Validate the keyword arguments shared by the single and the vector env
+    (``ValueError`` naming a bad one) and set them, with the nominal design, on ``env``."""
+    check_config(load_case=load_case, dt=dt, episode_length=episode_length, observer=observer,
+                 obs_mode=obs_mode, sensor_noise=sensor_noise, y_ref=y_ref, lam=lam,
+                 param_noise=param_noise, deflection_limit=deflection_limit,
+                 render_mode=render_mode, render_modes=env.metadata["render_modes"])
+    env.load_case = load_case
+    env.dt = float(dt)
+    env.episode_length = float(episode_length)
+    env.observer_kind = observer
+    env.obs_mode = obs_mode
+    env.sensor_noise = float(sensor_noise)
+    env.y_ref = float(y_ref)
+    env.lam = float(lam)
+    env.param_noise = float(param_noise)
+    env.deflection_limit = float(deflection_limit)
+    env.render_mode = render_mode
+    env.v_max = V_LIMIT
+    env.obs_hist = 8
+    env.nom = nominal(env.dt, 10, max(env.sensor_noise, 1e-9))
+
+
 def check_config(*, load_case, dt, episode_length, observer, obs_mode, sensor_noise, y_ref, lam,
                  param_noise, deflection_limit, render_mode, render_modes) -> None:
     """Validate the environment's keyword arguments (``ValueError`` on a bad one)."""

@@ -36,18 +36,16 @@ from .env import (
     Y_SCALE,
     _check_choice,
     check_actions,
-    check_config,
+    configure,
     draw_episode,
     estimate_map,
     load_schedule,
-    nominal,
     observation_size,
     reward_of,
     step_matrix,
 )
 from .loads import thesis_load
 from .render import FigureOwner
-from .thesis import V_LIMIT
 
 __all__ = ["ACLDBeamVectorEnv"]
 
@@ -77,11 +75,10 @@ class ACLDBeamVectorEnv(FigureOwner, VectorEnv):
         if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) \
                 or num_envs < 1:
             raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
-        check_config(load_case=load_case, dt=dt, episode_length=episode_length,
-                     observer=observer, obs_mode=obs_mode, sensor_noise=sensor_noise,
-                     y_ref=y_ref, lam=lam, param_noise=param_noise,
-                     deflection_limit=deflection_limit, render_mode=render_mode,
-                     render_modes=self.metadata["render_modes"])
+        configure(self, load_case=load_case, dt=dt, episode_length=episode_length,
+                  observer=observer, obs_mode=obs_mode, sensor_noise=sensor_noise,
+                  y_ref=y_ref, lam=lam, param_noise=param_noise,
+                  deflection_limit=deflection_limit, render_mode=render_mode)
         steps = int(round(episode_length / dt))
         if max_episode_steps is not None:
             if isinstance(max_episode_steps, bool) or not isinstance(
@@ -92,20 +89,6 @@ class ACLDBeamVectorEnv(FigureOwner, VectorEnv):
         self.num_envs = int(num_envs)
         self.max_episode_steps = max_episode_steps
         self.horizon = steps
-        self.load_case = load_case
-        self.dt = float(dt)
-        self.episode_length = float(episode_length)
-        self.observer_kind = observer
-        self.obs_mode = obs_mode
-        self.sensor_noise = float(sensor_noise)
-        self.y_ref = float(y_ref)
-        self.lam = float(lam)
-        self.param_noise = float(param_noise)
-        self.deflection_limit = float(deflection_limit)
-        self.render_mode = render_mode
-        self.v_max = V_LIMIT
-        self.obs_hist = 8
-        self.nom = nominal(self.dt, 10, max(self.sensor_noise, 1e-9))
         self._obs = self.nom.thesis if observer == "thesis" else self.nom.kalman
         self._est = estimate_map(self._obs, self.nom.xr_scale)
         self._tip = self.nom.design.model.tip_index

@@ -275,9 +275,10 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
         reward = reward_of(y, v, self.y_ref, self.lam, self.v_max)  # 4. on the true deflection
         terminated = bool(abs(y) > self.deflection_limit)  # 5. physical limit
         truncated = bool(self.k >= self.max_steps)
-        self.history.append((self.k * self.dt, y, v))
-        if self.render_mode == "human":
-            self.render()
+        if self.render_mode is not None:  # the history is only drawn, never observed
+            self.history.append((self.k * self.dt, y, v))
+            if self.render_mode == "human":
+                self.render()
         return self._observation(), float(reward), terminated, truncated, self._info(requested)
 
     def render(self):

@@ -67,13 +67,14 @@ def thesis_observer(A: np.ndarray, B: np.ndarray, E: np.ndarray, Cy: np.ndarray,
                     T=red.SL.T, name="thesis" + ("+load" if fed_load else ""))
 
 
-def _noise_covariances(red: ReducedModel, load_std: float, sensor_std: float):
+def _noise_covariances(E: np.ndarray, load_std: float, sensor_std: float):
+    """Process-noise covariance through the load input E and sensor-noise variance."""
     if not load_std > 0:
         raise ValueError(f"load_std must be positive [N], got {load_std!r}")
     if not sensor_std > 0:
         raise ValueError(f"sensor_std must be positive [m], got {sensor_std!r}")
-    W = red.E @ red.E.T * load_std**2
-    return W, np.array([[sensor_std**2]])
+    W = E @ E.T * load_std**2
+    return 0.5 * (W + W.T), np.array([[sensor_std**2]])
 
 
 def kalman_observer(red: ReducedModel, load_std: float = 1.0, sensor_std: float = 1e-7,
@@ -86,7 +87,7 @@ def kalman_observer(red: ReducedModel, load_std: float = 1.0, sensor_std: float 
     at the same sampling (intensity sensor_std^2 * bandwidth_s, m^2 s).
     :math:`L = X C_r^T V^{-1}` with X from the filter Riccati equation.
     """
-    W, V = _noise_covariances(red, load_std, sensor_std)
+    W, V = _noise_covariances(red.E, load_std, sensor_std)
     Lt, _ = care_gain(red.A.T, red.C.T, W * bandwidth_s, V * bandwidth_s)
     k = red.order
     return Observer(A=red.A, B=red.B, E=np.zeros_like(red.E), C=red.C, L=Lt.T, T=np.eye(k),
@@ -131,13 +132,8 @@ def discrete_kalman(Ad: np.ndarray, Bd: np.ndarray, Ed: np.ndarray, Cr: np.ndarr
     ``load_std`` [N]; the tip sensor noise is white with ``sensor_std`` [m].
     :math:`M = X C^T (C X C^T + V)^{-1}`, X the prior covariance from the DARE.
     """
-    if not load_std > 0:
-        raise ValueError(f"load_std must be positive [N], got {load_std!r}")
-    if not sensor_std > 0:
-        raise ValueError(f"sensor_std must be positive [m], got {sensor_std!r}")
-    W = Ed @ Ed.T * load_std**2
-    V = np.array([[sensor_std**2]])
-    X = sla.solve_discrete_are(Ad.T, Cr.T, 0.5 * (W + W.T), V)
+    W, V = _noise_covariances(Ed, load_std, sensor_std)
+    X = sla.solve_discrete_are(Ad.T, Cr.T, W, V)
     M = X @ Cr.T @ np.linalg.inv(Cr @ X @ Cr.T + V)
     return DiscreteObserver(A=Ad, B=Bd, C=Cr, Lc=M, Lp=Ad @ M, T=np.eye(Ad.shape[0]),
                             fed_load=False, name="kalman")

@@ -4,7 +4,7 @@ VENV    := .venv
 BIN     := $(VENV)/bin
 STAMP   := $(VENV)/.installed-stamp
 
-.PHONY: install run test test-slow lint format bench clean
+.PHONY: install run test test-slow lint format bench agents clean
 
 $(STAMP): pyproject.toml constraints.txt
 	$(PY) -m venv $(VENV)
@@ -15,10 +15,17 @@ $(STAMP): pyproject.toml constraints.txt
 
 install: $(STAMP)
 
-## Reproduce the thesis (Table 2, figures), then evaluate the reference policies in the env.
+## Reproduce the thesis (Table 2, figures), evaluate the reference policies in the env,
+## then compare the shipped PPO/SAC agents with them (thesis cases + held-out random loads).
 run: $(STAMP)
 	$(BIN)/acld-gym reproduce --json results/table2.json --plots results/figures
 	$(BIN)/python -m baselines.evaluate --json results/baselines.json --plots results/figures
+	$(BIN)/python -m train.compare --json results/compare.json --plots results/figures
+
+## Retrain the shipped agents (about 10-15 min each on 2 cores; see train/agents/*/metadata.json).
+agents: $(STAMP)
+	$(BIN)/python -m train ppo --seed 0 --out runs/ppo --no-progress
+	$(BIN)/python -m train sac --seed 0 --out runs/sac --no-progress
 
 ## Lint + the test suite (slow tests excluded; see test-slow).
 test: $(STAMP)

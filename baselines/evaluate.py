@@ -21,7 +21,8 @@ import numpy as np
 from acld_gym.env import ACLDBeamEnv, nominal, reward_of
 from acld_gym.metrics import max_abs, peak, settling_time
 
-__all__ = ["EvalRow", "Episode", "rollout", "bound_episode", "evaluate", "format_tables"]
+__all__ = ["EvalRow", "Episode", "rollout", "bound_episode", "episode_rows", "evaluate",
+           "mean_rows", "format_tables", "plot_episodes"]
 
 
 @dataclass(frozen=True)
@@ -99,24 +100,42 @@ def default_policies() -> dict:
             "mpc": MPCPolicy()}
 
 
+def episode_rows(policies: dict, case, seed: int = 0, env_kwargs: dict | None = None,
+                 episodes: dict | None = None) -> list[EvalRow]:
+    """One episode of ``case`` (seeded: load, parameters, sensor noise) per policy, plus
+    the clairvoyant bound for the same load and plant; fills ``episodes`` if given."""
+    env = ACLDBeamEnv(load_case=case, **(env_kwargs or {}))
+    rows = []
+    for name, pol in policies.items():
+        ep = rollout(pol, env, seed=seed)
+        rows.append(metrics_row(case, name, ep))
+        if episodes is not None:
+            episodes[case, name] = ep
+    env.reset(seed=seed)
+    ep = bound_episode(env)
+    rows.append(metrics_row(case, "bound", ep))
+    if episodes is not None:
+        episodes[case, "bound"] = ep
+    return rows
+
+
 def evaluate(policies: dict | None = None, cases=(1, 2, 3), seed: int = 0,
              env_kwargs: dict | None = None, episodes: dict | None = None) -> list[EvalRow]:
     """Rows for every (case, policy) plus the bound; fills ``episodes`` if given."""
     policies = default_policies() if policies is None else policies
-    rows = []
-    for case in cases:
-        env = ACLDBeamEnv(load_case=case, **(env_kwargs or {}))
-        for name, pol in policies.items():
-            ep = rollout(pol, env, seed=seed)
-            rows.append(metrics_row(case, name, ep))
-            if episodes is not None:
-                episodes[case, name] = ep
-        env.reset(seed=seed)
-        ep = bound_episode(env)
-        rows.append(metrics_row(case, "bound", ep))
-        if episodes is not None:
-            episodes[case, "bound"] = ep
-    return rows
+    return [row for case in cases
+            for row in episode_rows(policies, case, seed, env_kwargs, episodes)]
+
+
+def mean_rows(rows: list[EvalRow], case) -> list[EvalRow]:
+    """Per policy, the mean of each metric over ``rows`` (several episodes), labelled ``case``."""
+    out = []
+    for name in dict.fromkeys(r.policy for r in rows):
+        sub = [asdict(r) for r in rows if r.policy == name]
+        means = {k: float(np.mean([d[k] for d in sub])) for k in sub[0]
+                 if k not in ("case", "policy")}
+        out.append(EvalRow(case=case, policy=name, **means))
+    return out
 
 
 def format_tables(rows: list[EvalRow]) -> str:

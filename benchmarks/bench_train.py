@@ -1,0 +1,61 @@
+"""Training throughput (env steps/s) of PPO on the native batched env through the SB3
+adapter vs SB3's ``SubprocVecEnv`` over single envs, with the shipped PPO settings.
+
+Not a timed test: ``python benchmarks/bench_train.py [--timesteps 40960] [--n-envs 8]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from train.config import load_config
+
+
+def env_rate(backend: str, n_envs: int, steps: int) -> float:
+    """Env steps/s of the wrapped training env alone (random actions)."""
+    from train.vec import make_vec_env
+
+    cfg = load_config("ppo").with_overrides(n_envs=n_envs)
+    venv = make_vec_env(cfg, 0, backend=backend)
+    venv.reset()
+    acts = np.random.default_rng(0).uniform(-1, 1, (64, n_envs, 1)).astype(np.float32)
+    t0 = time.perf_counter()
+    for k in range(steps // n_envs):
+        venv.step_async(acts[k % 64])
+        venv.step_wait()
+    rate = (steps // n_envs) * n_envs / (time.perf_counter() - t0)
+    venv.close()
+    return rate
+
+
+def train_rate(backend: str, n_envs: int, steps: int) -> float:
+    """Env steps/s of a whole PPO run (collection + updates)."""
+    from train.cli import train
+
+    cfg = load_config("ppo").with_overrides(n_envs=n_envs, n_timesteps=steps,
+                                            eval_freq=10**9, checkpoint_freq=10**9)
+    with tempfile.TemporaryDirectory() as d:
+        t0 = time.perf_counter()
+        train(cfg, 0, Path(d), backend=backend)
+        return steps / (time.perf_counter() - t0)
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__)
+    p.add_argument("--timesteps", type=int, default=40_960)
+    p.add_argument("--n-envs", type=int, default=8)
+    a = p.parse_args()
+    print(f"PPO training env, {a.n_envs} sub-envs, {a.timesteps} steps")
+    for backend in ("native", "subproc"):
+        e = env_rate(backend, a.n_envs, a.timesteps)
+        t = train_rate(backend, a.n_envs, a.timesteps)
+        print(f"{backend:>8}: env alone {e:10.0f} steps/s   PPO training {t:8.0f} steps/s")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,66 @@
+"""The shipped agents (train/agents/): they load, act in volts, and reproduce the
+numbers of ``train/agents/compare.json`` -- the table in the README, written by
+``python -m train.compare --json train/agents/compare.json`` -- on the three
+thesis cases and the held-out random set. Tolerance: 1e-2 relative on ISE and peak
+(deterministic evaluation; the slack covers floating-point differences of
+torch/BLAS between machines)."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from acld_gym.env import ACLDBeamEnv
+from baselines.evaluate import mean_rows, metrics_row, rollout
+from train.compare import AGENTS_DIR, HELDOUT_SEEDS, load_agents
+
+RTOL = 1e-2
+ROWS = json.loads((AGENTS_DIR / "compare.json").read_text())
+README = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+
+
+def _row(case, policy):
+    return next(r for r in ROWS if r["case"] == case and r["policy"] == policy)
+
+
+@pytest.fixture(scope="module")
+def agents():
+    return load_agents()
+
+
+@pytest.mark.parametrize("name", ["ppo", "sac"])
+def test_metadata_records_how_it_was_made(agents, name):
+    meta = agents[name].metadata
+    assert meta["algo"] == name and meta["config"]["load_case"] == "random"
+    assert meta["command"].startswith(f"python -m train {name}")
+    assert {"torch", "stable_baselines3", "gymnasium"} <= set(meta["versions"])
+
+
+@pytest.mark.parametrize("name", ["ppo", "sac"])
+@pytest.mark.parametrize("case", [1, 2, 3])
+def test_thesis_cases_reproduce_the_table(agents, name, case):
+    ep = rollout(agents[name], ACLDBeamEnv(load_case=case), seed=0)
+    row = metrics_row(case, name, ep)
+    ref = _row(case, name)
+    assert row.ise == pytest.approx(ref["ise"], rel=RTOL)
+    assert row.peak_mm == pytest.approx(ref["peak_mm"], rel=RTOL)
+    assert np.abs(ep.voltage).max() <= 120.0
+    assert f"{ref['ise']:.3e}" in README
+
+
+@pytest.mark.parametrize("name", ["ppo", "sac"])
+def test_heldout_random_set_reproduces_the_table(agents, name):
+    env = ACLDBeamEnv(load_case="random")
+    rows = [metrics_row("random", name, rollout(agents[name], env, seed=s))
+            for s in HELDOUT_SEEDS]
+    mean = mean_rows(rows, "random")[0]
+    assert mean.ise == pytest.approx(_row("random", name)["ise"], rel=RTOL)
+
+
+def test_table_is_complete():
+    policies = {"passive", "lqr", "smc", "mpc", "ppo", "sac", "bound"}
+    for case in (1, 2, 3, "random"):
+        assert {r["policy"] for r in ROWS if r["case"] == case} >= policies
+    for r in ROWS:
+        assert r["ise_rel_bound"] >= 1.0 - 1e-9 or r["policy"] == "bound"

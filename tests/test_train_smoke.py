@@ -1,0 +1,56 @@
+"""A short training run per algorithm: it updates the networks, saves everything a
+user needs, loads back as a policy in volts, and repeats bit for bit with the same
+seed. Marked slow (about a minute each): ``make test-slow``."""
+
+import json
+
+import numpy as np
+import pytest
+import torch
+
+from acld_gym.env import ACLDBeamEnv
+from baselines.evaluate import rollout
+from train.agent import TrainedAgent
+from train.cli import train
+from train.config import load_config
+
+pytestmark = pytest.mark.slow
+
+
+def _params(model) -> np.ndarray:
+    return torch.cat([p.detach().flatten() for p in model.policy.parameters()]).numpy().copy()
+
+
+@pytest.mark.parametrize("algo, steps", [("ppo", 1024), ("sac", 600)])
+def test_smoke_training(algo, steps, tmp_path):
+    cfg = load_config(algo).with_overrides(n_timesteps=steps, n_envs=2, eval_freq=steps // 2,
+                                           checkpoint_freq=steps // 2)
+    if algo == "sac":
+        cfg = cfg.with_overrides(model={**cfg.model, "learning_starts": 100,
+                                        "buffer_size": 2000})
+    from stable_baselines3 import PPO, SAC
+
+    fresh = {"ppo": PPO, "sac": SAC}[algo]
+    m1 = train(cfg, 7, tmp_path / "a")
+    m2 = train(cfg, 7, tmp_path / "b")
+    # repeatable on one machine
+    assert np.array_equal(_params(m1), _params(m2))
+    # the networks moved away from their (seeded) initialization
+    from train.vec import make_vec_env
+
+    init = fresh(cfg.model["policy"], make_vec_env(cfg, 7), seed=7,
+                 **{k: v for k, v in cfg.model.items() if k != "policy"})
+    assert not np.allclose(_params(init), _params(m1))
+    out = tmp_path / "a"
+    for f in ("model.zip", "vecnormalize.pkl", "metadata.json", "learning_curve.csv",
+              "best/best_model.zip", "best/vecnormalize.pkl"):
+        assert (out / f).is_file(), f
+    assert list((out / "checkpoints").glob("*.zip"))
+    assert list((out / "tb").rglob("events.out.tfevents*"))
+    meta = json.loads((out / "metadata.json").read_text())
+    assert meta["seed"] == 7 and meta["algo"] == algo and "torch" in meta["versions"]
+    agent = TrainedAgent.load(out)
+    ep = rollout(agent, ACLDBeamEnv(load_case=1), seed=0)
+    assert np.all(np.abs(ep.voltage) <= 120.0) and np.isfinite(ep.y).all()
+    a, _ = agent.predict(np.zeros((4, 7), np.float32))
+    assert a.shape == (4, 1) and a.dtype == np.float32

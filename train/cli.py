@@ -1,0 +1,158 @@
+"""``python -m train ppo|sac``: train an agent on ``ACLDBeam-v0``.
+
+Writes to ``--out`` (default ``runs/<algo>-<load case>-s<seed>``): ``model.zip`` and
+``vecnormalize.pkl`` (final), ``best/`` (best on the thesis cases, with its
+statistics), ``checkpoints/``, ``tb/`` (TensorBoard), ``learning_curve.csv`` and
+``metadata.json`` (command, seed, config, versions). The final directory loads
+with :meth:`train.agent.TrainedAgent.load`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import shlex
+import sys
+import time
+from pathlib import Path
+
+from .config import ALGOS, TrainConfig, load_config
+
+__all__ = ["main", "train", "versions", "parse_load_case"]
+
+
+def versions() -> dict[str, str]:
+    import gymnasium
+    import numpy
+    import scipy
+    import stable_baselines3
+    import torch
+
+    import acld_gym
+
+    return {"python": platform.python_version(), "acld_gym": acld_gym.__version__,
+            "gymnasium": gymnasium.__version__, "stable_baselines3": stable_baselines3.__version__,
+            "torch": torch.__version__, "numpy": numpy.__version__, "scipy": scipy.__version__}
+
+
+def train(cfg: TrainConfig, seed: int, out: Path, progress_bar: bool = False,
+          backend: str = "native", command: str | None = None, verbose: int = 0):
+    """Train ``cfg`` with ``seed`` into ``out``; returns the SB3 model.
+
+    Repeatable on one machine: the env's sub-env seeds, the algorithm's seed and
+    torch (one thread) are all set from ``seed``.
+    """
+    import torch
+    from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback
+
+    from .agent import META_FILE, MODEL_FILE, STATS_FILE, _algo_class
+    from .callbacks import PhysicsRolloutLogger, make_eval_callback
+    from .vec import make_vec_env
+
+    torch.set_num_threads(1)  # small networks: threads cost more than they give, and
+    # a single thread keeps runs bit-for-bit repeatable
+    out.mkdir(parents=True, exist_ok=True)
+    venv = make_vec_env(cfg, seed, backend=backend)
+    kwargs = dict(cfg.model)
+    policy = kwargs.pop("policy")
+    model = _algo_class(cfg.algo)(policy, venv, seed=seed, device="cpu", verbose=verbose,
+                                  tensorboard_log=str(out / "tb"), **kwargs)
+    callbacks = CallbackList([
+        make_eval_callback(cfg, out, cfg.n_envs),
+        CheckpointCallback(max(cfg.checkpoint_freq // cfg.n_envs, 1), str(out / "checkpoints"),
+                           name_prefix=cfg.algo, save_vecnormalize=True),
+        PhysicsRolloutLogger(),
+    ])
+    t0 = time.perf_counter()
+    model.learn(cfg.n_timesteps, callback=callbacks, progress_bar=progress_bar,
+                tb_log_name=cfg.algo)
+    seconds = time.perf_counter() - t0
+    model.save(str(out / MODEL_FILE))
+    venv.save(str(out / STATS_FILE))
+    meta = {"algo": cfg.algo, "seed": seed, "command": command, "config": cfg.as_dict(),
+            "timesteps": int(model.num_timesteps), "train_seconds": round(seconds, 1),
+            "backend": backend, "versions": versions()}
+    (out / META_FILE).write_text(json.dumps(meta, indent=2) + "\n")
+    venv.close()
+    return model
+
+
+def parse_load_case(text: str):
+    """``--load-case`` value: 1, 2, 3 or ``random``."""
+    if text == "random":
+        return text
+    if text in ("1", "2", "3"):
+        return int(text)
+    raise argparse.ArgumentTypeError(f"expected 1, 2, 3 or random, got {text!r}")
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}")
+    return value
+
+
+def _non_negative_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {text!r}")
+    return value
+
+
+def _non_negative_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number >= 0, got {text!r}") from None
+    if not value >= 0:
+        raise argparse.ArgumentTypeError(f"expected a number >= 0, got {text!r}")
+    return value
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python -m train", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("algo", choices=ALGOS, help="the algorithm")
+    p.add_argument("--load-case", type=parse_load_case, default=None,
+                   help="training loads: 1, 2, 3 or random (default: the config's)")
+    p.add_argument("--timesteps", type=_positive_int, default=None,
+                   help="env steps in total (default: the config's n_timesteps)")
+    p.add_argument("--seed", type=_non_negative_int, default=0, help="seed (default 0)")
+    p.add_argument("--n-envs", type=_positive_int, default=None,
+                   help="sub-envs of the batched env (default: the config's)")
+    p.add_argument("--param-noise", type=_non_negative_float, default=None,
+                   help="per-episode parameter randomization (default: the config's)")
+    p.add_argument("--config", metavar="YAML", default=None,
+                   help="hyperparameter file (default: train/<algo>.yaml)")
+    p.add_argument("--out", metavar="DIR", default=None,
+                   help="output directory (default: runs/<algo>-<case>-s<seed>)")
+    p.add_argument("--backend", choices=("native", "subproc"), default="native",
+                   help="native batched env (default) or SB3 SubprocVecEnv")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        cfg = load_config(args.algo, args.config).with_overrides(
+            load_case=args.load_case, n_timesteps=args.timesteps, n_envs=args.n_envs,
+            param_noise=args.param_noise)
+    except (OSError, ValueError) as exc:
+        parser.error(str(exc))  # exit status 2, no traceback
+    out = Path(args.out or f"runs/{cfg.algo}-{cfg.load_case}-s{args.seed}")
+    command = "python -m train " + " ".join(shlex.quote(a) for a in
+                                            (sys.argv[1:] if argv is None else argv))
+    train(cfg, args.seed, out, progress_bar=not args.no_progress, backend=args.backend,
+          command=command)
+    print(f"wrote {out}/: model.zip, vecnormalize.pkl, best/, learning_curve.csv, tb/")
+    return 0

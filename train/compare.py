@@ -1,0 +1,181 @@
+"""``python -m train.compare``: the shipped agents against the reference policies.
+
+For each thesis load case (1, 2, 3) and a fixed held-out set of random loads
+(``case "random"``: the mean over the set; seeds disjoint from anything used in
+training), runs passive / LQR / SMC / MPC / PPO / SAC and the clairvoyant bound
+through ``ACLDBeam-v0`` (+/-120 V, 1 ms, default Kalman observer) and prints
+peak [mm], 5 % settling [s], ISE [m^2 s], ISE relative to LQR and to the bound,
+max |V| [V], return, and compute time per step [ms].
+
+``--param-noise X`` repeats the comparison with per-episode parameter
+randomization (every policy sees the same randomized plants; the bound knows
+the plant). ``--json PATH`` writes the rows (as ``baselines.evaluate``'s, plus
+``ise_rel_lqr`` and ``ise_rel_bound``); ``--plots DIR`` writes one figure per
+thesis case and the learning curves.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from baselines.evaluate import (
+    EvalRow,
+    default_policies,
+    episode_rows,
+    format_tables,
+    mean_rows,
+    plot_episodes,
+)
+
+__all__ = ["AGENTS_DIR", "HELDOUT_SEEDS", "load_agents", "compare", "relative", "markdown_table",
+           "plot_learning_curves", "main"]
+
+AGENTS_DIR = Path(__file__).resolve().parent / "agents"
+#: Seeds of the held-out random-load episodes (training uses seeds < 1000 per sub-env).
+HELDOUT_SEEDS = tuple(range(100_000, 100_020))
+
+
+def load_agents(directory: str | Path = AGENTS_DIR, names=("ppo", "sac")) -> dict:
+    """The agents ``directory/<name>/`` as policies (``FileNotFoundError`` if one is missing)."""
+    from .agent import TrainedAgent
+
+    directory = Path(directory)
+    return {name: TrainedAgent.load(directory / name, name) for name in names}
+
+
+def compare(policies: dict, cases=(1, 2, 3), random_seeds=HELDOUT_SEEDS, seed: int = 0,
+            env_kwargs: dict | None = None, episodes: dict | None = None) -> list[EvalRow]:
+    """Rows per thesis case (episode ``seed``) and the mean over the held-out random
+    episodes (``case="random"``); every policy sees the same episodes."""
+    rows = [r for case in cases for r in episode_rows(policies, case, seed, env_kwargs, episodes)]
+    if random_seeds:
+        held = [r for s in random_seeds for r in episode_rows(policies, "random", s, env_kwargs)]
+        rows += mean_rows(held, "random")
+    return rows
+
+
+def relative(rows: list[EvalRow]) -> list[dict]:
+    """Rows as dicts with ``ise_rel_lqr`` and ``ise_rel_bound`` (per case)."""
+    out = []
+    for r in rows:
+        same = {x.policy: x.ise for x in rows if x.case == r.case}
+        d = r.as_dict()
+        d["ise_rel_lqr"] = r.ise / same["lqr"] if "lqr" in same else None
+        d["ise_rel_bound"] = r.ise / same["bound"] if "bound" in same else None
+        out.append(d)
+    return out
+
+
+def markdown_table(rows: list[dict]) -> str:
+    """The comparison as one markdown table (rows from :func:`relative`)."""
+    head = ("| case | policy | peak [mm] | settling [s] | ISE [m^2 s] | ISE / LQR | ISE / bound "
+            "| max abs V [V] | ms / step |")
+    out = [head, "|---|---|---|---|---|---|---|---|---|"]
+    for d in rows:
+        out.append(f"| {d['case']} | {d['policy']} | {d['peak_mm']:.3f} | {d['settling_s']:.3f} "
+                   f"| {d['ise']:.3e} | {d['ise_rel_lqr']:.2f} | {d['ise_rel_bound']:.2f} "
+                   f"| {d['max_voltage_V']:.0f} | {d['ms_per_step']:.3f} |")
+    return "\n".join(out)
+
+
+def plot_learning_curves(agents: dict, directory: Path) -> Path | None:
+    """ISE on the three thesis cases vs training steps for each agent (from its
+    ``learning_curve.csv``), against the LQR line."""
+    import csv
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from .callbacks import lqr_reference_ise
+
+    curves = {}
+    for name, agent in agents.items():
+        path = None if agent.directory is None else agent.directory / "learning_curve.csv"
+        if path is not None and path.is_file():
+            with path.open() as fh:
+                curves[name] = list(csv.DictReader(fh))
+    if not curves:
+        return None
+    lqr = lqr_reference_ise()
+    fig, axes = plt.subplots(1, 3, figsize=(12, 3.6))
+    for ax, case in zip(axes, (1, 2, 3), strict=True):
+        for name, rows in curves.items():
+            sub = [r for r in rows if r["case"] == str(case)]
+            ax.plot([int(r["timesteps"]) for r in sub], [float(r["ise"]) for r in sub],
+                    marker=".", lw=1, label=name)
+        ax.axhline(lqr[case], color="k", ls="--", lw=1, label="LQR")
+        ax.set_title(f"load case {case}")
+        ax.set_xlabel("training env steps")
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("ISE [m$^2$ s]")
+    axes[0].legend(fontsize=8)
+    fig.tight_layout()
+    directory.mkdir(parents=True, exist_ok=True)
+    out = directory / "learning_curves.png"
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+    return out
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python -m train.compare", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--json", metavar="PATH", help="write the rows as JSON")
+    p.add_argument("--plots", metavar="DIR", help="write the figures to DIR")
+    p.add_argument("--markdown", metavar="PATH", help="write the table as markdown")
+    p.add_argument("--agents", metavar="DIR", default=str(AGENTS_DIR),
+                   help="directory with ppo/ and sac/ agent directories (default: shipped)")
+    p.add_argument("--extra-agents", metavar="NAME", nargs="*", default=(),
+                   help="further agent directories under --agents to include (e.g. ppo_robust)")
+    p.add_argument("--random-episodes", type=int, default=len(HELDOUT_SEEDS),
+                   help="held-out random-load episodes (default 20; 0 for none)")
+    p.add_argument("--param-noise", type=float, default=0.0,
+                   help="per-episode parameter randomization of the plant (default 0)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the thesis-case episodes")
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.random_episodes < 0 or args.random_episodes > 1000:
+        parser.error(f"--random-episodes must be in 0..1000, got {args.random_episodes}")
+    if not args.param_noise >= 0:
+        parser.error(f"--param-noise must be >= 0, got {args.param_noise}")
+    try:
+        agents = load_agents(args.agents, ("ppo", "sac", *args.extra_agents))
+    except (OSError, ValueError) as exc:
+        parser.error(str(exc))
+    policies = {**default_policies(), **agents}
+    seeds = tuple(range(HELDOUT_SEEDS[0], HELDOUT_SEEDS[0] + args.random_episodes))
+    episodes: dict = {}
+    rows = compare(policies, random_seeds=seeds, seed=args.seed,
+                   env_kwargs={"param_noise": args.param_noise}, episodes=episodes)
+    title = f" (param_noise = {args.param_noise})" if args.param_noise else ""
+    print(f"Agents vs reference policies{title}; 'random' = mean over {len(seeds)} "
+          "held-out random-load episodes")
+    print(format_tables(rows))
+    if args.json:
+        path = Path(args.json)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps(relative(rows), indent=2) + "\n")
+        print(f"\nwrote {path}")
+    if args.markdown:
+        path = Path(args.markdown)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(markdown_table(relative(rows)) + "\n")
+        print(f"wrote {path}")
+    if args.plots:
+        plot_episodes(episodes, Path(args.plots))
+        plot_learning_curves(agents, Path(args.plots))
+        print(f"wrote figures to {args.plots}/")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,110 @@
+"""``python -m train.sweep``: seeds x learning rates with Ray Tune.
+
+Each trial is one ``python -m train`` run (:func:`trial`) scored by the mean over
+the thesis cases of the last evaluation's ISE relative to LQR (lower is better).
+Locally Ray starts with ``--num-cpus`` workers (one trial per CPU); with
+``--address`` (or ``RAY_ADDRESS``) the same command runs on a Ray cluster.
+Ray is the optional extra ``pip install -e ".[sweep]"`` (Tune only; RLlib
+cannot share an environment with gymnasium 1.4).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import sys
+from pathlib import Path
+
+from .config import ALGOS, load_config
+
+__all__ = ["trial", "score_run", "main"]
+
+
+def score_run(out: str | Path) -> float:
+    """Mean ISE / ISE_LQR over the thesis cases at the run's last evaluation."""
+    path = Path(out) / "learning_curve.csv"
+    with path.open() as fh:
+        rows = list(csv.DictReader(fh))
+    if not rows:
+        raise ValueError(f"{path} has no evaluation")
+    last = rows[-1]["timesteps"]
+    vals = [float(r["ise_rel_lqr"]) for r in rows if r["timesteps"] == last]
+    return sum(vals) / len(vals)
+
+
+def trial(config: dict, out: str | Path) -> dict:
+    """Train ``config`` (algo, seed, timesteps, optional learning_rate / n_envs /
+    eval_freq) into ``out``; returns ``{"ise_rel_lqr": score}``."""
+    from .cli import train
+
+    cfg = load_config(config["algo"])
+    model = dict(cfg.model)
+    if config.get("learning_rate") is not None:
+        model["learning_rate"] = float(config["learning_rate"])
+    cfg = cfg.with_overrides(n_timesteps=int(config["timesteps"]), model=model,
+                             n_envs=config.get("n_envs"), eval_freq=config.get("eval_freq"))
+    train(cfg, int(config["seed"]), Path(out))
+    return {"ise_rel_lqr": score_run(out)}
+
+
+def _tune_trainable(config: dict) -> None:
+    from ray import tune
+
+    out = Path(tune.get_context().get_trial_dir()) / "run"
+    tune.report(trial(config, out))
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python -m train.sweep", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("algo", choices=ALGOS)
+    p.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
+    p.add_argument("--learning-rates", type=float, nargs="+", default=None,
+                   help="grid of learning rates (default: the config's)")
+    p.add_argument("--timesteps", type=int, default=200_000, help="env steps per trial")
+    p.add_argument("--eval-freq", type=int, default=None, help="env steps between evaluations")
+    p.add_argument("--num-cpus", type=int, default=2, help="CPUs for a local Ray (default 2)")
+    p.add_argument("--address", default=None, help="Ray cluster address (default: local)")
+    p.add_argument("--out", default="runs/sweep", help="Tune's storage directory")
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.timesteps < 1:
+        parser.error(f"--timesteps must be positive, got {args.timesteps}")
+    if args.num_cpus < 1:
+        parser.error(f"--num-cpus must be positive, got {args.num_cpus}")
+    if any(s < 0 for s in args.seeds):
+        parser.error(f"--seeds must be >= 0, got {args.seeds}")
+    if args.learning_rates and any(not lr > 0 for lr in args.learning_rates):
+        parser.error(f"--learning-rates must be positive, got {args.learning_rates}")
+    try:
+        import ray
+        from ray import tune
+    except ImportError:
+        parser.error('Ray Tune is not installed: pip install -e ".[sweep]"')
+    if args.address:
+        ray.init(address=args.address)
+    else:
+        ray.init(num_cpus=args.num_cpus)
+    space = {"algo": args.algo, "timesteps": args.timesteps, "eval_freq": args.eval_freq,
+             "seed": tune.grid_search(args.seeds),
+             "learning_rate": (tune.grid_search(args.learning_rates) if args.learning_rates
+                               else None)}
+    tuner = tune.Tuner(
+        tune.with_resources(_tune_trainable, {"cpu": 1}), param_space=space,
+        tune_config=tune.TuneConfig(metric="ise_rel_lqr", mode="min"),
+        run_config=tune.RunConfig(storage_path=str(Path(args.out).resolve()), name=args.algo))
+    results = tuner.fit()
+    df = results.get_dataframe()
+    cols = [c for c in ("config/seed", "config/learning_rate", "ise_rel_lqr") if c in df]
+    print(df[cols].sort_values("ise_rel_lqr").to_string(index=False))
+    best = results.get_best_result()
+    print(f"best: {best.config} -> ISE/LQR {best.metrics['ise_rel_lqr']:.3f}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

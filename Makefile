@@ -22,10 +22,11 @@ run: $(STAMP)
 	$(BIN)/python -m baselines.evaluate --json results/baselines.json --plots results/figures
 	$(BIN)/python -m train.compare --json results/compare.json --plots results/figures
 
-## Retrain the shipped agents (about 10-15 min each on 2 cores; see train/agents/*/metadata.json).
+## Retrain the shipped agents (the commands in train/agents/*/metadata.json; a few minutes
+## each on 2 cores). The shipped files are each run's best/ checkpoint.
 agents: $(STAMP)
-	$(BIN)/python -m train ppo --seed 0 --out runs/ppo --no-progress
-	$(BIN)/python -m train sac --seed 0 --out runs/sac --no-progress
+	$(BIN)/python -m train ppo --seed 0 --timesteps 2400000 --out runs/ppo --no-progress
+	$(BIN)/python -m train sac --seed 0 --timesteps 140000 --out runs/sac --no-progress
 
 ## Lint + the test suite (slow tests excluded; see test-slow).
 test: $(STAMP)
@@ -42,6 +43,7 @@ format: $(STAMP)
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_reproduce.py
 	$(BIN)/python benchmarks/bench_env.py
+	$(BIN)/python benchmarks/bench_train.py --timesteps 32768 --n-envs 8
 
 clean:
 	rm -rf $(VENV) results .pytest_cache

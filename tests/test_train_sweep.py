@@ -18,3 +18,14 @@ def test_score_needs_an_evaluation(tmp_path):
         "timesteps,case,ise,ise_rel_lqr,peak_mm,tip_rms_mm,max_voltage_V\n")
     with pytest.raises(ValueError, match="no evaluation"):
         score_run(tmp_path)
+
+
+@pytest.mark.slow
+def test_tune_sweep_runs_locally(tmp_path, capsys):
+    pytest.importorskip("ray", reason="Ray Tune is the optional extra .[sweep]")
+    from train.sweep import main
+
+    assert main(["ppo", "--seeds", "0", "1", "--timesteps", "4096", "--eval-freq", "2048",
+                 "--num-cpus", "2", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "best:" in out and "ise_rel_lqr" in out

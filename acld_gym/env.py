@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 from functools import lru_cache
 from typing import Any
@@ -22,7 +23,8 @@ from .thesis import V_LIMIT
 
 __all__ = ["ACLDBeamEnv", "Nominal", "nominal", "random_load", "LOAD_CASES", "OBS_MODES",
            "configure", "check_config", "check_actions", "observation_size", "estimate_map",
-           "step_matrix", "load_schedule", "draw_episode", "randomized_plant", "reward_of"]
+           "step_matrix", "output_matrix", "load_schedule", "draw_episode", "randomized_plant",
+           "reward_of"]
 
 LOAD_CASES = (1, 2, 3, "random")
 #: Default tip-sensor noise std [m]: 0.1 um, the resolution of a laser displacement
@@ -199,50 +201,65 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
         self._reset_state(thesis_load(1) if load_case == "random" else thesis_load(load_case))
 
     # --- composition of a step ----------------------------------------------
+    # The state lives in one buffer z = [x, xhat, y_meas, V, f0, f1, w'] (x and xhat
+    # are views into it). One product G z (output_matrix) advances plant and observer
+    # and gives the new measurement, the observation and the info's numbers.
     def _reset_state(self, load: TipLoad) -> None:
         self.load = load
         self.k = 0
-        self.x = np.zeros(self._plant.Ad.shape[0])
-        self.xhat = np.zeros(self._obs.n)
+        n, k = self._plant.Ad.shape[0], self._obs.n
+        self._nk = nk = n + k
+        self._z = np.zeros(nk + 3 + 2 * self._plant.substeps)
+        self.x, self.xhat = self._z[:n], self._z[n:nk]
         self.v = 0.0
         self.y_meas = 0.0
         self.y_hist = np.zeros(self.obs_hist)
         self.history: list[tuple[float, float, float]] = []
-        self._F, self._tipf = load_schedule(self.nom.plant, load, 0, self.max_steps)
-        self._big = step_matrix(self._plant, self.nom.plant, self._obs)
+        F, self._tipf = load_schedule(self.nom.plant, load, 0, self.max_steps)
+        self._noise = np.zeros(self.max_steps + 1)
+        self._inputs = np.hstack([F, self._noise[1:, None]])  # per step: [f0, f1, w']
+        self._G = output_matrix(step_matrix(self._plant, self.nom.plant, self._obs), n, k,
+                                self._tip, self.nom.design.reduced.SL, self._est)
+        self._last = np.zeros(self._G.shape[0])  # G z of the last step (all zero at rest)
 
-    def _load_row(self, k: int) -> tuple[np.ndarray, float]:
-        """Load samples of period k (precomputed for the episode, computed beyond it)."""
+    def _draw_noise(self) -> None:
+        """The episode's sensor noise, drawn at reset (the vector env draws the same)."""
+        if self.sensor_noise:
+            self._noise = self.np_random.normal(0.0, self.sensor_noise, self.max_steps + 1)
+            self._inputs[:, -1] = self._noise[1:]
+
+    def _voltage(self, action) -> tuple[float, float]:
+        """(applied, requested) voltage; ``ValueError`` (state untouched) on bad input."""
+        if type(action) is np.ndarray and action.shape == (1,):  # fast path (SB3, policies)
+            requested = float(action[0])
+            if math.isfinite(requested):
+                return min(max(requested, -self.v_max), self.v_max), requested
+        req, v = check_actions(action, 1, self.v_max)
+        return float(v[0]), float(req[0])
+
+    def _step_inputs(self, k: int) -> np.ndarray:
+        """``[f0, f1, w']`` of period k: tabulated for the episode, computed beyond it."""
         if k < self.max_steps:
-            return self._F[k], float(self._tipf[k])
-        F, tip = load_schedule(self.nom.plant, self.load, k, k + 1)
-        return F[0], float(tip[0])
-
-    def _measure(self) -> float:
-        noise = self.np_random.normal(0.0, self.sensor_noise) if self.sensor_noise else 0.0
-        return float(self.x[self._tip] + noise)
+            return self._inputs[k]
+        f = load_schedule(self.nom.plant, self.load, k, k + 1)[0][0]
+        w = self.np_random.normal(0.0, self.sensor_noise) if self.sensor_noise else 0.0
+        return np.append(f, w)
 
     def _observation(self) -> np.ndarray:
         if self.obs_mode == "estimate":
-            z = np.concatenate([self.xhat, (self.y_meas,)])
-            out = np.concatenate([z @ self._est, (self.y_meas / Y_SCALE,)])
-        elif self.obs_mode == "measurement":
-            out = np.concatenate([self.y_hist / Y_SCALE, [self.v / self.v_max]])
-        else:
-            out = self.x
-        return out.astype(np.float32)
+            return self._last[-(self._est.shape[1] + 1):].astype(np.float32)
+        if self.obs_mode == "measurement":
+            return np.append(self.y_hist / Y_SCALE, self.v / self.v_max).astype(np.float32)
+        return self.x.astype(np.float32)
 
     def _info(self, requested: float | None = None) -> dict[str, Any]:
-        y = float(self.x[self._tip])
-        t = self.k * self.dt
-        tip_load = float(self._tipf[self.k]) if self.k <= self.max_steps else float(self.load(t))
-        info = {"tip_deflection": y, "voltage": self.v, "tip_load": tip_load,
-                "time": t, "xr_true": self.nom.design.reduced.SL.T @ self.x,
-                "clipped": False, "requested_voltage": self.v}
-        if requested is not None:
-            info["clipped"] = bool(requested != self.v)
-            info["requested_voltage"] = requested
-        return info
+        k, nk = self.k, self._nk
+        tip_load = float(self._tipf[k]) if k <= self.max_steps else float(self.load(k * self.dt))
+        return {"tip_deflection": float(self._last[nk + 1]), "voltage": self.v,
+                "tip_load": tip_load, "time": k * self.dt,
+                "xr_true": self._last[nk + 2:nk + 8].copy(),
+                "clipped": requested is not None and requested != self.v,
+                "requested_voltage": self.v if requested is None else requested}
 
     # --- Gymnasium API -------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict | None = None):
@@ -254,32 +271,37 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
         load, self._plant = draw_episode(self.np_random, case, self.nom, self.episode_length,
                                          self.param_noise)
         self._reset_state(load)
-        self.y_meas = self._measure()
-        self.y_hist[-1] = self.y_meas
+        self._draw_noise()
+        w = float(self._noise[0])  # the beam starts at rest: the first measurement is noise
+        self.y_meas = self._z[self._nk] = w
+        self.y_hist[-1] = w
+        self._last[self._nk] = w
+        self._last[-(self._est.shape[1] + 1):] = w * np.append(self._est[-1], 1.0 / Y_SCALE)
         return self._observation(), self._info()
 
     def step(self, action):
-        requested_a, v_a = check_actions(action, 1, self.v_max)
-        requested, v = float(requested_a[0]), float(v_a[0])
-        # 1. plant over one period (ZOH) and 2. observer prediction, one product
-        n = self.x.shape[0]
-        f, _ = self._load_row(self.k)
-        s = self._big @ np.concatenate([self.x, self.xhat, (self.y_meas, v), f])
-        self.x, self.xhat = s[:n], s[n:]
-        self.k += 1
+        v, requested = self._voltage(action)
+        k, z, nk = self.k, self._z, self._nk
+        z[nk + 1] = v
+        z[nk + 2:] = self._step_inputs(k)
+        # 1. plant (ZOH) and 2. observer over one period, 3. the new measurement
+        out = self._last = self._G @ z
+        z[:nk + 1] = out[:nk + 1]
+        self.k = k = k + 1
         self.v = v
-        self.y_meas = self._measure()             # 3. new measurement
-        self.y_hist[:-1] = self.y_hist[1:]
-        self.y_hist[-1] = self.y_meas
-        y = float(self.x[self._tip])
+        self.y_meas = float(out[nk])
+        y = float(out[nk + 1])
+        if self.obs_mode == "measurement":
+            self.y_hist[:-1] = self.y_hist[1:]
+            self.y_hist[-1] = self.y_meas
         reward = reward_of(y, v, self.y_ref, self.lam, self.v_max)  # 4. on the true deflection
-        terminated = bool(abs(y) > self.deflection_limit)  # 5. physical limit
-        truncated = bool(self.k >= self.max_steps)
+        terminated = abs(y) > self.deflection_limit  # 5. physical limit
+        truncated = k >= self.max_steps
         if self.render_mode is not None:  # the history is only drawn, never observed
-            self.history.append((self.k * self.dt, y, v))
+            self.history.append((k * self.dt, y, v))
             if self.render_mode == "human":
                 self.render()
-        return self._observation(), float(reward), terminated, truncated, self._info(requested)
+        return self._observation(), reward, terminated, truncated, self._info(requested)
 
     def render(self):
         if self.render_mode is None:
@@ -399,6 +421,25 @@ def step_matrix(plant: SampledSystem, nom_plant: SampledSystem,
     if obs.fed_load:
         S[n:, n + k + 2:] = np.hstack([nom_plant.W0, nom_plant.W1])
     return S
+
+
+def output_matrix(S: np.ndarray, n: int, k: int, tip: int, SL: np.ndarray,
+                  est: np.ndarray) -> np.ndarray:
+    """The single env's whole step as one matrix G, from :func:`step_matrix` S.
+
+    Input ``z = [x, xhat, y_meas, V, f0, f1, w']`` (S's input and the noise w' of the
+    new measurement); output ``G z = [x', xhat', y_meas', y', x_r', e', y_meas' / Y_SCALE]``
+    with ``y' = x'[tip]`` the true tip deflection, ``y_meas' = y' + w'``,
+    ``x_r' = S_L^T x'`` the true reduced state and ``e' = [xhat', y_meas'] M`` the
+    scaled estimate (:func:`estimate_map` M). So ``(G z)[:n+k+1]`` is the next state
+    and ``(G z)[-7:]`` the ``"estimate"`` observation.
+    """
+    X = np.hstack([S[:n + k], np.zeros((n + k, 1))])
+    y = X[tip]
+    y_meas = y.copy()
+    y_meas[-1] = 1.0
+    e = est[:k].T @ X[n:] + np.outer(est[k], y_meas)
+    return np.vstack([X, y_meas, y, SL.T @ X[:n], e, y_meas / Y_SCALE])
 
 
 def load_schedule(plant: SampledSystem, load: TipLoad, start: int,

@@ -68,6 +68,40 @@ def bench_sb3(n: int, seconds: float) -> float:
     return _timed(step, n, seconds)
 
 
+class _NoOpEnv(gym.Env):
+    """The Gymnasium API with no physics: same spaces, a 7-entry info dict (the floor)."""
+
+    observation_space = gym.spaces.Box(-np.inf, np.inf, (7,), np.float32)
+    action_space = gym.spaces.Box(-120.0, 120.0, (1,), np.float32)
+
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        self.k = 0
+        return np.zeros(7, np.float32), {}
+
+    def step(self, action):
+        v = float(action[0])
+        self.k += 1
+        info = {"tip_deflection": 0.0, "voltage": v, "tip_load": 0.0, "time": self.k * 1e-3,
+                "xr_true": np.zeros(6), "clipped": False, "requested_voltage": v}
+        return np.zeros(7, np.float32), -v * v, False, self.k >= 1000, info
+
+
+def bench_breakdown(seconds: float) -> list[tuple[str, float]]:
+    """Microseconds per single-env step: the whole step, its one fused product, and a
+    no-op env with the same API (what any Python Gymnasium env costs)."""
+    env = ACLDBeamEnv(**KW)
+    env.reset(seed=0)
+    G, z = env._G, env._z
+    t_step = 1e6 / bench_single(env, seconds)
+    t_noop = 1e6 / bench_single(_NoOpEnv(), seconds)
+    t_mv = 1e6 / _timed(lambda j: G @ z, 1, seconds)
+    return [(f"single env step [us] (fused product {G.shape[0]} x {G.shape[1]})", t_step),
+            ("  of which the fused matrix-vector product [us]", t_mv),
+            ("  no-op Gymnasium env, same spaces and info [us]", t_noop),
+            ("  the rest: Python bookkeeping of the step [us]", t_step - t_mv - t_noop)]
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seconds", type=float, default=2.0, help="time per measurement [s]")
@@ -88,6 +122,9 @@ def main(argv=None) -> None:
     width = max(len(name) for name, _ in rows)
     for name, rate in rows:
         print(f"{name:<{width}}  {rate:>12,.0f}")
+    print()
+    for name, us in bench_breakdown(s):
+        print(f"{name:<{width}}  {us:>12.2f}")
 
 
 if __name__ == "__main__":

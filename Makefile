@@ -27,6 +27,9 @@ run: $(STAMP)
 agents: $(STAMP)
 	$(BIN)/python -m train ppo --seed 0 --timesteps 2400000 --out runs/ppo --no-progress
 	$(BIN)/python -m train sac --seed 0 --timesteps 140000 --out runs/sac --no-progress
+	$(BIN)/python -m train ppo --seed 0 --timesteps 2400000 --param-noise 0.1 --out runs/ppo_robust --no-progress
+	$(BIN)/python -m train sac --seed 0 --timesteps 140000 --param-noise 0.1 --out runs/sac_robust --no-progress
+	for a in ppo sac ppo_robust sac_robust; do $(BIN)/python -m train.ship runs/$$a $$a; done
 
 ## Lint + the test suite (slow tests excluded; see test-slow).
 test: $(STAMP)

@@ -257,7 +257,7 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
         tip_load = float(self._tipf[k]) if k <= self.max_steps else float(self.load(k * self.dt))
         return {"tip_deflection": float(self._last[nk + 1]), "voltage": self.v,
                 "tip_load": tip_load, "time": k * self.dt,
-                "xr_true": self._last[nk + 2:nk + 8].copy(),
+                "xr_true": self._last[nk + 2:nk + 8],  # a view of this step's fresh output
                 "clipped": requested is not None and requested != self.v,
                 "requested_voltage": self.v if requested is None else requested}
 

@@ -64,3 +64,18 @@ def test_table_is_complete():
         assert {r["policy"] for r in ROWS if r["case"] == case} >= policies
     for r in ROWS:
         assert r["ise_rel_bound"] >= 1.0 - 1e-9 or r["policy"] == "bound"
+
+
+ROBUST = json.loads((AGENTS_DIR / "compare_param_noise.json").read_text())
+
+
+@pytest.mark.parametrize("name", ["ppo_robust", "sac_robust"])
+def test_robust_agents_reproduce_the_randomized_table(name):
+    """Trained with param_noise 0.1; case 1 on the seed-0 randomized plant as in the
+    README's robustness table."""
+    agent = load_agents(names=(name,))[name]
+    assert agent.metadata["config"]["param_noise"] == 0.1
+    ep = rollout(agent, ACLDBeamEnv(load_case=1, param_noise=0.1), seed=0)
+    ref = next(r for r in ROBUST if r["case"] == 1 and r["policy"] == name)
+    assert metrics_row(1, name, ep).ise == pytest.approx(ref["ise"], rel=RTOL)
+    assert f"{ref['ise']:.3e}" in README

@@ -71,3 +71,10 @@ def test_sweep_without_ray_says_how_to_install(capsys, monkeypatch):
 
     monkeypatch.setattr(builtins, "__import__", no_ray)
     _exit2(sweep_main, ["ppo"], capsys, "[sweep]")
+
+
+def test_ship_cli_bad_input(tmp_path, capsys):
+    from train.ship import main as ship_main
+
+    _exit2(ship_main, [str(tmp_path), "ppo"], capsys, "lacks")
+    _exit2(ship_main, [str(tmp_path), "../x"], capsys, "name")

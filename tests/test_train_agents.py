@@ -79,3 +79,16 @@ def test_robust_agents_reproduce_the_randomized_table(name):
     ref = next(r for r in ROBUST if r["case"] == 1 and r["policy"] == name)
     assert metrics_row(1, name, ep).ise == pytest.approx(ref["ise"], rel=RTOL)
     assert f"{ref['ise']:.3e}" in README
+
+
+@pytest.mark.parametrize("name", ["ppo", "sac", "ppo_robust", "sac_robust"])
+def test_numpy_actor_equals_sb3_predict(name):
+    agent = load_agents(names=(name,))[name]
+    obs = np.random.default_rng(0).normal(0.0, 2.0, (256, 7)).astype(np.float32)
+    norm = agent.obs_norm.normalize_obs(obs)
+    sb3, _ = agent.model.predict(norm, deterministic=True)
+    assert np.allclose(agent.actor(norm), sb3, atol=1e-5)
+    v, _ = agent.predict(obs)
+    assert v.shape == (256, 1) and np.all(np.abs(v) <= 120.0)
+    with pytest.raises(ValueError, match="deterministic"):
+        agent.predict(obs[0], deterministic=False)

@@ -11,7 +11,7 @@ import numpy as np
 
 from .vec import VoltageMap
 
-__all__ = ["TrainedAgent", "MODEL_FILE", "STATS_FILE", "META_FILE"]
+__all__ = ["TrainedAgent", "NumpyActor", "MODEL_FILE", "STATS_FILE", "META_FILE"]
 
 MODEL_FILE = "model.zip"
 STATS_FILE = "vecnormalize.pkl"
@@ -29,19 +29,76 @@ def _algo_class(algo: str):
 
 
 
+class NumpyActor:
+    """The deterministic actor of an SB3 ``MlpPolicy`` (PPO or SAC) as numpy layers.
+
+    SB3's ``predict`` costs about 0.2 ms per call (tensor conversion, checks); the
+    network itself is a few small matrix-vector products. This evaluates exactly
+    SB3's deterministic action -- PPO: the Gaussian mean clipped to the action box;
+    SAC: tanh of the mean -- in float64 (the tests compare it with ``predict``).
+    """
+
+    def __init__(self, model):
+        import torch.nn as nn
+        from stable_baselines3 import SAC
+        from stable_baselines3.common.torch_layers import FlattenExtractor
+
+        pol = model.policy
+        if isinstance(model, SAC):
+            extractor = pol.actor.features_extractor
+            mu = pol.actor.mu
+            layers = [*pol.actor.latent_pi, *(mu if isinstance(mu, nn.Sequential) else [mu])]
+            self.squash = True
+        else:
+            extractor = pol.pi_features_extractor
+            layers = [*pol.mlp_extractor.policy_net, pol.action_net]
+            self.squash = bool(pol.squash_output)
+        if not isinstance(extractor, FlattenExtractor):
+            raise TypeError(f"NumpyActor supports MlpPolicy only, got {type(extractor).__name__}")
+        self.ops: list[tuple] = []
+        for layer in layers:
+            if isinstance(layer, nn.Linear):
+                self.ops.append(("linear", layer.weight.detach().double().numpy().T.copy(),
+                                 layer.bias.detach().double().numpy().copy()))
+            elif isinstance(layer, nn.Tanh):
+                self.ops.append(("tanh",))
+            elif isinstance(layer, nn.ReLU):
+                self.ops.append(("relu",))
+            elif isinstance(layer, nn.Hardtanh):
+                self.ops.append(("clip", float(layer.min_val), float(layer.max_val)))
+            else:
+                raise TypeError(f"NumpyActor: unsupported layer {layer!r}")
+
+    def __call__(self, obs: np.ndarray) -> np.ndarray:
+        """Actions in [-1, 1], shape (n, 1), for normalized observations (n, d)."""
+        z = np.asarray(obs, dtype=np.float64)
+        for op in self.ops:
+            if op[0] == "linear":
+                z = z @ op[1] + op[2]
+            elif op[0] == "tanh":
+                z = np.tanh(z)
+            elif op[0] == "relu":
+                z = np.maximum(z, 0.0)
+            else:
+                z = np.clip(z, op[1], op[2])
+        return np.clip(np.tanh(z) if self.squash else z, -1.0, 1.0)
+
+
 class TrainedAgent:
     """An agent directory (``model.zip``, ``vecnormalize.pkl``, ``metadata.json``)
     as a policy on the env's raw ``"estimate"`` observation.
 
     ``predict`` normalizes the observation with the frozen ``VecNormalize``
-    statistics, runs the network deterministically and maps its action to volts
-    with the same :class:`train.vec.VoltageMap` as in training.
+    statistics, runs the actor network deterministically (:class:`NumpyActor`) and
+    maps its action to volts with the same :class:`train.vec.VoltageMap` as in
+    training. ``model`` is the SB3 model (``model.predict`` gives the same actions).
     """
 
     def __init__(self, model, obs_norm, residual: str | None, name: str = "agent",
                  metadata: dict | None = None, directory: Path | None = None):
         self.directory = directory
         self.model = model
+        self.actor = NumpyActor(model)
         self.obs_norm = obs_norm
         self.map = VoltageMap(residual)
         self.name = name
@@ -68,7 +125,8 @@ class TrainedAgent:
         obs = np.asarray(observation, dtype=np.float32)
         batched = obs.ndim == 2
         obs2 = np.atleast_2d(obs)
-        action, _ = self.model.predict(self.obs_norm.normalize_obs(obs2),
-                                       deterministic=deterministic)
-        v = self.map(action, obs2)
+        if not deterministic:
+            raise ValueError("deterministic must be True: TrainedAgent evaluates the "
+                             "deterministic policy (use .model.predict to sample)")
+        v = self.map(self.actor(self.obs_norm.normalize_obs(obs2)), obs2)
         return (v if batched else v[0]), state

@@ -28,6 +28,8 @@ def test_smoke_training(algo, steps, tmp_path):
     if algo == "sac":
         cfg = cfg.with_overrides(model={**cfg.model, "learning_starts": 100,
                                         "buffer_size": 2000})
+    else:  # a mini-batch that divides the 2 x 256-step rollout
+        cfg = cfg.with_overrides(model={**cfg.model, "batch_size": 256})
     from stable_baselines3 import PPO, SAC
 
     fresh = {"ppo": PPO, "sac": SAC}[algo]

@@ -22,13 +22,13 @@ run: $(STAMP)
 	$(BIN)/python -m baselines.evaluate --json results/baselines.json --plots results/figures
 	$(BIN)/python -m train.compare --json results/compare.json --plots results/figures
 
-## Retrain the shipped agents (the commands in train/agents/*/metadata.json; a few minutes
-## each on 2 cores). The shipped files are each run's best/ checkpoint.
+## Retrain the shipped agents (the commands in train/agents/*/metadata.json; about a
+## minute each on 2 cores). The shipped files are each run's best/ checkpoint.
 agents: $(STAMP)
-	$(BIN)/python -m train ppo --seed 0 --timesteps 2400000 --out runs/ppo --no-progress
-	$(BIN)/python -m train sac --seed 0 --timesteps 140000 --out runs/sac --no-progress
-	$(BIN)/python -m train ppo --seed 0 --timesteps 2400000 --param-noise 0.1 --out runs/ppo_robust --no-progress
-	$(BIN)/python -m train sac --seed 0 --timesteps 140000 --param-noise 0.1 --out runs/sac_robust --no-progress
+	$(BIN)/python -m train ppo --seed 0 --out runs/ppo --no-progress
+	$(BIN)/python -m train sac --seed 0 --out runs/sac --no-progress
+	$(BIN)/python -m train ppo --seed 0 --param-noise 0.1 --out runs/ppo_robust --no-progress
+	$(BIN)/python -m train sac --seed 0 --param-noise 0.1 --out runs/sac_robust --no-progress
 	for a in ppo sac ppo_robust sac_robust; do $(BIN)/python -m train.ship runs/$$a $$a; done
 
 ## Lint + the test suite (slow tests excluded; see test-slow).

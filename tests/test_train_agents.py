@@ -35,6 +35,10 @@ def test_metadata_records_how_it_was_made(agents, name):
     assert meta["algo"] == name and meta["config"]["load_case"] == "random"
     assert meta["command"].startswith(f"python -m train {name}")
     assert {"torch", "stable_baselines3", "gymnasium"} <= set(meta["versions"])
+    # initialised by DAgger from the MPC, then trained; the shipped checkpoint's step
+    assert meta["config"]["distill"]["teacher"] == "mpc"
+    assert meta["distill"]["history"][-1]["agreement"] > 0.9
+    assert 0 <= meta["best_timesteps"] <= meta["timesteps"]
 
 
 @pytest.mark.parametrize("name", ["ppo", "sac"])
@@ -87,7 +91,11 @@ def test_numpy_actor_equals_sb3_predict(name):
     obs = np.random.default_rng(0).normal(0.0, 2.0, (256, 7)).astype(np.float32)
     norm = agent.obs_norm.normalize_obs(obs)
     sb3, _ = agent.model.predict(norm, deterministic=True)
-    assert np.allclose(agent.actor(norm), sb3, atol=1e-5)
+    # equal up to torch's float32 rounding, which scales with the weights (the
+    # distilled linear actors have |w|_1 of several thousand: a thin boundary layer)
+    scale = max(np.abs(op[1]).sum(axis=0).max() for op in agent.actor.ops if op[0] == "linear")
+    atol = 1e-5 + 4 * np.finfo(np.float32).eps * scale
+    assert np.allclose(agent.actor(norm), sb3, rtol=0.0, atol=atol)
     v, _ = agent.predict(obs)
     assert v.shape == (256, 1) and np.all(np.abs(v) <= 120.0)
     with pytest.raises(ValueError, match="deterministic"):

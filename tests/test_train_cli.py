@@ -78,3 +78,18 @@ def test_ship_cli_bad_input(tmp_path, capsys):
 
     _exit2(ship_main, [str(tmp_path), "ppo"], capsys, "lacks")
     _exit2(ship_main, [str(tmp_path), "../x"], capsys, "name")
+
+
+def test_best_timesteps_follows_the_eval_ranking(tmp_path):
+    """The lowest mean ISE / LQR over the thesis cases; the first of equal ones."""
+    from train.ship import best_timesteps
+
+    head = "timesteps,case,ise,ise_rel_lqr,peak_mm,tip_rms_mm,max_voltage_V\n"
+    rows = [(0, 1, 0.5), (0, 2, 0.5), (100, 1, 0.4), (100, 2, 0.5), (200, 1, 0.5),
+            (200, 2, 0.4)]
+    curve = tmp_path / "learning_curve.csv"
+    curve.write_text(head + "".join(f"{t},{c},0,{r},0,0,0\n" for t, c, r in rows))
+    assert best_timesteps(curve) == 100
+    curve.write_text(head)
+    with pytest.raises(ValueError, match="empty"):
+        best_timesteps(curve)

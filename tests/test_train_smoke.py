@@ -11,7 +11,7 @@ import torch
 from acld_gym.env import ACLDBeamEnv
 from baselines.evaluate import rollout
 from train.agent import TrainedAgent
-from train.cli import train
+from train.cli import make_model, train
 from train.config import load_config
 
 pytestmark = pytest.mark.slow
@@ -30,9 +30,7 @@ def test_smoke_training(algo, steps, tmp_path):
                                         "buffer_size": 2000})
     else:  # a mini-batch that divides the 2 x 256-step rollout
         cfg = cfg.with_overrides(model={**cfg.model, "batch_size": 256})
-    from stable_baselines3 import PPO, SAC
-
-    fresh = {"ppo": PPO, "sac": SAC}[algo]
+    cfg = cfg.with_overrides(distill={**cfg.distill, "iterations": 2})
     m1 = train(cfg, 7, tmp_path / "a")
     m2 = train(cfg, 7, tmp_path / "b")
     # repeatable on one machine
@@ -40,8 +38,7 @@ def test_smoke_training(algo, steps, tmp_path):
     # the networks moved away from their (seeded) initialization
     from train.vec import make_vec_env
 
-    init = fresh(cfg.model["policy"], make_vec_env(cfg, 7), seed=7,
-                 **{k: v for k, v in cfg.model.items() if k != "policy"})
+    init = make_model(cfg, make_vec_env(cfg, 7), seed=7)
     assert not np.allclose(_params(init), _params(m1))
     out = tmp_path / "a"
     for f in ("model.zip", "vecnormalize.pkl", "metadata.json", "learning_curve.csv",
@@ -51,6 +48,7 @@ def test_smoke_training(algo, steps, tmp_path):
     assert list((out / "tb").rglob("events.out.tfevents*"))
     meta = json.loads((out / "metadata.json").read_text())
     assert meta["seed"] == 7 and meta["algo"] == algo and "torch" in meta["versions"]
+    assert [h["iteration"] for h in meta["distill"]["history"]] == [0, 1]
     agent = TrainedAgent.load(out)
     ep = rollout(agent, ACLDBeamEnv(load_case=1), seed=0)
     assert np.all(np.abs(ep.voltage) <= 120.0) and np.isfinite(ep.y).all()

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .features import direction_features
 from .vec import VoltageMap
 
 __all__ = ["TrainedAgent", "NumpyActor", "MODEL_FILE", "STATS_FILE", "META_FILE"]
@@ -28,14 +29,14 @@ def _algo_class(algo: str):
 
 
 
-
 class NumpyActor:
     """The deterministic actor of an SB3 ``MlpPolicy`` (PPO or SAC) as numpy layers.
 
     SB3's ``predict`` costs about 0.2 ms per call (tensor conversion, checks); the
     network itself is a few small matrix-vector products. This evaluates exactly
     SB3's deterministic action -- PPO: the Gaussian mean clipped to the action box;
-    SAC: tanh of the mean -- in float64 (the tests compare it with ``predict``).
+    SAC: tanh of the mean -- in float64 (the tests compare it with ``predict``), with
+    the flatten or :class:`train.features.DirectionFeatures` extractor.
     """
 
     def __init__(self, model):
@@ -53,9 +54,14 @@ class NumpyActor:
             extractor = pol.pi_features_extractor
             layers = [*pol.mlp_extractor.policy_net, pol.action_net]
             self.squash = bool(pol.squash_output)
-        if not isinstance(extractor, FlattenExtractor):
-            raise TypeError(f"NumpyActor supports MlpPolicy only, got {type(extractor).__name__}")
+        from .features import DirectionFeatures
+
         self.ops: list[tuple] = []
+        if isinstance(extractor, DirectionFeatures):
+            self.ops.append(("direction",))
+        elif not isinstance(extractor, FlattenExtractor):
+            raise TypeError(f"NumpyActor supports MlpPolicy with the flatten or direction "
+                            f"features only, got {type(extractor).__name__}")
         for layer in layers:
             if isinstance(layer, nn.Linear):
                 self.ops.append(("linear", layer.weight.detach().double().numpy().T.copy(),
@@ -77,6 +83,8 @@ class NumpyActor:
                 z = z @ op[1] + op[2]
             elif op[0] == "tanh":
                 z = np.tanh(z)
+            elif op[0] == "direction":
+                z = direction_features(z)
             elif op[0] == "relu":
                 z = np.maximum(z, 0.0)
             else:

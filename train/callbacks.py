@@ -53,10 +53,15 @@ class ThesisCaseMonitor(gym.Wrapper):
     """Evaluation wrapper of one thesis case: the reward becomes the step's share of
     ISE relative to LQR's, ``-y^2 dt / ISE_LQR`` (an episode's return is
     ``-ISE / ISE_LQR``, so the three cases weigh alike when ``EvalCallback`` ranks
-    models), and the finished episode's metrics are kept in ``last_metrics``."""
+    models), and the finished episode's metrics are kept in ``last_metrics``.
 
-    def __init__(self, env: ACLDBeamEnv, lqr_ise: float):
+    Every episode is reset with the same ``seed`` (the comparison's seed 0), so all
+    evaluations see the same sensor noise: checkpoints are ranked on equal terms, the
+    ranking repeats, and an evaluation equals the comparison table's row."""
+
+    def __init__(self, env: ACLDBeamEnv, lqr_ise: float, seed: int = 0):
         super().__init__(env)
+        self.seed = int(seed)
         self.case = env.unwrapped.load_case
         self.lqr_ise = float(lqr_ise)
         self.metrics = EpisodeMetrics(env.unwrapped.dt)
@@ -64,6 +69,7 @@ class ThesisCaseMonitor(gym.Wrapper):
 
     def reset(self, **kwargs):
         self.metrics.clear()
+        kwargs["seed"] = self.seed
         return self.env.reset(**kwargs)
 
     def step(self, action):
@@ -160,11 +166,21 @@ class EvalPhysicsLogger(BaseCallback):
         return True
 
 
+class EvalFromStart(EvalCallback):
+    """``EvalCallback`` that also evaluates before the first step, so the learning
+    curve starts at 0 steps (the initial or distilled actor) and that actor is a
+    candidate for the best model."""
+
+    def _on_training_start(self) -> None:
+        super()._on_training_start()
+        self._on_step()  # n_calls == 0: due
+
+
 def make_eval_callback(cfg, out: Path, n_envs: int) -> EvalCallback:
     """``EvalCallback`` on the three thesis cases every ``cfg.eval_freq`` env steps,
     ranking models by the mean ISE relative to LQR; the best model goes to
     ``out/best/best_model.zip`` with ``out/best/vecnormalize.pkl``."""
-    return EvalCallback(
+    return EvalFromStart(
         thesis_eval_env(cfg), n_eval_episodes=len(THESIS_CASES),
         eval_freq=max(cfg.eval_freq // n_envs, 1), deterministic=True,
         best_model_save_path=str(out / "best"), log_path=str(out / "eval"),

@@ -19,7 +19,7 @@ from pathlib import Path
 
 from .config import ALGOS, TrainConfig, load_config
 
-__all__ = ["main", "train", "versions", "parse_load_case"]
+__all__ = ["main", "train", "make_model", "versions", "parse_load_case"]
 
 
 def versions() -> dict[str, str]:
@@ -36,6 +36,22 @@ def versions() -> dict[str, str]:
             "torch": torch.__version__, "numpy": numpy.__version__, "scipy": scipy.__version__}
 
 
+def make_model(cfg: TrainConfig, venv, seed: int, **kwargs):
+    """The (untrained) SB3 model of ``cfg`` on ``venv``: the config's keyword
+    arguments with its ``features`` extractor, CPU, seeded; ``kwargs`` add to them."""
+    from .agent import _algo_class
+
+    model_kwargs = dict(cfg.model)
+    policy = model_kwargs.pop("policy")
+    if cfg.features is not None:
+        from .features import FEATURES
+
+        model_kwargs["policy_kwargs"] = {**model_kwargs.get("policy_kwargs", {}),
+                                         "features_extractor_class": FEATURES[cfg.features]}
+    return _algo_class(cfg.algo)(policy, venv, seed=seed, device="cpu",
+                                 **{**model_kwargs, **kwargs})
+
+
 def train(cfg: TrainConfig, seed: int, out: Path, progress_bar: bool = False,
           backend: str = "native", command: str | None = None, verbose: int = 0):
     """Train ``cfg`` with ``seed`` into ``out``; returns the SB3 model.
@@ -46,7 +62,7 @@ def train(cfg: TrainConfig, seed: int, out: Path, progress_bar: bool = False,
     import torch
     from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback
 
-    from .agent import META_FILE, MODEL_FILE, STATS_FILE, _algo_class
+    from .agent import META_FILE, MODEL_FILE, STATS_FILE
     from .callbacks import PhysicsRolloutLogger, make_eval_callback
     from .vec import make_vec_env
 
@@ -54,10 +70,14 @@ def train(cfg: TrainConfig, seed: int, out: Path, progress_bar: bool = False,
     # a single thread keeps runs bit-for-bit repeatable
     out.mkdir(parents=True, exist_ok=True)
     venv = make_vec_env(cfg, seed, backend=backend)
-    kwargs = dict(cfg.model)
-    policy = kwargs.pop("policy")
-    model = _algo_class(cfg.algo)(policy, venv, seed=seed, device="cpu", verbose=verbose,
-                                  tensorboard_log=str(out / "tb"), **kwargs)
+    model = make_model(cfg, venv, seed, verbose=verbose, tensorboard_log=str(out / "tb"))
+    distilled = None
+    if cfg.distill is not None:
+        from .distill import distill
+
+        t0 = time.perf_counter()
+        distilled = {"history": distill(model, venv, cfg.distill_config, seed=seed),
+                     "seconds": round(time.perf_counter() - t0, 1)}
     callbacks = CallbackList([
         make_eval_callback(cfg, out, cfg.n_envs),
         CheckpointCallback(max(cfg.checkpoint_freq // cfg.n_envs, 1), str(out / "checkpoints"),
@@ -72,6 +92,7 @@ def train(cfg: TrainConfig, seed: int, out: Path, progress_bar: bool = False,
     venv.save(str(out / STATS_FILE))
     meta = {"algo": cfg.algo, "seed": seed, "command": command, "config": cfg.as_dict(),
             "timesteps": int(model.num_timesteps), "train_seconds": round(seconds, 1),
+            "distill": distilled,
             "backend": backend, "versions": versions()}
     (out / META_FILE).write_text(json.dumps(meta, indent=2) + "\n")
     venv.close()

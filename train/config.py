@@ -15,6 +15,7 @@ __all__ = ["ALGOS", "TrainConfig", "load_config", "config_path"]
 
 ALGOS = ("ppo", "sac")
 RESIDUALS = (None, "lqr")
+FEATURE_NAMES = ("direction",)
 _HERE = Path(__file__).resolve().parent
 
 
@@ -37,6 +38,12 @@ class TrainConfig:
     residual : str or None
         ``"lqr"``: the agent's action a in [-1, 1] is added to the discrete LQR
         voltage, ``V = 120 clip(u_lqr / 120 + 2 a, -1, 1)`` [V]; None: ``V = 120 a``.
+    features : str or None
+        ``"direction"``: the networks see :class:`train.features.DirectionFeatures`
+        of the observation (``[z/|z|, log|z|]``); None: SB3's default (flattened).
+    distill : dict or None
+        DAgger initialisation of the actor before reinforcement learning
+        (:class:`train.distill.DistillConfig`'s fields); None: from scratch.
     shaping : float or None
         Voltage weight of the LQ potential used for reward shaping during training
         (:class:`train.vec.VecLQShaping`); None: the env's reward as is.
@@ -55,6 +62,8 @@ class TrainConfig:
     param_noise: float = 0.0
     residual: str | None = None
     shaping: float | None = None
+    features: str | None = None
+    distill: dict | None = None
     normalize: dict = field(default_factory=dict)
     eval_freq: int = 100_000
     checkpoint_freq: int = 500_000
@@ -78,6 +87,16 @@ class TrainConfig:
         if self.shaping is not None and not (isinstance(self.shaping, (int, float))
                                              and self.shaping > 0):
             raise ValueError(f"shaping must be a positive number or null, got {self.shaping!r}")
+        if self.features is not None and self.features not in FEATURE_NAMES:
+            raise ValueError(f"features must be one of {list(FEATURE_NAMES)} or null, "
+                             f"got {self.features!r}")
+        if self.distill is not None:
+            if not isinstance(self.distill, dict):
+                raise ValueError(f"distill must be a mapping or null, got {self.distill!r}")
+            _ = self.distill_config  # validates the fields
+            if self.residual is not None:
+                raise ValueError("distill needs residual: null (the action's sign is the "
+                                 f"voltage's), got residual {self.residual!r}")
         if "policy" not in self.model:
             raise ValueError("model must name the SB3 policy (e.g. policy: MlpPolicy)")
 
@@ -85,6 +104,19 @@ class TrainConfig:
     def gamma(self) -> float:
         """Discount factor of the algorithm (SB3's default 0.99 if not set)."""
         return float(self.model.get("gamma", 0.99))
+
+    @property
+    def distill_config(self):
+        """The :class:`train.distill.DistillConfig` of ``distill`` (None if off)."""
+        from .distill import DistillConfig
+
+        if self.distill is None:
+            return None
+        known = set(DistillConfig.__dataclass_fields__)
+        unknown = sorted(set(self.distill) - known)
+        if unknown:
+            raise ValueError(f"distill: unknown key(s) {unknown}; expected some of {sorted(known)}")
+        return DistillConfig(**self.distill)
 
     def with_overrides(self, **changes: Any) -> TrainConfig:
         """A copy with the non-None ``changes`` applied (validated again)."""

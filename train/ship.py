@@ -13,7 +13,23 @@ from pathlib import Path
 from .agent import META_FILE, MODEL_FILE, STATS_FILE
 from .compare import AGENTS_DIR
 
-__all__ = ["ship", "main"]
+__all__ = ["ship", "best_timesteps", "main"]
+
+
+def best_timesteps(curve: str | Path) -> int:
+    """Training steps of the best evaluation in a ``learning_curve.csv``: the lowest
+    mean ISE relative to LQR over the thesis cases (the ``EvalCallback``'s ranking;
+    the first of equal ones)."""
+    import csv
+
+    with Path(curve).open() as fh:
+        rows = list(csv.DictReader(fh))
+    if not rows:
+        raise ValueError(f"{curve}: empty learning curve")
+    steps = sorted({int(r["timesteps"]) for r in rows})
+    score = {t: sum(float(r["ise_rel_lqr"]) for r in rows if int(r["timesteps"]) == t)
+             for t in steps}
+    return min(steps, key=lambda t: (score[t], t))
 
 
 def ship(run: str | Path, name: str, agents_dir: str | Path = AGENTS_DIR) -> Path:
@@ -32,6 +48,7 @@ def ship(run: str | Path, name: str, agents_dir: str | Path = AGENTS_DIR) -> Pat
     shutil.copy(needed[3], dst / "learning_curve.csv")
     meta = json.loads(needed[2].read_text())
     meta["checkpoint"] = "best on the thesis cases (EvalCallback)"
+    meta["best_timesteps"] = best_timesteps(needed[3])
     (dst / META_FILE).write_text(json.dumps(meta, indent=2) + "\n")
     return dst
 

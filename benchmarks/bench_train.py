@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import tempfile
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -34,11 +35,14 @@ def env_rate(backend: str, n_envs: int, steps: int) -> float:
 
 
 def train_rate(backend: str, n_envs: int, steps: int) -> float:
-    """Env steps/s of a whole PPO run (collection + updates)."""
+    """Env steps/s of a whole PPO run (collection + updates, and the one evaluation of
+    the thesis cases at step 0), without the DAgger initialisation, which does not
+    depend on the backend's speed as much as on the MPC's QPs."""
     from train.cli import train
 
     cfg = load_config("ppo").with_overrides(n_envs=n_envs, n_timesteps=steps,
                                             eval_freq=10**9, checkpoint_freq=10**9)
+    cfg = replace(cfg, distill=None)
     with tempfile.TemporaryDirectory() as d:
         t0 = time.perf_counter()
         train(cfg, 0, Path(d), backend=backend)

@@ -128,12 +128,6 @@ def fit_sign(f, params, x, s, max_iter: int = 300) -> float:
         return float(torch.nn.functional.softplus(-s * f(x)).mean())
 
 
-def _teacher(name: str):
-    from baselines.policies import LQRPolicy, MPCPolicy, SMCPolicy
-
-    return {"mpc": MPCPolicy, "smc": SMCPolicy, "lqr": LQRPolicy}[name]()
-
-
 def distill(model, venv, cfg: DistillConfig, seed: int = 0, log=None) -> list[dict]:
     r"""Fit ``model``'s actor to ``cfg.teacher`` by DAgger in ``venv`` (in place).
 
@@ -150,7 +144,9 @@ def distill(model, venv, cfg: DistillConfig, seed: int = 0, log=None) -> list[di
     if venv.venv.map.residual is not None:
         raise ValueError("distill needs the plain voltage map (residual: null), got "
                          f"residual {venv.venv.map.residual!r}")
-    teacher = _teacher(cfg.teacher)
+    from baselines.evaluate import default_policies
+
+    teacher = default_policies()[cfg.teacher]
     f, params, squash = actor_mean(model)
     rng = np.random.default_rng(seed)
     steps = int(venv.get_attr("horizon", [0])[0])  # one episode per sub-env and iteration

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, replace
 from functools import lru_cache
 from typing import Any
@@ -21,10 +22,21 @@ from .render import FigureOwner
 from .simulate import simulate
 from .thesis import V_LIMIT
 
-__all__ = ["ACLDBeamEnv", "Nominal", "nominal", "random_load", "LOAD_CASES", "OBS_MODES",
-           "configure", "check_config", "check_actions", "observation_size", "estimate_map",
-           "step_matrix", "output_matrix", "load_schedule", "draw_episode", "randomized_plant",
-           "reward_of"]
+if os.environ.get("ACLD_GYM_PURE_PYTHON") == "1":  # debugging: numpy steps only
+    StepCore = None
+else:
+    try:
+        from ._stepcore import StepCore
+    except ImportError:  # built without a C compiler: the numpy reference step serves
+        StepCore = None
+
+#: Whether ``ACLDBeamEnv.step`` runs its common path compiled (``acld_gym._stepcore``).
+COMPILED_STEP = StepCore is not None
+
+__all__ = ["ACLDBeamEnv", "COMPILED_STEP", "Nominal", "nominal", "random_load", "LOAD_CASES",
+           "OBS_MODES", "configure", "check_config", "check_actions", "observation_size",
+           "estimate_map", "step_matrix", "output_matrix", "load_schedule", "draw_episode",
+           "randomized_plant", "reward_of"]
 
 LOAD_CASES = (1, 2, 3, "random")
 #: Default tip-sensor noise std [m]: 0.1 um, the resolution of a laser displacement
@@ -203,24 +215,64 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
     # --- composition of a step ----------------------------------------------
     # The state lives in one buffer z = [x, xhat, y_meas, V, f0, f1, w'] (x and xhat
     # are views into it). One product G z (output_matrix) advances plant and observer
-    # and gives the new measurement, the observation and the info's numbers.
+    # and gives the new measurement, the observation and the info's numbers. The step
+    # runs in C (acld_gym._stepcore.StepCore) where it can, else in numpy (_step); the
+    # core holds the step count, voltage, last measurement and last output for both.
+    _compiled = COMPILED_STEP  # False on an instance (before reset): numpy steps only
+
+    k = property(lambda self: self._core.k, lambda self, val: setattr(self._core, "k", val),
+                 doc="Steps taken in the episode.")
+    v = property(lambda self: self._core.v, lambda self, val: setattr(self._core, "v", val),
+                 doc="Voltage applied in the last step [V].")
+    y_meas = property(lambda self: self._core.y_meas,
+                      lambda self, val: setattr(self._core, "y_meas", val),
+                      doc="Last tip measurement [m].")
+    _last = property(lambda self: self._core.last,
+                     doc="G z of the last step (:func:`output_matrix`; one buffer).")
+    x = property(lambda self: self._z[:self._n], doc="True plant state [q; dq/dt] (a view).")
+    xhat = property(lambda self: self._z[self._n:self._nk], doc="Observer state (a view).")
+
     def _reset_state(self, load: TipLoad) -> None:
         self.load = load
-        self.k = 0
-        n, k = self._plant.Ad.shape[0], self._obs.n
+        self._n, k = n, k = self._plant.Ad.shape[0], self._obs.n
         self._nk = nk = n + k
         self._z = np.zeros(nk + 3 + 2 * self._plant.substeps)
-        self.x, self.xhat = self._z[:n], self._z[n:nk]
-        self.v = 0.0
-        self.y_meas = 0.0
         self.y_hist = np.zeros(self.obs_hist)
         self.history: list[tuple[float, float, float]] = []
-        F, self._tipf = load_schedule(self.nom.plant, load, 0, self.max_steps)
+        F, tipf = load_schedule(self.nom.plant, load, 0, self.max_steps)
+        self._tipf = np.ascontiguousarray(tipf, dtype=np.float64)
         self._noise = np.zeros(self.max_steps + 1)
         self._inputs = np.hstack([F, self._noise[1:, None]])  # per step: [f0, f1, w']
         self._G = output_matrix(step_matrix(self._plant, self.nom.plant, self._obs), n, k,
                                 self._tip, self.nom.design.reduced.SL, self._est)
-        self._last = np.zeros(self._G.shape[0])  # G z of the last step (all zero at rest)
+        self._core = self._make_core()
+
+    def _make_core(self):
+        """The step's core over this episode's arrays (state: at rest)."""
+        if not (self._compiled and COMPILED_STEP):
+            return _NumpyCore(self._G.shape[0])
+        core = StepCore(G=self._G, z=self._z, inputs=self._inputs, tipf=self._tipf,
+                        y_hist=self.y_hist, nk=self._nk, n_x=self._n,
+                        n_xr=self.nom.design.reduced.order,
+                        obs_mode=OBS_MODES.index(self.obs_mode),
+                        n_obs=self.observation_space.shape[0], dt=self.dt, y_ref=self.y_ref,
+                        lam=self.lam, v_max=self.v_max, limit=self.deflection_limit,
+                        y_scale=Y_SCALE)
+        core.active = self.render_mode is None  # rendering steps in numpy (draws history)
+        return core
+
+    def __getstate__(self):
+        state = super().__getstate__()
+        c = self._core
+        state["_core"] = (c.k, c.v, c.y_meas, c.last)  # the C core does not pickle
+        return state
+
+    def __setstate__(self, state):
+        k, v, y_meas, last = state.pop("_core")
+        self.__dict__.update(state)
+        self._core = self._make_core()
+        self.k, self.v, self.y_meas = k, v, y_meas
+        self._last[:] = last
 
     def _draw_noise(self) -> None:
         """The episode's sensor noise, drawn at reset (the vector env draws the same)."""
@@ -257,7 +309,7 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
         tip_load = float(self._tipf[k]) if k <= self.max_steps else float(self.load(k * self.dt))
         return {"tip_deflection": float(self._last[nk + 1]), "voltage": self.v,
                 "tip_load": tip_load, "time": k * self.dt,
-                "xr_true": self._last[nk + 2:nk + 8],  # a view of this step's fresh output
+                "xr_true": self._last[nk + 2:nk + 2 + self.nom.design.reduced.order].copy(),
                 "clipped": requested is not None and requested != self.v,
                 "requested_voltage": self.v if requested is None else requested}
 
@@ -280,20 +332,28 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
         return self._observation(), self._info()
 
     def step(self, action):
+        result = self._core.step(action)  # the compiled path; None where it does not apply
+        return result if result is not None else self._step(action)
+
+    def _step(self, action):
+        """The step in numpy: the reference for :class:`acld_gym._stepcore.StepCore`, and
+        the path for actions of other types, bad actions, rendering and steps past the
+        tabulated episode."""
         v, requested = self._voltage(action)
-        k, z, nk = self.k, self._z, self._nk
+        c, z, nk = self._core, self._z, self._nk
+        k = c.k
         z[nk + 1] = v
         z[nk + 2:] = self._step_inputs(k)
         # 1. plant (ZOH) and 2. observer over one period, 3. the new measurement
-        out = self._last = self._G @ z
+        out = np.dot(self._G, z, out=c.last)
         z[:nk + 1] = out[:nk + 1]
-        self.k = k = k + 1
-        self.v = v
-        self.y_meas = float(out[nk])
+        c.k = k = k + 1
+        c.v = v
+        c.y_meas = float(out[nk])
         y = float(out[nk + 1])
         if self.obs_mode == "measurement":
             self.y_hist[:-1] = self.y_hist[1:]
-            self.y_hist[-1] = self.y_meas
+            self.y_hist[-1] = c.y_meas
         reward = reward_of(y, v, self.y_ref, self.lam, self.v_max)  # 4. on the true deflection
         terminated = abs(y) > self.deflection_limit  # 5. physical limit
         truncated = k >= self.max_steps
@@ -319,6 +379,19 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
 
     def close(self):
         self._close_figure()
+
+
+class _NumpyCore:
+    """The state :class:`acld_gym._stepcore.StepCore` keeps, without a compiled step
+    (every step goes to ``ACLDBeamEnv._step``)."""
+
+    __slots__ = ("k", "v", "y_meas", "last")
+
+    def __init__(self, m: int):
+        self.k, self.v, self.y_meas, self.last = 0, 0.0, 0.0, np.zeros(m)
+
+    def step(self, action) -> None:
+        return None
 
 
 def _check_choice(name: str, value, choices) -> None:

@@ -1,5 +1,10 @@
 """Env-steps per second of ACLDBeam-v0: single env, native vector env, SB3 adapter.
 
+Then the single env's step taken apart (resets excluded): the compiled step, its
+matrix-vector product alone (timed in C, mean over the states of an episode), the
+numpy reference step, and a no-op Python env with the same API (the floor of any
+pure-Python Gymnasium env).
+
 Not a timed test: run ``python benchmarks/bench_env.py [--seconds 2]``. Actions
 are pre-generated uniform random voltages (beyond +/-120 V sometimes, so the
 clipping path is exercised); episodes (1000 steps) autoreset as in training, so
@@ -17,7 +22,7 @@ import gymnasium as gym
 import numpy as np
 
 import acld_gym  # noqa: F401  (registers ACLDBeam-v0)
-from acld_gym.env import ACLDBeamEnv
+from acld_gym.env import COMPILED_STEP, ACLDBeamEnv
 from acld_gym.sb3 import SB3VecEnv
 from acld_gym.vector_env import ACLDBeamVectorEnv
 
@@ -87,19 +92,56 @@ class _NoOpEnv(gym.Env):
         return np.zeros(7, np.float32), -v * v, False, self.k >= 1000, info
 
 
+def _episode_step_us(env, acts, episodes: int) -> float:
+    """Mean wall time of ``env.step`` over whole episodes, resets not counted [us]."""
+    total, n = 0.0, 0
+    for e in range(episodes):
+        env.reset(seed=e)
+        t0 = time.perf_counter()
+        for a in acts:
+            env.step(a)
+        total += time.perf_counter() - t0
+        n += len(acts)
+    return 1e6 * total / n
+
+
+def _product_us(env, acts) -> float:
+    """Mean wall time of the compiled step's product alone, over the states of an
+    episode (columns with z_j = 0 are skipped, so the cost depends on the state) [us]."""
+    env.reset(seed=0)
+    times = []
+    for k, a in enumerate(acts):
+        env.step(a)
+        if k % 50 == 25:
+            times.append(env._core.product_seconds(4000))
+    return 1e6 * float(np.mean(times))
+
+
 def bench_breakdown(seconds: float) -> list[tuple[str, float]]:
-    """Microseconds per single-env step: the whole step, its one fused product, and a
-    no-op env with the same API (what any Python Gymnasium env costs)."""
+    """Microseconds per single-env step (resets excluded): the compiled step, its
+    product, the numpy reference step, and a no-op env with the same API."""
+    acts = np.random.default_rng(0).uniform(-150, 150, (1000, 1)).astype(np.float32)
+    episodes = max(1, int(seconds / 1e-3))  # ~1 ms per episode compiled
     env = ACLDBeamEnv(**KW)
     env.reset(seed=0)
-    G, z = env._G, env._z
-    t_step = 1e6 / bench_single(env, seconds)
-    t_noop = 1e6 / bench_single(_NoOpEnv(), seconds)
-    t_mv = 1e6 / _timed(lambda j: G @ z, 1, seconds)
-    return [(f"single env step [us] (fused product {G.shape[0]} x {G.shape[1]})", t_step),
-            ("  of which the fused matrix-vector product [us]", t_mv),
-            ("  no-op Gymnasium env, same spaces and info [us]", t_noop),
-            ("  the rest: Python bookkeeping of the step [us]", t_step - t_mv - t_noop)]
+    G = env._G
+    rows = []
+    if COMPILED_STEP:
+        t_step = _episode_step_us(env, acts, episodes)
+        t_prod = _product_us(env, acts)
+        rows += [("single env step, compiled (acld_gym._stepcore) [us]", t_step),
+                 (f"  of which the fused {G.shape[0]} x {G.shape[1]} product [us]", t_prod),
+                 ("  the rest: call, action check, reward, obs, info [us]", t_step - t_prod),
+                 ("  product's share of the step [%]", 100 * t_prod / t_step)]
+    else:
+        rows.append(("(acld_gym._stepcore not built: numpy steps only)", float("nan")))
+    ref = ACLDBeamEnv(**KW)
+    ref._compiled = False
+    rows.append(("single env step, numpy reference path [us]",
+                 _episode_step_us(ref, acts, max(1, episodes // 5))))
+    rows.append(("no-op Gymnasium env in Python, same spaces and info [us]",
+                 1e6 / bench_single(_NoOpEnv(), seconds)))
+    return rows
 
 
 def main(argv=None) -> None:
@@ -108,7 +150,7 @@ def main(argv=None) -> None:
     args = ap.parse_args(argv)
     s = args.seconds
     print(f"ACLDBeam-v0 env-steps/s (load_case='random', obs 'estimate'; {os.cpu_count()} CPUs, "
-          f"numpy {np.__version__}, {s:g} s each)")
+          f"numpy {np.__version__}, {s:g} s each; compiled step: {COMPILED_STEP})")
     rows = [
         ("single ACLDBeamEnv (raw class)", bench_single(ACLDBeamEnv(**KW), s)),
         ("single gym.make (TimeLimit, OrderEnforcing, PassiveEnvChecker)",

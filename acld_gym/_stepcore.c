@@ -68,10 +68,11 @@ check_array(PyObject *a, const char *name, int ndim, npy_intp d0, npy_intp d1)
 {
     if (!PyArray_Check(a) || PyArray_TYPE((PyArrayObject *)a) != NPY_DOUBLE
         || !PyArray_IS_C_CONTIGUOUS((PyArrayObject *)a)
+        || !PyArray_ISNOTSWAPPED((PyArrayObject *)a) || !PyArray_ISALIGNED((PyArrayObject *)a)
         || !PyArray_ISWRITEABLE((PyArrayObject *)a)
         || PyArray_NDIM((PyArrayObject *)a) != ndim) {
-        PyErr_Format(PyExc_ValueError, "StepCore: %s must be a writeable C-contiguous "
-                     "float64 array with %d dimension(s)", name, ndim);
+        PyErr_Format(PyExc_ValueError, "StepCore: %s must be a writeable, aligned, "
+                     "C-contiguous native float64 array with %d dimension(s)", name, ndim);
         return -1;
     }
     npy_intp *s = PyArray_DIMS((PyArrayObject *)a);
@@ -200,7 +201,9 @@ core_step(StepCore *self, PyObject *action)
     if (!self->active || self->k >= self->max_steps || !PyArray_CheckExact(action))
         Py_RETURN_NONE;
     PyArrayObject *a = (PyArrayObject *)action;
-    if (PyArray_NDIM(a) != 1 || PyArray_DIM(a, 0) != 1) Py_RETURN_NONE;
+    if (PyArray_NDIM(a) != 1 || PyArray_DIM(a, 0) != 1 || !PyArray_ISNOTSWAPPED(a)
+        || !PyArray_ISALIGNED(a))
+        Py_RETURN_NONE;
     double requested;
     if (PyArray_TYPE(a) == NPY_FLOAT32) requested = *(float *)PyArray_DATA(a);
     else if (PyArray_TYPE(a) == NPY_DOUBLE) requested = *(double *)PyArray_DATA(a);

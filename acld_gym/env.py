@@ -129,7 +129,9 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
     exactly with a zero-order hold on the voltage; the tip load is
     integrated within each period (sub-steps with first-order hold, exact
     for pulses). The observer runs on the nominal model, never on the
-    (possibly randomized) plant.
+    (possibly randomized) plant. A step is one fused matrix-vector product
+    (:func:`output_matrix`); it runs in C (``acld_gym._stepcore``) when that
+    module was built (``COMPILED_STEP``), else in numpy, with the same results.
 
     ## Action Space
 

@@ -85,8 +85,9 @@ def test_compiled_and_numpy_steps_give_the_same_episode(kw):
 @needs_core
 @pytest.mark.parametrize("action", [
     [35.0], (35.0,), np.array([35.0]), np.array([35]), np.array([[35.0]], np.float32),
-    np.array([35.0], np.float32)[::1], np.float32(35.0),
-], ids=["list", "tuple", "float64", "int", "2d", "view", "scalar"])
+    np.array([35.0], np.float32)[::1], np.float32(35.0), np.array([35.0], ">f4"),
+    np.array([35.0], np.float16),
+], ids=["list", "tuple", "float64", "int", "2d", "view", "scalar", "big-endian", "float16"])
 def test_every_action_type_steps_alike(action):
     # float32/float64 1-element arrays take the compiled path, the rest the numpy path
     ref = _env(True, load_case=2)
@@ -98,6 +99,15 @@ def test_every_action_type_steps_alike(action):
         o2, r2, *_, i2 = got.step(action)
         np.testing.assert_allclose(o1, o2, rtol=1e-6, atol=1e-7)
         assert r1 == pytest.approx(r2, rel=1e-12) and i1["voltage"] == i2["voltage"] == 35.0
+
+
+@needs_core
+def test_paths_hand_over_state_mid_episode():
+    # lists step in numpy, float32 arrays in C: alternating them equals all-C
+    acts = np.random.default_rng(2).uniform(-150, 150, (300, 1)).astype(np.float32)
+    mixed = [a if k % 3 else [float(a[0])] for k, a in enumerate(acts)]
+    _assert_same(_episode(_env(True, load_case="random", obs_mode="measurement"), 4, mixed),
+                 _episode(_env(True, load_case="random", obs_mode="measurement"), 4, acts))
 
 
 @pytest.mark.parametrize("compiled", [True, False])
@@ -150,6 +160,7 @@ def test_rendering_steps_in_numpy_and_records_history():
     (dict(n_obs=8), "obs_mode"),
     (dict(n_x=100), "inconsistent sizes"),
     (dict(z=np.zeros(134)[::2]), "z must be"),
+    (dict(tipf=np.zeros(1001, ">f8")), "tipf must be"),
 ])
 def test_core_constructor_rejects_inconsistent_arrays(change, match):
     from acld_gym._stepcore import StepCore

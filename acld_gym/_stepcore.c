@@ -198,7 +198,8 @@ static PyObject *
 core_step(StepCore *self, PyObject *action)
 {
     /* The common path only: anything else goes to the Python reference step. */
-    if (!self->active || self->k >= self->max_steps || !PyArray_CheckExact(action))
+    if (!self->active || self->Gt == NULL || self->k < 0 || self->k >= self->max_steps
+        || !PyArray_CheckExact(action))
         Py_RETURN_NONE;
     PyArrayObject *a = (PyArrayObject *)action;
     if (PyArray_NDIM(a) != 1 || PyArray_DIM(a, 0) != 1 || !PyArray_ISNOTSWAPPED(a)
@@ -292,6 +293,10 @@ core_product_seconds(StepCore *self, PyObject *arg)
     if (n == -1 && PyErr_Occurred()) return NULL;
     if (n < 1) {
         PyErr_SetString(PyExc_ValueError, "product_seconds: n must be a positive integer");
+        return NULL;
+    }
+    if (self->Gt == NULL) {
+        PyErr_SetString(PyExc_RuntimeError, "product_seconds: StepCore was not initialized");
         return NULL;
     }
     double *buf = PyMem_Malloc((size_t)self->m * sizeof(double));

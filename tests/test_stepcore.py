@@ -176,6 +176,21 @@ def test_core_constructor_rejects_inconsistent_arrays(change, match):
 
 
 @needs_core
+def test_core_declines_what_it_cannot_step_safely():
+    from acld_gym._stepcore import StepCore
+
+    a = np.zeros(1, np.float32)
+    bare = StepCore.__new__(StepCore)  # never initialized: no arrays
+    assert bare.step(a) is None
+    with pytest.raises(RuntimeError, match="not initialized"):
+        bare.product_seconds(1)
+    env = ACLDBeamEnv()
+    env.reset(seed=0)
+    env._core.k = -1  # out of the tabulated range: the numpy path decides
+    assert env._core.step(a) is None
+
+
+@needs_core
 def test_product_timer_checks_its_argument_and_leaves_the_state():
     env = ACLDBeamEnv(load_case=2)
     env.reset(seed=0)

@@ -236,7 +236,8 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
 
     def _reset_state(self, load: TipLoad) -> None:
         self.load = load
-        self._n, k = n, k = self._plant.Ad.shape[0], self._obs.n
+        n, k = self._plant.Ad.shape[0], self._obs.n
+        self._n = n
         self._nk = nk = n + k
         self._z = np.zeros(nk + 3 + 2 * self._plant.substeps)
         self.y_hist = np.zeros(self.obs_hist)

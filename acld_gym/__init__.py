@@ -1,13 +1,20 @@
 """acld-gym: an ACLD cantilever (Rodriguez 2006) as a Gymnasium benchmark.
 
-Importing the package registers ``ACLDBeam-v0``; ``gym.make("acld_gym:ACLDBeam-v0")``
-imports it by itself.
+Importing the package registers ``ACLDBeam-v1`` (the mesh-converged beam, canonical
+observation) and ``ACLDBeam-v0`` (the thesis mesh, legacy coordinates);
+``gym.make("acld_gym:ACLDBeam-v1")`` imports it by itself.
 """
 
 from gymnasium.envs.registration import register, registry
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
-if "ACLDBeam-v0" not in registry:
-    register(id="ACLDBeam-v0", entry_point="acld_gym.env:ACLDBeamEnv",
+#: The current environment id.
+ENV_ID = "ACLDBeam-v1"
+
+if "ACLDBeam-v1" not in registry:
+    register(id="ACLDBeam-v1", entry_point="acld_gym.env:ACLDBeamEnv",
              vector_entry_point="acld_gym.vector_env:ACLDBeamVectorEnv", max_episode_steps=1000)
+if "ACLDBeam-v0" not in registry:
+    register(id="ACLDBeam-v0", entry_point="acld_gym.legacy:ACLDBeamEnvV0",
+             vector_entry_point="acld_gym.legacy:ACLDBeamVectorEnvV0", max_episode_steps=1000)

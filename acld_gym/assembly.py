@@ -13,13 +13,21 @@ index 17 (0-based).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
+import scipy.sparse as sp
 
-from .elements import ACLD_NODE_DOFS, BEAM_NODE_DOFS, acld_element, timoshenko_element
+from .elements import (
+    ACLD_NODE_DOFS,
+    BEAM_NODE_DOFS,
+    acld_terms,
+    combine_terms,
+    timoshenko_terms,
+)
 from .params import BeamParameters, Mesh
 
-__all__ = ["DofMap", "number_dofs", "assemble"]
+__all__ = ["DofMap", "AssembledTerms", "number_dofs", "assemble", "assemble_terms"]
 
 
 @dataclass(frozen=True)
@@ -47,18 +55,29 @@ class DofMap:
         """Global DOFs fixed by the clamp at x = 0: u, w and theta of node 0."""
         return tuple(self.node_dofs[0][k] for k in BEAM_NODE_DOFS)
 
-    @property
+    @cached_property
     def free(self) -> np.ndarray:
-        """Global DOFs that remain after clamping, in order."""
-        return np.setdiff1d(np.arange(self.n_dofs), self.clamped)
+        """Global DOFs that remain after clamping, in order (read-only)."""
+        free = np.setdiff1d(np.arange(self.n_dofs), self.clamped)
+        free.setflags(write=False)
+        return free
+
+    @cached_property
+    def _reduced(self) -> dict[int, int]:
+        return {int(g): i for i, g in enumerate(self.free)}
 
     def reduced_index(self, node: int, dof: str) -> int:
         """Index of a nodal DOF in the clamped system (raises if it is clamped)."""
         g = self.node_dofs[node][dof]
-        hits = np.flatnonzero(self.free == g)
-        if hits.size == 0:
+        if g not in self._reduced:
             raise ValueError(f"DOF {dof!r} of node {node} is clamped")
-        return int(hits[0])
+        return self._reduced[g]
+
+    def reduced_of(self, g: int) -> int:
+        """Index of global DOF ``g`` in the clamped system (raises if it is clamped)."""
+        if g not in self._reduced:
+            raise ValueError(f"global DOF {g} is clamped")
+        return self._reduced[g]
 
 
 def number_dofs(p: BeamParameters, mesh: Mesh) -> DofMap:
@@ -108,23 +127,53 @@ def number_dofs(p: BeamParameters, mesh: Mesh) -> DofMap:
                   z_dofs=tuple(z_dofs), n_dofs=nxt)
 
 
-def assemble(p: BeamParameters, dofs: DofMap) -> tuple[np.ndarray, ...]:
-    """Global ``(M, C, K, Pc)`` before the clamp (FEASMBL / FEASMBL2).
+@dataclass(frozen=True, eq=False)
+class AssembledTerms:
+    """Global unit matrices of every term (sparse CSR, all DOFs before the clamp) and the
+    piezo unit vector; :meth:`combine` weights them with a parameter set's material
+    coefficients (:data:`acld_gym.elements.TERM_COEFFICIENTS`)."""
 
-    Element matrices are computed once per distinct (kind, length).
+    units: dict[str, sp.csr_matrix]
+    piezo: np.ndarray
+
+    def combine(self, p: BeamParameters):
+        """Global sparse ``(M, C, K)`` and dense ``Pc`` for the material parameters of ``p``."""
+        return combine_terms(self.units, self.piezo, p)
+
+
+def assemble_terms(p: BeamParameters, dofs: DofMap) -> AssembledTerms:
+    """Assemble each term's unit matrices into global sparse matrices (FEASMBL order).
+
+    Unit matrices depend on the geometry only; they are computed once per distinct
+    (kind, length).
     """
     n = dofs.n_dofs
-    M, C, K = (np.zeros((n, n)) for _ in range(3))
-    Pc = np.zeros(n)
+    rows: dict[str, list] = {}
+    cols: dict[str, list] = {}
+    vals: dict[str, list] = {}
+    piezo = np.zeros(n)
     cache: dict[tuple[str, float], object] = {}
     for kind, le, idx in dofs.elements:
         key = (kind, round(le, 15))
         if key not in cache:
-            cache[key] = (acld_element if kind == "acld" else timoshenko_element)(p, le)
-        em = cache[key]
-        ix = np.ix_(idx, idx)
-        M[ix] += em.M
-        C[ix] += em.C
-        K[ix] += em.K
-        Pc[list(idx)] += em.Pc
-    return M, C, K, Pc
+            cache[key] = (acld_terms if kind == "acld" else timoshenko_terms)(p, le)
+        et = cache[key]
+        ii = np.asarray(idx)
+        r = np.repeat(ii, ii.size)
+        c = np.tile(ii, ii.size)
+        for name, U in et.units.items():
+            rows.setdefault(name, []).append(r)
+            cols.setdefault(name, []).append(c)
+            vals.setdefault(name, []).append(U.ravel())
+        np.add.at(piezo, ii, et.piezo)
+    units = {name: sp.coo_matrix((np.concatenate(vals[name]), (np.concatenate(rows[name]),
+                                                               np.concatenate(cols[name]))),
+                                 shape=(n, n)).tocsr()
+             for name in rows}
+    return AssembledTerms(units=units, piezo=piezo)
+
+
+def assemble(p: BeamParameters, dofs: DofMap) -> tuple[np.ndarray, ...]:
+    """Global dense ``(M, C, K, Pc)`` before the clamp (FEASMBL / FEASMBL2)."""
+    M, C, K, Pc = assemble_terms(p, dofs).combine(p)
+    return M.toarray(), C.toarray(), K.toarray(), Pc

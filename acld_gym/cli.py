@@ -66,7 +66,7 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
 
 def cmd_model(args: argparse.Namespace) -> int:
     d = design(preset=args.preset)
-    m = d.model
+    m = d.truth
     A, B, E, Cy = d.plant
     res = simulate(A, B, E, Cy, d.observer("thesis"), d.passive, thesis_load(1), t_end=T_END,
                    v_max=None)

@@ -10,7 +10,9 @@ state :math:`x_r`,
 
 described by :class:`Feedback`. LQR is the special case :math:`c = 0`.
 
-* LQR (eqs. 65-67): :math:`\hat Q = q\,S_R^T S_R` (q = 1e11), R = 1.
+* LQR (eqs. 65-67): :math:`\hat Q = q\,S_R^T W S_R` (q = 1e11), R = 1, with W the
+  metric of the full state (the identity on the thesis mesh's DOFs, where the thesis
+  puts its weight; :attr:`acld_gym.design.Design.metric` for other plants).
 * SMC (eqs. 68-72): sliding surface :math:`s` = the LQR gain for
   :math:`q = 10^6`; equivalent control :math:`-(sB_r)^{-1} s A_r x_r`;
   switching gain :math:`\eta = 1.5\,|(sB_r)^{-1} s S_L^T \hat B|`
@@ -23,11 +25,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg as sla
 
 from .numerics import care_gain
 from .reduction import ReducedModel
 
-__all__ = ["Feedback", "passive", "lqr", "smc", "THESIS_LQR_WEIGHT", "THESIS_SMC_WEIGHT"]
+__all__ = ["Feedback", "passive", "lqr", "smc", "projected_weight", "discrete_lqr_gain",
+           "THESIS_LQR_WEIGHT",
+           "THESIS_SMC_WEIGHT"]
 
 #: Full-state weight of the thesis's LQR, Q = 1e11 I (Table 1).
 THESIS_LQR_WEIGHT = 1e11
@@ -70,24 +75,34 @@ def passive(k: int) -> Feedback:
     return Feedback(a=z, s=z, c=0.0, eps=1.0, name="passive")
 
 
-def _projected_lqr(red: ReducedModel, weight: float, R: float) -> np.ndarray:
+def _projected_lqr(red: ReducedModel, weight: float, R: float,
+                   metric: np.ndarray | None) -> np.ndarray:
     if not weight > 0:
         raise ValueError(f"weight must be positive, got {weight!r}")
     if not R > 0:
         raise ValueError(f"R must be positive, got {R!r}")
-    Q = weight * red.SR.T @ red.SR
-    K, _ = care_gain(red.A, red.B, 0.5 * (Q + Q.T), np.array([[R]]))
+    K, _ = care_gain(red.A, red.B, projected_weight(red, weight, metric), np.array([[R]]))
     return K[0]
 
 
-def lqr(red: ReducedModel, weight: float = THESIS_LQR_WEIGHT, R: float = 1.0) -> Feedback:
-    """LQR with the full-state weight ``weight * I`` projected by S_R (eq. 67)."""
-    K = _projected_lqr(red, weight, R)
+def projected_weight(red: ReducedModel, weight: float,
+                     metric: np.ndarray | None = None) -> np.ndarray:
+    r""":math:`q\,S_R^T W S_R`: the full-state weight ``weight * W`` seen by the reduced
+    state (W = ``metric``, default the identity), symmetrized."""
+    SR = red.SR
+    Q = weight * (SR.T @ SR if metric is None else SR.T @ metric @ SR)
+    return 0.5 * (Q + Q.T)
+
+
+def lqr(red: ReducedModel, weight: float = THESIS_LQR_WEIGHT, R: float = 1.0,
+        metric: np.ndarray | None = None) -> Feedback:
+    """LQR with the full-state weight ``weight * W`` projected by S_R (eq. 67)."""
+    K = _projected_lqr(red, weight, R, metric)
     return Feedback(a=K, s=np.zeros_like(K), c=0.0, eps=1.0, name="lqr")
 
 
 def smc(red: ReducedModel, weight: float = THESIS_SMC_WEIGHT, R: float = 1.0,
-        eta_factor: float = 1.5, eps: float = 1.0) -> Feedback:
+        eta_factor: float = 1.5, eps: float = 1.0, metric: np.ndarray | None = None) -> Feedback:
     """Sliding-mode control with boundary layer (eqs. 68-72).
 
     ``red.E`` must hold the reduced tip-load input :math:`S_L^T \\hat B`.
@@ -96,8 +111,16 @@ def smc(red: ReducedModel, weight: float = THESIS_SMC_WEIGHT, R: float = 1.0,
         raise ValueError(f"eps must be positive, got {eps!r}")
     if red.E.shape[1] != 1:
         raise ValueError("red: the reduced model needs its tip-load input E (one column)")
-    S = _projected_lqr(red, weight, R)
+    S = _projected_lqr(red, weight, R, metric)
     sb = float(S @ red.B[:, 0])
     eta = eta_factor * abs(float(S @ red.E[:, 0]) / sb)
     a = (S @ red.A) / sb  # u_eq = -(S B)^-1 S A x_r
     return Feedback(a=a, s=S, c=float(np.sign(sb)) * eta, eps=eps, name="smc")
+
+
+def discrete_lqr_gain(A: np.ndarray, B: np.ndarray, Q: np.ndarray,
+                      R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Discrete LQR: :math:`K = (R + B^T X B)^{-1} B^T X A` with X from the DARE;
+    returns ``(K, X)``."""
+    X = sla.solve_discrete_are(A, B, 0.5 * (Q + Q.T), R)
+    return np.linalg.solve(R + B.T @ X @ B, B.T @ X @ A), X

@@ -24,14 +24,16 @@ strain, :math:`\delta W = E_c d_{31} b V \int \delta(\partial u_c/\partial x)\,d
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
 from .params import BeamParameters
 
-__all__ = ["ElementMatrices", "timoshenko_element", "acld_element", "BEAM_NODE_DOFS",
-           "ACLD_NODE_DOFS"]
+__all__ = ["ElementMatrices", "ElementTerms", "timoshenko_element", "acld_element",
+           "timoshenko_terms", "acld_terms", "combine_terms", "TERM_COEFFICIENTS",
+           "PIEZO_COEFFICIENT", "BEAM_NODE_DOFS", "ACLD_NODE_DOFS"]
 
 #: Nodal degrees of freedom of the plain Timoshenko element, in order.
 BEAM_NODE_DOFS = ("u", "w", "theta")
@@ -85,36 +87,180 @@ def _outer(row: np.ndarray) -> np.ndarray:
     return np.outer(row, row)
 
 
-def _beam_layer(sh: _Shape, E: float, G: float, rho: float, A: float, I: float,
-                k_shear: float) -> tuple[np.ndarray, np.ndarray]:
-    """Timoshenko layer on the beam axis: bending, reduced-integration shear,
-    extension (stiffness) and transverse/rotary plus axial inertia (mass).
+# --- parameter-affine form -------------------------------------------------------
+# Every element matrix is a sum of parameter-free "unit" matrices (geometry and shape
+# functions only) times a coefficient that is a product of material parameters:
+#
+#     M = sum_t m_t(p) U_t,   C = sum_t c_t(p) U_t,   K = sum_t k_t(p) U_t,   Pc = e(p) u.
+#
+# The table below owns that structure. The environment's parameter randomization
+# relies on it: a randomized plant is the same unit matrices with new coefficients
+# (acld_gym.plant), so its reduced matrices are sums of precomputed small matrices.
+#: term -> {"M" | "C" | "K": coefficient(p)}; Rayleigh damping C = a M + b K acts on the
+#: beam, PZT and VEM layers, not on the GHM dissipation coordinates.
+TERM_COEFFICIENTS: dict[str, dict[str, Callable[[BeamParameters], float]]] = {
+    "beam.inertia": {"M": lambda p: p.beam_density,
+                     "C": lambda p: p.rayleigh_mass * p.beam_density},
+    "beam.stiffness": {"K": lambda p: p.beam_youngs_modulus,
+                       "C": lambda p: p.rayleigh_stiffness * p.beam_youngs_modulus},
+    "beam.shear": {"K": lambda p: p.shear_correction * p.beam_shear_modulus,
+                   "C": lambda p: p.rayleigh_stiffness * p.shear_correction
+                   * p.beam_shear_modulus},
+    "pzt.inertia": {"M": lambda p: p.pzt_density,
+                    "C": lambda p: p.rayleigh_mass * p.pzt_density},
+    "pzt.stiffness": {"K": lambda p: p.pzt_youngs_modulus,
+                      "C": lambda p: p.rayleigh_stiffness * p.pzt_youngs_modulus},
+    "pzt.shear": {"K": lambda p: p.shear_correction * p.pzt_shear_modulus,
+                  "C": lambda p: p.rayleigh_stiffness * p.shear_correction
+                  * p.pzt_shear_modulus},
+    "vem.inertia": {"M": lambda p: p.vem_density,
+                    "C": lambda p: p.rayleigh_mass * p.vem_density},
+    "vem.stiffness": {"K": lambda p: p.vem_youngs_modulus,
+                      "C": lambda p: p.rayleigh_stiffness * p.vem_youngs_modulus},
+    "vem.shear": {"K": lambda p: p.ghm_kappa * (1.0 + p.ghm_alpha),
+                  "C": lambda p: p.rayleigh_stiffness * p.ghm_kappa * (1.0 + p.ghm_alpha)},
+    "ghm.coupling": {"K": lambda p: p.ghm_alpha * p.ghm_kappa},
+    "ghm.dissipation": {"M": lambda p: p.ghm_alpha * p.ghm_kappa / p.ghm_omega**2,
+                        "C": lambda p: 2.0 * p.ghm_zeta * p.ghm_alpha * p.ghm_kappa
+                        / p.ghm_omega},
+}
+#: Coefficient of the piezo unit vector: E_c d_31 [N/(V m)] (the width is geometry).
+PIEZO_COEFFICIENT: Callable[[BeamParameters], float] = \
+    lambda p: p.pzt_youngs_modulus * p.d31  # noqa: E731
+
+
+@dataclass(frozen=True)
+class ElementTerms:
+    """An element's unit matrices (``units[term]``, local DOFs) and piezo unit vector."""
+
+    units: dict[str, np.ndarray]
+    piezo: np.ndarray
+
+    def combine(self, p: BeamParameters) -> ElementMatrices:
+        """The element's matrices for the material parameters of ``p``."""
+        return ElementMatrices(*combine_terms(self.units, self.piezo, p))
+
+
+def combine_terms(units: dict, piezo, p: BeamParameters):
+    """``(M, C, K, Pc)`` = the coefficient-weighted sums of ``units`` (dense or sparse,
+    local or assembled) for the material parameters of ``p``."""
+    out = {}
+    for name, unit in units.items():
+        for which, coef in TERM_COEFFICIENTS[name].items():
+            term = coef(p) * unit
+            out[which] = term if which not in out else out[which] + term
+    return out["M"], out["C"], out["K"], PIEZO_COEFFICIENT(p) * piezo
+
+
+def _layer_units(sh: _Shape, area: float, inertia: float, axial=None,
+                 axial_rate=None) -> tuple[np.ndarray, np.ndarray]:
+    """Inertia and axial/bending stiffness units of one layer,
+
+    .. math::
+
+        U_m = \\int A N_w^T N_w + I N_\\theta^T N_\\theta + A N_a^T N_a, \\qquad
+        U_k = \\int I N_\\theta'^T N_\\theta' + A N_a'^T N_a'
+
+    with :math:`N_a` the layer's axial displacement (``axial(x)``; default the beam
+    axis, u) and :math:`N_a'` its derivative (``axial_rate()``).
+    """
+    axial = axial or (lambda x: sh.N("u", x))
+    axial_rate = axial_rate or (lambda: sh.dN("u"))
+    Um = sh.integrate(lambda x: area * _outer(sh.N("w", x)) + inertia * _outer(sh.N("theta", x))
+                      + area * _outer(axial(x)))
+    Uk = sh.integrate(lambda x: inertia * _outer(sh.dN("theta")) + area * _outer(axial_rate()))
+    return Um, Uk
+
+
+def _shear_unit(sh: _Shape, area: float) -> np.ndarray:
+    """:math:`A \\int_{1pt} (N_\\theta - N_w')^T (N_\\theta - N_w')`: transverse shear with
+    one-point reduced integration (no shear locking)."""
+    return sh.integrate(lambda x: area * _outer(sh.N("theta", x) - sh.dN("w")), points=1)
+
+
+def timoshenko_terms(p: BeamParameters, length: float) -> ElementTerms:
+    """Unit matrices of the plain-beam element, DOFs ``[u1 w1 theta1 u2 w2 theta2]``.
+
+    .. math::
+
+        M = \\rho_b U_m, \\quad K = E_b U_k + k G_b U_s, \\quad C = \\hat a M + \\hat b K.
+    """
+    sh = _Shape(BEAM_NODE_DOFS, length)
+    Um, Uk = _layer_units(sh, p.beam_area, p.beam_inertia)
+    return ElementTerms(units={"beam.inertia": Um, "beam.stiffness": Uk,
+                               "beam.shear": _shear_unit(sh, p.beam_area)},
+                        piezo=np.zeros(sh.n))
+
+
+def timoshenko_element(p: BeamParameters, length: float) -> ElementMatrices:
+    """Plain-beam element, DOFs ``[u1 w1 theta1 u2 w2 theta2]`` (``TimoshenkoFEM2.m``).
 
     .. math::
 
         K = E I \\int N_\\theta'^T N_\\theta'
             + k G A \\int_{1pt} (N_\\theta - N_w')^T (N_\\theta - N_w')
             + E A \\int N_u'^T N_u', \\quad
-        M = \\rho \\int (A N_w^T N_w + I N_\\theta^T N_\\theta + A N_u^T N_u)
+        M = \\rho \\int (A N_w^T N_w + I N_\\theta^T N_\\theta + A N_u^T N_u),
+
+    and Rayleigh damping :math:`C = \\hat a M + \\hat b K`.
     """
-    K = sh.integrate(lambda x: E * I * _outer(sh.dN("theta")) + E * A * _outer(sh.dN("u")))
-    K = K + sh.integrate(lambda x: k_shear * G * A * _outer(sh.N("theta", x) - sh.dN("w")),
-                         points=1)
-    M = sh.integrate(lambda x: rho * (A * _outer(sh.N("w", x)) + I * _outer(sh.N("theta", x))
-                                      + A * _outer(sh.N("u", x))))
-    return M, K
+    return timoshenko_terms(p, length).combine(p)
 
 
-def timoshenko_element(p: BeamParameters, length: float) -> ElementMatrices:
-    """Plain-beam element, DOFs ``[u1 w1 theta1 u2 w2 theta2]`` (``TimoshenkoFEM2.m``).
+def acld_terms(p: BeamParameters, length: float) -> ElementTerms:
+    """Unit matrices of the ACLD element, DOFs ``[u1 w1 theta1 gamma1 u2 w2 theta2 gamma2
+    z1 z2]`` (see :func:`acld_element` for the physics)."""
+    sh = _Shape(ACLD_NODE_DOFS, length)
+    tb, ts, h = p.beam_thickness, p.vem_thickness, p.pzt_offset
 
-    Rayleigh damping :math:`C = \\hat a M + \\hat b K`.
-    """
-    sh = _Shape(BEAM_NODE_DOFS, length)
-    M, K = _beam_layer(sh, p.beam_youngs_modulus, p.beam_shear_modulus, p.beam_density,
-                       p.beam_area, p.beam_inertia, p.shear_correction)
-    C = p.rayleigh_mass * M + p.rayleigh_stiffness * K
-    return ElementMatrices(M=M, C=C, K=K, Pc=np.zeros(sh.n))
+    def u_c(x):
+        return sh.N("u", x) - h * sh.N("theta", x) + ts * sh.N("gamma", x)
+
+    def du_c():
+        return sh.dN("u") - h * sh.dN("theta") + ts * sh.dN("gamma")
+
+    def u_s(x):
+        return sh.N("u", x) - 0.5 * (tb + ts) * sh.N("theta", x) + 0.5 * ts * sh.N("gamma", x)
+
+    def du_s():
+        return sh.dN("u") - 0.5 * (tb + ts) * sh.dN("theta") + 0.5 * ts * sh.dN("gamma")
+
+    n = sh.n
+
+    def pad(U: np.ndarray) -> np.ndarray:  # nodal DOFs -> nodal + the two z
+        out = np.zeros((n + 2, n + 2))
+        out[:n, :n] = U
+        return out
+
+    units: dict[str, np.ndarray] = {}
+    # Beam and PZT are Timoshenko layers; the PZT's axial motion is u_c, not u.
+    Um, Uk = _layer_units(sh, p.beam_area, p.beam_inertia)
+    units["beam.inertia"], units["beam.stiffness"] = pad(Um), pad(Uk)
+    units["beam.shear"] = pad(_shear_unit(sh, p.beam_area))
+    Um, Uk = _layer_units(sh, p.pzt_area, p.pzt_inertia, u_c, du_c)
+    units["pzt.inertia"], units["pzt.stiffness"] = pad(Um), pad(Uk)
+    units["pzt.shear"] = pad(_shear_unit(sh, p.pzt_area))
+    # VEM: inertia, bending and extension (with E_s), shear with the GHM
+    # high-frequency modulus kappa (1 + alpha).
+    As = p.vem_area
+    Um, Uk = _layer_units(sh, As, p.vem_inertia, u_s, du_s)
+    units["vem.inertia"], units["vem.stiffness"] = pad(Um), pad(Uk)
+    units["vem.shear"] = pad(sh.integrate(lambda x: As * _outer(sh.N("gamma", x))))
+
+    # GHM dissipation coordinates z (linear over the element).
+    def Nz(x):
+        return np.array([1.0 - x / length, x / length])
+
+    Uqz = sh.integrate(lambda x: As * np.outer(sh.N("gamma", x), Nz(x)))
+    Uz = sh.integrate(lambda x: As * np.outer(Nz(x), Nz(x)))
+    coupling = np.zeros((n + 2, n + 2))
+    coupling[:n, n:], coupling[n:, :n], coupling[n:, n:] = -Uqz, -Uqz.T, Uz
+    dissipation = np.zeros((n + 2, n + 2))
+    dissipation[n:, n:] = Uz
+    units["ghm.coupling"], units["ghm.dissipation"] = coupling, dissipation
+    piezo = np.zeros(n + 2)
+    piezo[:n] = p.width * sh.integrate(lambda x: du_c(), points=1)
+    return ElementTerms(units=units, piezo=piezo)
 
 
 def acld_element(p: BeamParameters, length: float) -> ElementMatrices:
@@ -130,63 +276,7 @@ def acld_element(p: BeamParameters, length: float) -> ElementMatrices:
         K_{qz} = A_s \\alpha \\kappa \\int N_\\gamma^T N_z, \\quad
         K_z = A_s \\alpha \\kappa \\int N_z^T N_z, \\quad
         M_z = K_z / \\omega^2, \\quad C_z = 2 \\zeta K_z / \\omega .
+
+    The piezoelectric load vector is :math:`E_c d_{31} b \\int N_{u_c}'`.
     """
-    sh = _Shape(ACLD_NODE_DOFS, length)
-    tb, ts, h = p.beam_thickness, p.vem_thickness, p.pzt_offset
-    # Beam and PZT are Timoshenko layers (the PZT's own bending and shear).
-    Mb, Kb = _beam_layer(sh, p.beam_youngs_modulus, p.beam_shear_modulus, p.beam_density,
-                         p.beam_area, p.beam_inertia, p.shear_correction)
-    Mc, Kc = _beam_layer(sh, p.pzt_youngs_modulus, p.pzt_shear_modulus, p.pzt_density,
-                         p.pzt_area, p.pzt_inertia, p.shear_correction)
-    # The PZT's axial motion is u_c, not u: replace its axial terms accordingly.
-    Mc = Mc - sh.integrate(lambda x: p.pzt_density * p.pzt_area * _outer(sh.N("u", x)))
-    Kc = Kc - sh.integrate(lambda x: p.pzt_youngs_modulus * p.pzt_area * _outer(sh.dN("u")))
-
-    def u_c(x):
-        return sh.N("u", x) - h * sh.N("theta", x) + ts * sh.N("gamma", x)
-
-    def du_c():
-        return sh.dN("u") - h * sh.dN("theta") + ts * sh.dN("gamma")
-
-    def u_s(x):
-        return sh.N("u", x) - 0.5 * (tb + ts) * sh.N("theta", x) + 0.5 * ts * sh.N("gamma", x)
-
-    def du_s():
-        return sh.dN("u") - 0.5 * (tb + ts) * sh.dN("theta") + 0.5 * ts * sh.dN("gamma")
-
-    Mc = Mc + sh.integrate(lambda x: p.pzt_density * p.pzt_area * _outer(u_c(x)))
-    Kc = Kc + sh.integrate(lambda x: p.pzt_youngs_modulus * p.pzt_area * _outer(du_c()))
-    # VEM: transverse/rotary and axial inertia; bending and extension with E_s;
-    # shear with the GHM high-frequency modulus kappa (1 + alpha).
-    As, Is = p.vem_area, p.vem_inertia
-    Ms = sh.integrate(lambda x: p.vem_density * (As * _outer(sh.N("w", x))
-                                                 + Is * _outer(sh.N("theta", x))
-                                                 + As * _outer(u_s(x))))
-    Ks = sh.integrate(lambda x: p.vem_youngs_modulus * (Is * _outer(sh.dN("theta"))
-                                                        + As * _outer(du_s()))
-                      + As * p.ghm_kappa * (1.0 + p.ghm_alpha) * _outer(sh.N("gamma", x)))
-    Me = Mb + Mc + Ms
-    Ke = Kb + Kc + Ks
-    Ce = p.rayleigh_mass * Me + p.rayleigh_stiffness * Ke
-
-    # GHM dissipation coordinates.
-    def Nz(x):
-        return np.array([1.0 - x / length, x / length])
-
-    ak = As * p.ghm_alpha * p.ghm_kappa
-    Kqz = sh.integrate(lambda x: ak * np.outer(sh.N("gamma", x), Nz(x)))
-    Kz = sh.integrate(lambda x: ak * np.outer(Nz(x), Nz(x)))
-    Mz = Kz / p.ghm_omega**2
-    Cz = Kz * 2.0 * p.ghm_zeta / p.ghm_omega
-
-    n = sh.n
-    M = np.zeros((n + 2, n + 2))
-    C = np.zeros_like(M)
-    K = np.zeros_like(M)
-    M[:n, :n], M[n:, n:] = Me, Mz
-    C[:n, :n], C[n:, n:] = Ce, Cz
-    K[:n, :n], K[n:, n:] = Ke, Kz
-    K[:n, n:], K[n:, :n] = -Kqz, -Kqz.T
-    Pc = np.zeros(n + 2)
-    Pc[:n] = p.piezo_force_per_volt * sh.integrate(lambda x: du_c(), points=1)
-    return ElementMatrices(M=M, C=C, K=K, Pc=Pc)
+    return acld_terms(p, length).combine(p)

@@ -1,4 +1,5 @@
-"""``ACLDBeam-v0``: the ACLD cantilever as a Gymnasium environment."""
+"""``ACLDBeam-v1``: the ACLD cantilever as a Gymnasium environment (``ACLDBeam-v0``: the
+legacy variant in :mod:`acld_gym.legacy`)."""
 
 from __future__ import annotations
 
@@ -12,12 +13,15 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from .design import Design, design
+from .design import DESIGN_ORDER, Design, design
 from .discrete import SampledSystem, discretize
+from .fingerprint import observation_fingerprint
 from .loads import Harmonic, Pulse, Samples, TipLoad, thesis_load
-from .model import build_model
-from .observer import DiscreteObserver, discrete_kalman, discrete_thesis
+from .observer import MODEL_STD, DiscreteObserver, discrete_kalman, discrete_thesis
 from .params import BeamParameters
+from .plant import MESHES, Plant
+from .plant import plant as nominal_plant
+from .reduction import BASES
 from .render import FigureOwner
 from .simulate import simulate
 from .thesis import V_LIMIT
@@ -34,7 +38,8 @@ else:
 COMPILED_STEP = StepCore is not None
 
 __all__ = ["ACLDBeamEnv", "COMPILED_STEP", "Nominal", "nominal", "random_load", "LOAD_CASES",
-           "OBS_MODES", "configure", "check_config", "check_actions", "observation_size",
+           "OBS_MODES", "MESHES", "PARAM_NOISE_MAX", "configure", "check_config", "check_actions",
+           "observation_size",
            "estimate_map", "step_matrix", "output_matrix", "load_schedule", "draw_episode",
            "randomized_plant", "reward_of"]
 
@@ -51,13 +56,21 @@ Y_SCALE = 1e-3
 RANDOMIZED = ("ghm_kappa", "ghm_alpha", "ghm_omega", "ghm_zeta", "vem_density",
               "beam_youngs_modulus", "pzt_youngs_modulus", "d31", "rayleigh_mass",
               "rayleigh_stiffness")
+#: Largest accepted ``param_noise`` per mesh (relative std of the log-normal factors,
+#: which are truncated at 3 std). Every drawn plant is a physical beam, hence stable;
+#: within these bounds the nominal Kalman observer with LQR, SMC and MPC also stays
+#: stable on every plant: checked at all 1024 corners of the box of +/-3 std
+#: (tests/test_robustness.py). At 0.1 on the thesis mesh 512 corners are unstable.
+PARAM_NOISE_MAX = {"converged": 0.1, "thesis": 0.05}
+#: Truncation of the log-normal parameter factors, in standard deviations.
+PARAM_NOISE_CLIP = 3.0
 
 
 @dataclass(frozen=True, eq=False)
 class Nominal:
-    """The nominal design for one control period: what observers and
-    baselines know. ``xr_scale`` are the fixed observation scales: each
-    reduced state's peak magnitude in the passive response to thesis case 1."""
+    """The nominal design for one control period: what observers and baselines know,
+    and the nominal truth plant the env samples. ``xr_scale`` are the fixed observation
+    scales: each reduced state's peak magnitude in the passive response to thesis case 1."""
 
     design: Design
     plant: SampledSystem
@@ -65,38 +78,65 @@ class Nominal:
     kalman: DiscreteObserver
     thesis: DiscreteObserver
     xr_scale: np.ndarray
+    mesh: str
+    basis: str
+
+    @property
+    def truth(self) -> Plant:
+        """The nominal truth plant (continuous, second-order form)."""
+        return self.design.truth
+
+    @property
+    def output(self) -> np.ndarray:
+        """Tip-deflection row of the truth plant's state, y = output @ x [m]."""
+        return self.design.plant[3][0]
+
+    @property
+    def modes(self) -> np.ndarray:
+        """Damped natural frequencies of the nominal truth plant [rad/s], ascending."""
+        return self.design.truth.natural_frequencies()
 
 
 @lru_cache(maxsize=8)
 def nominal(dt: float = 1e-3, substeps: int = 10, sensor_std: float = SENSOR_NOISE_M,
-            load_std: float = 1.0) -> Nominal:
-    """Nominal design sampled at ``dt`` (cached: the env, its vector version and
+            load_std: float = 1.0, mesh: str = "converged", basis: str = "modal",
+            model_std: float = MODEL_STD) -> Nominal:
+    """Nominal design of the ``mesh`` plant (:data:`acld_gym.plant.MESHES`) sampled at
+    ``dt``, with the design order :data:`acld_gym.design.DESIGN_ORDER` and the Kalman
+    filter's model-error noise ``model_std`` (cached: the env, its vector version and
     the baselines share it)."""
-    d = design()
+    if basis not in BASES:
+        raise ValueError(f"basis must be one of {list(BASES)}, got {basis!r}")
+    if mesh not in MESHES:
+        raise ValueError(f"mesh must be one of {list(MESHES)}, got {mesh!r}")
+    d = design(nominal_plant(mesh, dt), order=DESIGN_ORDER[mesh], basis=basis)
     A, B, E, Cy = d.plant
     sd = discretize(A, B, E, dt, substeps)
     r = d.reduced
     sr = discretize(r.A, r.B, r.E, dt, substeps)
-    kal = discrete_kalman(sr.Ad, sr.Bd, sr.Ed, r.C, load_std=load_std, sensor_std=sensor_std)
+    kal = discrete_kalman(sr.Ad, sr.Bd, sr.Ed, r.C, load_std=load_std, sensor_std=sensor_std,
+                          model_std=model_std)
     cont = d.observer("thesis")
     # Held-input matrix of the thesis gain: int_0^dt e^{As} ds L (columnwise ZOH).
     sl = discretize(A, cont.L, E, dt, 1)
     th = discrete_thesis(sd.Ad, sl.Bd, sd.Bd, Cy, cont)
     res = simulate(A, B, E, Cy, cont, d.passive, thesis_load(1), t_end=0.2, v_max=None)
     scale = np.abs(res.xr).max(axis=0)
-    return Nominal(design=d, plant=sd, reduced=sr, kalman=kal, thesis=th, xr_scale=scale)
+    return Nominal(design=d, plant=sd, reduced=sr, kalman=kal, thesis=th, xr_scale=scale,
+                   mesh=mesh, basis=basis)
 
 
-def random_load(rng: np.random.Generator, duration: float, grid: float) -> TipLoad:
+def random_load(rng: np.random.Generator, duration: float, grid: float,
+                modes: tuple[float, float] = (179.0, 1115.0)) -> TipLoad:
     """A bounded random tip load drawn from ``rng``.
 
     Always one to three pulses (amplitude U(-1.5, 1.5) N, width 0.5-3 ms,
     start in the first 70 % of the episode); with probability 1/2 a harmonic
-    of amplitude up to 0.08 N within +/-5 % of the first (179 rad/s) or
-    second (1115 rad/s) mode, 0.05-0.3 s long; with probability 1/2
-    band-limited noise (low-pass random samples every 2 ms, std about 0.05 N).
-    Pulse edges lie on ``grid`` [s] (the env's load sub-step), so the
-    sampled model integrates them exactly.
+    of amplitude up to 0.08 N within +/-5 % of the plant's first (probability 0.7)
+    or second natural frequency ``modes`` [rad/s], 0.05-0.3 s long; with
+    probability 1/2 band-limited noise (low-pass random samples every 2 ms, std
+    about 0.05 N). Pulse edges lie on ``grid`` [s] (the env's load sub-step), so
+    the sampled model integrates them exactly.
     """
     comps: list = []
     for _ in range(int(rng.integers(1, 4))):
@@ -104,7 +144,7 @@ def random_load(rng: np.random.Generator, duration: float, grid: float) -> TipLo
         width = max(np.round(rng.uniform(5e-4, 3e-3) / grid), 1) * grid
         comps.append(Pulse(float(start), float(width), float(rng.uniform(-1.5, 1.5))))
     if rng.uniform() < 0.5:
-        w0 = 179.0 if rng.uniform() < 0.7 else 1115.0
+        w0 = modes[0] if rng.uniform() < 0.7 else modes[1]
         comps.append(Harmonic(float(rng.uniform(0.0, 0.08)), float(w0 * rng.uniform(0.95, 1.05)),
                               float(rng.uniform(0.0, 0.5 * duration)),
                               float(rng.uniform(0.05, 0.3)), float(rng.uniform(0, 2 * np.pi))))
@@ -124,14 +164,18 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
     Vibration control of a 300 x 15 x 3 mm aluminium cantilever with an active
     constrained layer damping (ACLD) patch (Rodriguez 2006). The agent sets the
     voltage on the piezoelectric constraining layer to suppress the tip
-    deflection caused by a tip load. The plant is the full 38-state
-    finite-element model (Timoshenko beam + GHM viscoelastic layer) sampled
-    exactly with a zero-order hold on the voltage; the tip load is
-    integrated within each period (sub-steps with first-order hold, exact
-    for pulses). The observer runs on the nominal model, never on the
-    (possibly randomized) plant. A step is one fused matrix-vector product
-    (:func:`output_matrix`); it runs in C (``acld_gym._stepcore``) when that
-    module was built (``COMPILED_STEP``), else in numpy, with the same results.
+    deflection caused by a tip load. The plant (the "truth model",
+    :mod:`acld_gym.plant`) is, by default, the mesh-converged beam: the
+    Timoshenko + GHM finite-element model on a 128x refined mesh (2305 DOFs),
+    projected onto a 36-state rational Krylov basis that matches its frequency
+    responses to 1e-5 up to twice the Nyquist frequency; ``mesh="thesis"`` gives
+    the thesis's own 1 + 1 + 3-element model (38 states) instead. It is sampled
+    exactly with a zero-order hold on the voltage; the tip load is integrated
+    within each period (sub-steps with first-order hold, exact for pulses). The
+    observer runs on the nominal 6-state reduced model (the design model), never on
+    the (possibly randomized) plant. A step is one fused matrix-vector product
+    (:func:`output_matrix`); it runs in C (``acld_gym._stepcore``) when that module
+    was built (``COMPILED_STEP``), else in numpy, with the same results.
 
     ## Action Space
 
@@ -146,13 +190,19 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
 
     | obs_mode | n | content | scale |
     |---|---|---|---|
-    | ``"estimate"`` (default) | 7 | x_r estimate (6), measured tip | see below; y / 1 mm |
+    | ``"estimate"`` (default) | 9 (7) | x_r estimate (8; thesis mesh: 6), tip | below; y / 1 mm |
     | ``"measurement"`` | 9 | last 8 tip measurements, last voltage | y / 1 mm; V / 120 V |
-    | ``"full"`` | 38 | true plant state [q; dq/dt] (privileged) | SI (m, rad, m/s, rad/s) |
+    | ``"full"`` | 36 (38) | true plant state [q; dq/dt] (privileged) | see below |
 
-    Each x_r component is divided by its peak magnitude in the passive response
-    to thesis load case 1 (``Nominal.xr_scale``), so a 1 N x 1 ms pulse gives
-    values of order one.
+    x_r is the state of the 6-state reduced model in its canonical real modal
+    form (:func:`acld_gym.reduction.modal_form`): one (cosine, sine)-like pair per
+    mode (modes 1-4 in order; 1-3 on the thesis mesh), the same on every machine. Each component is
+    divided by its peak magnitude in the passive response to thesis load case 1
+    (``Nominal.xr_scale``), so a 1 N x 1 ms pulse gives values of order one (mode 4,
+    above the Nyquist frequency, is seen by the 1 kHz Kalman filter at about a tenth).
+    ``"full"``: for ``mesh="converged"`` q are the 18 mass-normalized Ritz
+    coordinates of the plant [kg^0.5 m] and their rates; for ``mesh="thesis"`` the
+    19 FE DOFs (m, rad) and their rates.
 
     ## Rewards
 
@@ -161,7 +211,7 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
 
     ## Starting State
 
-    The beam at rest (all 38 states zero), the observer at zero. The load of
+    The beam at rest (all plant states zero), the observer at zero. The load of
     the episode is set by ``load_case`` (or ``reset(options={"load_case": ...})``).
 
     ## Episode End
@@ -175,6 +225,7 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
     | kwarg | default | meaning |
     |---|---|---|
     | ``load_case`` | 1 | 1, 2, 3 (thesis ch. 5) or ``"random"`` (:func:`random_load`) |
+    | ``mesh`` | ``"converged"`` | truth plant: ``"converged"`` or ``"thesis"`` (38 states) |
     | ``dt`` | 1e-3 | control period [s] |
     | ``episode_length`` | 1.0 | episode duration [s] |
     | ``observer`` | ``"kalman"`` | ``"kalman"`` (reduced model, not fed the load) or |
@@ -183,23 +234,53 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
     | ``sensor_noise`` | 1e-7 | tip-sensor noise std [m] (seeded; 0 for none) |
     | ``y_ref`` | 1e-3 | deflection scale of the reward [m] |
     | ``lam`` | 0.01 | voltage weight of the reward |
-    | ``param_noise`` | 0.0 | relative std of per-episode parameter randomization |
+    | ``param_noise`` | 0.0 | relative std of per-episode parameter randomization, at |
+    | | | most 0.1 (``"converged"``) or 0.05 (``"thesis"``); log-normal factors |
+    | | | truncated at 3 std |
     | ``deflection_limit`` | 0.02 | termination limit [m] |
     | ``render_mode`` | None | ``"rgb_array"`` or ``"human"`` |
 
+    Load case 3 is the thesis's resonant harmonic, 0.1 sin(179 t) N for 5.5 cycles,
+    on every mesh: the thesis tuned it to its model's first resonance (178.6 rad/s);
+    the converged beam's is 177.4 rad/s, and over the 0.193 s of the load the 1.6 rad/s
+    detuning adds up to 0.31 rad of phase, so the load still pumps the first mode
+    (README, "Thesis mesh vs converged plant"). Random loads aim their harmonics at
+    the plant's own modes.
+
     ## Version History
 
-    * v0: initial version.
+    * v1: the truth plant is the mesh-converged beam (``mesh="converged"``; the thesis
+      mesh is ``mesh="thesis"``); the reduced-state estimate is in canonical
+      coordinates (real modal form), identical on every machine; random loads aim at
+      the plant's own first two modes; the design model has 8 states on the converged
+      plant (modes 1-4; 6 on the thesis mesh) and the Kalman filter a model-error noise
+      (``model_std`` 0.1), so the baselines stay stable on every randomized plant;
+      ``param_noise`` is bounded (0.1; 0.05 on the thesis mesh) and its factors
+      truncated at 3 std.
+    * v0: the thesis's 38-state mesh; the reduced state in the Schur method's
+      coordinates, which depend on the CPU's BLAS kernels (:mod:`acld_gym.legacy`).
     """
 
     metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 30}
 
-    def __init__(self, load_case: int | str = 1, dt: float = 1e-3, episode_length: float = 1.0,
-                 observer: str = "kalman", obs_mode: str = "estimate",
-                 sensor_noise: float = SENSOR_NOISE_M, y_ref: float = 1e-3, lam: float = 0.01,
-                 param_noise: float = 0.0, deflection_limit: float = 0.02,
-                 render_mode: str | None = None):
-        configure(self, load_case=load_case, dt=dt, episode_length=episode_length,
+    #: The id this class is registered under (used when it is built without ``gym.make``).
+    env_id = "ACLDBeam-v1"
+    #: Coordinates of the reduced model (:data:`acld_gym.reduction.BASES`); ACLDBeam-v0's
+    #: class keeps the machine-dependent ``"schur"``.
+    _basis = "modal"
+    #: Harmonic targets of random loads [rad/s]; None: the plant's own first two modes.
+    _harmonic_modes: tuple[float, float] | None = None
+    #: Model-error noise of the Kalman filter (:func:`acld_gym.observer.discrete_kalman`).
+    _model_std = MODEL_STD
+    #: Bound of ``param_noise`` (None: :data:`PARAM_NOISE_MAX` of the mesh).
+    _param_noise_max: float | None = None
+
+    def __init__(self, load_case: int | str = 1, mesh: str = "converged", dt: float = 1e-3,
+                 episode_length: float = 1.0, observer: str = "kalman",
+                 obs_mode: str = "estimate", sensor_noise: float = SENSOR_NOISE_M,
+                 y_ref: float = 1e-3, lam: float = 0.01, param_noise: float = 0.0,
+                 deflection_limit: float = 0.02, render_mode: str | None = None):
+        configure(self, load_case=load_case, mesh=mesh, dt=dt, episode_length=episode_length,
                   observer=observer, obs_mode=obs_mode, sensor_noise=sensor_noise,
                   y_ref=y_ref, lam=lam, param_noise=param_noise,
                   deflection_limit=deflection_limit, render_mode=render_mode)
@@ -207,7 +288,6 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
         n_obs = observation_size(self.nom, obs_mode, self.obs_hist)
         self.action_space = spaces.Box(-self.v_max, self.v_max, (1,), np.float32)
         self.observation_space = spaces.Box(-np.inf, np.inf, (n_obs,), np.float32)
-        self._tip = self.nom.design.model.tip_index
         self._plant = self.nom.plant
         self._obs = self.nom.thesis if observer == "thesis" else self.nom.kalman
         self._est = estimate_map(self._obs, self.nom.xr_scale)
@@ -232,6 +312,14 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
     _last = property(lambda self: self._core.last,
                      doc="G z of the last step (:func:`output_matrix`; one buffer).")
     x = property(lambda self: self._z[:self._n], doc="True plant state [q; dq/dt] (a view).")
+    episode_plant = property(lambda self: self._plant,
+                             doc="The sampled plant of this episode (randomized with "
+                                 "``param_noise``), a :class:`acld_gym.discrete.SampledSystem`.")
+
+    @property
+    def observation_fingerprint(self) -> dict:
+        """What the observation depends on (:mod:`acld_gym.fingerprint`)."""
+        return observation_fingerprint(self)
     xhat = property(lambda self: self._z[self._n:self._nk], doc="Observer state (a view).")
 
     def _reset_state(self, load: TipLoad) -> None:
@@ -247,7 +335,7 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
         self._noise = np.zeros(self.max_steps + 1)
         self._inputs = np.hstack([F, self._noise[1:, None]])  # per step: [f0, f1, w']
         self._G = output_matrix(step_matrix(self._plant, self.nom.plant, self._obs), n, k,
-                                self._tip, self.nom.design.reduced.SL, self._est)
+                                self.nom.output, self.nom.design.reduced.SL, self._est)
         self._core = self._make_core()
 
     def _make_core(self):
@@ -324,7 +412,7 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
         if options:
             raise ValueError(f"options: unknown key(s) {sorted(options)}; expected 'load_case'")
         load, self._plant = draw_episode(self.np_random, case, self.nom, self.episode_length,
-                                         self.param_noise)
+                                         self.param_noise, self.harmonic_modes)
         self._reset_state(load)
         self._draw_noise()
         w = float(self._noise[0])  # the beam starts at rest: the first measurement is noise
@@ -412,15 +500,17 @@ def _check_positive(name: str, value, allow_zero: bool = False) -> None:
 
 
 # --- pieces shared by ACLDBeamEnv and ACLDBeamVectorEnv ------------------------
-def configure(env, *, load_case, dt, episode_length, observer, obs_mode, sensor_noise, y_ref,
-              lam, param_noise, deflection_limit, render_mode) -> None:
+def configure(env, *, load_case, mesh, dt, episode_length, observer, obs_mode, sensor_noise,
+              y_ref, lam, param_noise, deflection_limit, render_mode) -> None:
     """Validate the keyword arguments shared by the single and the vector env
     (``ValueError`` naming a bad one) and set them, with the nominal design, on ``env``."""
-    check_config(load_case=load_case, dt=dt, episode_length=episode_length, observer=observer,
-                 obs_mode=obs_mode, sensor_noise=sensor_noise, y_ref=y_ref, lam=lam,
-                 param_noise=param_noise, deflection_limit=deflection_limit,
-                 render_mode=render_mode, render_modes=env.metadata["render_modes"])
+    check_config(load_case=load_case, mesh=mesh, dt=dt, episode_length=episode_length,
+                 observer=observer, obs_mode=obs_mode, sensor_noise=sensor_noise, y_ref=y_ref,
+                 lam=lam, param_noise=param_noise, deflection_limit=deflection_limit,
+                 render_mode=render_mode, render_modes=env.metadata["render_modes"],
+                 param_noise_max=env._param_noise_max)
     env.load_case = load_case
+    env.mesh = mesh
     env.dt = float(dt)
     env.episode_length = float(episode_length)
     env.observer_kind = observer
@@ -433,13 +523,18 @@ def configure(env, *, load_case, dt, episode_length, observer, obs_mode, sensor_
     env.render_mode = render_mode
     env.v_max = V_LIMIT
     env.obs_hist = 8
-    env.nom = nominal(env.dt, 10, max(env.sensor_noise, 1e-9))
+    env.nom = nominal(env.dt, 10, max(env.sensor_noise, 1e-9), mesh=mesh, basis=env._basis,
+                      model_std=env._model_std)
+    env.harmonic_modes = (env._harmonic_modes if env._harmonic_modes is not None
+                          else tuple(float(w) for w in env.nom.modes[:2]))
 
 
-def check_config(*, load_case, dt, episode_length, observer, obs_mode, sensor_noise, y_ref, lam,
-                 param_noise, deflection_limit, render_mode, render_modes) -> None:
+def check_config(*, load_case, mesh, dt, episode_length, observer, obs_mode, sensor_noise, y_ref,
+                 lam, param_noise, deflection_limit, render_mode, render_modes,
+                 param_noise_max: float | None = None) -> None:
     """Validate the environment's keyword arguments (``ValueError`` on a bad one)."""
     _check_choice("load_case", load_case, LOAD_CASES)
+    _check_choice("mesh", mesh, MESHES)
     _check_choice("observer", observer, OBSERVERS)
     _check_choice("obs_mode", obs_mode, OBS_MODES)
     for name, value in (("dt", dt), ("episode_length", episode_length), ("y_ref", y_ref),
@@ -450,6 +545,11 @@ def check_config(*, load_case, dt, episode_length, observer, obs_mode, sensor_no
         _check_positive(name, value, allow_zero=True)
     if episode_length < dt:
         raise ValueError(f"episode_length must be at least dt, got {episode_length!r}")
+    limit = param_noise_max if param_noise_max is not None else PARAM_NOISE_MAX.get(mesh, 0.0)
+    if param_noise > limit:
+        raise ValueError(f"param_noise must be at most {limit} for mesh={mesh!r} (relative std; "
+                         f"beyond it the nominal observer and baselines are not validated), got "
+                         f"{param_noise!r}")
     if render_mode is not None and render_mode not in render_modes:
         raise ValueError(f"render_mode must be one of {list(render_modes)} or "
                          f"None, got {render_mode!r}")
@@ -499,19 +599,19 @@ def step_matrix(plant: SampledSystem, nom_plant: SampledSystem,
     return S
 
 
-def output_matrix(S: np.ndarray, n: int, k: int, tip: int, SL: np.ndarray,
+def output_matrix(S: np.ndarray, n: int, k: int, output: np.ndarray, SL: np.ndarray,
                   est: np.ndarray) -> np.ndarray:
     """The single env's whole step as one matrix G, from :func:`step_matrix` S.
 
     Input ``z = [x, xhat, y_meas, V, f0, f1, w']`` (S's input and the noise w' of the
     new measurement); output ``G z = [x', xhat', y_meas', y', x_r', e', y_meas' / Y_SCALE]``
-    with ``y' = x'[tip]`` the true tip deflection, ``y_meas' = y' + w'``,
+    with ``y' = output @ x'`` the true tip deflection, ``y_meas' = y' + w'``,
     ``x_r' = S_L^T x'`` the true reduced state and ``e' = [xhat', y_meas'] M`` the
     scaled estimate (:func:`estimate_map` M). So ``(G z)[:n+k+1]`` is the next state
     and ``(G z)[-7:]`` the ``"estimate"`` observation.
     """
     X = np.hstack([S[:n + k], np.zeros((n + k, 1))])
-    y = X[tip]
+    y = output @ X[:n]
     y_meas = y.copy()
     y_meas[-1] = 1.0
     e = est[:k].T @ X[n:] + np.outer(est[k], y_meas)
@@ -531,27 +631,39 @@ def load_schedule(plant: SampledSystem, load: TipLoad, start: int,
 
 
 def draw_episode(rng: np.random.Generator, case, nom: Nominal, episode_length: float,
-                 param_noise: float) -> tuple[TipLoad, SampledSystem]:
+                 param_noise: float,
+                 harmonic_modes: tuple[float, float]) -> tuple[TipLoad, SampledSystem]:
     """The load and the (possibly randomized) plant of an episode, drawn from ``rng``
     in a fixed order: load first, then parameters."""
     _check_choice("load_case", case, LOAD_CASES)
     plant = nom.plant
-    load = (random_load(rng, episode_length, plant.dt / plant.substeps) if case == "random"
-            else thesis_load(case))
+    load = (random_load(rng, episode_length, plant.dt / plant.substeps, harmonic_modes)
+            if case == "random" else thesis_load(case))
     if param_noise > 0:
-        plant = randomized_plant(rng, param_noise, plant.dt, plant.substeps)
+        plant = randomized_plant(rng, param_noise, nom)
     return load, plant
 
 
-def randomized_plant(rng: np.random.Generator, param_noise: float, dt: float,
-                     substeps: int) -> SampledSystem:
-    p = BeamParameters()
-    noise = rng.normal(0.0, param_noise, len(RANDOMIZED))
-    changed = {name: getattr(p, name) * float(np.exp(z))
-               for name, z in zip(RANDOMIZED, noise, strict=True)}
-    m = build_model(replace(p, **changed))
-    A, B, E, _ = m.state_space()
-    return discretize(A, B, E, dt, substeps)
+def randomized_parameters(rng: np.random.Generator, param_noise: float,
+                          params: BeamParameters) -> BeamParameters:
+    """``params`` with each of :data:`RANDOMIZED` times :math:`e^z`,
+    :math:`z \\sim N(0, \\sigma^2)` truncated to :math:`\\pm 3\\sigma`
+    (:data:`PARAM_NOISE_CLIP`); ``sigma = param_noise``."""
+    z = np.clip(rng.normal(0.0, param_noise, len(RANDOMIZED)),
+                -PARAM_NOISE_CLIP * param_noise, PARAM_NOISE_CLIP * param_noise)
+    return replace(params, **{name: getattr(params, name) * float(np.exp(zi))
+                              for name, zi in zip(RANDOMIZED, z, strict=True)})
+
+
+def randomized_plant(rng: np.random.Generator, param_noise: float,
+                     nom: Nominal) -> SampledSystem:
+    """The nominal truth plant with randomized material parameters
+    (:func:`randomized_parameters`), sampled like the nominal one. It is the Galerkin
+    projection of the physical beam with those parameters, hence stable
+    (:mod:`acld_gym.plant`)."""
+    truth = nom.truth
+    A, B, E, _ = truth.state_space(randomized_parameters(rng, param_noise, truth.params))
+    return discretize(A, B, E, nom.plant.dt, nom.plant.substeps)
 
 
 def reward_of(y, v, y_ref: float, lam: float, v_max: float):

@@ -23,10 +23,36 @@ from typing import Any
 import numpy as np
 import scipy.linalg as sla
 
-from .assembly import DofMap, assemble, number_dofs
+from .assembly import AssembledTerms, DofMap, assemble_terms, number_dofs
 from .params import PRESETS, BeamParameters, Mesh, split_overrides
 
-__all__ = ["BeamModel", "build_model"]
+__all__ = ["BeamModel", "ParametricModel", "first_order", "build_model", "parametric_model",
+           "resolve"]
+
+
+def first_order(M: np.ndarray, C: np.ndarray, K: np.ndarray, Pc: np.ndarray, Fd: np.ndarray,
+                c: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    r"""First-order form of :math:`M\ddot q + C\dot q + Kq = P_c V + F_d f`,
+    :math:`y = c^T q`, with state :math:`x = [q; \dot q]` (module docstring).
+
+    Returns read-only ``(A, B, E, Cy)``.
+    """
+    n = M.shape[0]
+    lu = sla.lu_factor(M)
+    minv = sla.lu_solve(lu, np.column_stack([K, C, Pc, Fd]))
+    A = np.zeros((2 * n, 2 * n))
+    A[:n, n:] = np.eye(n)
+    A[n:, :n] = -minv[:, :n]
+    A[n:, n:] = -minv[:, n:2 * n]
+    B = np.zeros((2 * n, 1))
+    B[n:, 0] = minv[:, 2 * n]
+    E = np.zeros((2 * n, 1))
+    E[n:, 0] = minv[:, 2 * n + 1]
+    Cy = np.zeros((1, 2 * n))
+    Cy[0, :n] = c
+    for arr in (A, B, E, Cy):
+        arr.setflags(write=False)
+    return A, B, E, Cy
 
 
 @dataclass(frozen=True, eq=False)
@@ -66,22 +92,9 @@ class BeamModel:
 
     @cached_property
     def _matrices(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        n = self.n_dofs
-        lu = sla.lu_factor(self.M)
-        minv = sla.lu_solve(lu, np.column_stack([self.K, self.C, self.Pc, self.Fd]))
-        A = np.zeros((2 * n, 2 * n))
-        A[:n, n:] = np.eye(n)
-        A[n:, :n] = -minv[:, :n]
-        A[n:, n:] = -minv[:, n:2 * n]
-        B = np.zeros((2 * n, 1))
-        B[n:, 0] = minv[:, 2 * n]
-        E = np.zeros((2 * n, 1))
-        E[n:, 0] = minv[:, 2 * n + 1]
-        Cy = np.zeros((1, 2 * n))
-        Cy[0, self.tip_index] = 1.0
-        for arr in (A, B, E, Cy):
-            arr.setflags(write=False)
-        return A, B, E, Cy
+        c = np.zeros(self.n_dofs)
+        c[self.tip_index] = 1.0
+        return first_order(self.M, self.C, self.K, self.Pc, self.Fd, c)
 
     def state_space(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """``(A, B, E, Cy)``: state matrix, voltage input [V], tip-load input [N],
@@ -116,6 +129,74 @@ class BeamModel:
         return float(np.linalg.solve(self.K, self.Fd * force)[self.tip_index])
 
 
+@dataclass(frozen=True, eq=False)
+class ParametricModel:
+    """The clamped model as parameter-free sparse unit matrices (one per term of
+    :data:`acld_gym.elements.TERM_COEFFICIENTS`): ``M(p) = sum_t m_t(p) U_t`` and so on.
+
+    The geometry (lengths, thicknesses, mesh) is fixed; :meth:`combine` gives the
+    matrices for any material parameters. Used for fine meshes (sparse) and for
+    parameter randomization (acld_gym.plant).
+
+    Attributes
+    ----------
+    params, mesh, dofs : the inputs and the DOF numbering.
+    terms : clamped sparse unit matrices and piezo unit vector.
+    Fd : generalized force of a unit tip load (clamped).
+    tip_index : index of the tip deflection in the clamped DOFs.
+    """
+
+    params: BeamParameters
+    mesh: Mesh
+    dofs: DofMap = field(repr=False)
+    terms: AssembledTerms = field(repr=False)
+    Fd: np.ndarray = field(repr=False)
+    tip_index: int = 0
+
+    @property
+    def n_dofs(self) -> int:
+        return self.Fd.shape[0]
+
+    def combine(self, params: BeamParameters | None = None):
+        """Sparse clamped ``(M, C, K)`` and ``Pc`` for ``params`` (default: ``self.params``;
+        only its material fields matter, the geometry is this model's)."""
+        return self.terms.combine(self.params if params is None else params)
+
+
+def resolve(params: BeamParameters | None = None, mesh: Mesh | None = None, *,
+            preset: str | None = None, **overrides: Any) -> tuple[BeamParameters, Mesh]:
+    """The ``(params, mesh)`` that :func:`build_model` would use for these arguments."""
+    if preset is not None:
+        if params is not None:
+            raise ValueError("preset: give either params or preset, not both")
+        if preset not in PRESETS:
+            raise ValueError(f"preset must be one of {sorted(PRESETS)}, got {preset!r}")
+        params = PRESETS[preset]()
+    pkw, mkw = split_overrides(overrides)
+    params = BeamParameters() if params is None else params
+    mesh = Mesh() if mesh is None else mesh
+    if pkw:
+        params = BeamParameters(**{**params.__dict__, **pkw})
+    if mkw:
+        mesh = Mesh(**{**mesh.__dict__, **mkw})
+    return params, mesh
+
+
+def parametric_model(params: BeamParameters | None = None, mesh: Mesh | None = None, *,
+                     preset: str | None = None, **overrides: Any) -> ParametricModel:
+    """Assemble the clamped model's unit matrices (arguments as :func:`build_model`)."""
+    params, mesh = resolve(params, mesh, preset=preset, **overrides)
+    dofs = number_dofs(params, mesh)
+    terms = assemble_terms(params, dofs)
+    free = dofs.free
+    Fd = np.zeros(dofs.n_dofs)
+    Fd[dofs.node_dofs[-1]["w"]] = 1.0
+    clamped = AssembledTerms(units={k: U[free][:, free] for k, U in terms.units.items()},
+                             piezo=terms.piezo[free])
+    return ParametricModel(params=params, mesh=mesh, dofs=dofs, terms=clamped, Fd=Fd[free],
+                           tip_index=dofs.reduced_index(len(dofs.node_x) - 1, "w"))
+
+
 def build_model(params: BeamParameters | None = None, mesh: Mesh | None = None, *,
                 preset: str | None = None, **overrides: Any) -> BeamModel:
     """Assemble the clamped ACLD beam.
@@ -138,25 +219,7 @@ def build_model(params: BeamParameters | None = None, mesh: Mesh | None = None, 
     >>> m.n_states, m.tip_index
     (38, 17)
     """
-    if preset is not None:
-        if params is not None:
-            raise ValueError("preset: give either params or preset, not both")
-        if preset not in PRESETS:
-            raise ValueError(f"preset must be one of {sorted(PRESETS)}, got {preset!r}")
-        params = PRESETS[preset]()
-    pkw, mkw = split_overrides(overrides)
-    params = BeamParameters() if params is None else params
-    mesh = Mesh() if mesh is None else mesh
-    if pkw:
-        params = BeamParameters(**{**params.__dict__, **pkw})
-    if mkw:
-        mesh = Mesh(**{**mesh.__dict__, **mkw})
-    dofs = number_dofs(params, mesh)
-    M, C, K, Pc = assemble(params, dofs)
-    free = dofs.free
-    Fd = np.zeros(dofs.n_dofs)
-    Fd[dofs.node_dofs[-1]["w"]] = 1.0
-    sel = np.ix_(free, free)
-    return BeamModel(params=params, mesh=mesh, dofs=dofs, M=M[sel], C=C[sel], K=K[sel],
-                     Pc=Pc[free], Fd=Fd[free],
-                     tip_index=dofs.reduced_index(len(dofs.node_x) - 1, "w"))
+    pm = parametric_model(params, mesh, preset=preset, **overrides)
+    M, C, K, Pc = pm.combine()
+    return BeamModel(params=pm.params, mesh=pm.mesh, dofs=pm.dofs, M=M.toarray(), C=C.toarray(),
+                     K=K.toarray(), Pc=Pc, Fd=pm.Fd, tip_index=pm.tip_index)

@@ -45,6 +45,7 @@ from .env import (
     step_matrix,
 )
 from .loads import thesis_load
+from .observer import MODEL_STD
 from .render import FigureOwner
 
 __all__ = ["ACLDBeamVectorEnv"]
@@ -66,8 +67,15 @@ class ACLDBeamVectorEnv(FigureOwner, VectorEnv):
     metadata = {"render_modes": ["rgb_array"], "render_fps": 30,
                 "autoreset_mode": AutoresetMode.NEXT_STEP}
 
+    env_id = "ACLDBeam-v1"  # see ACLDBeamEnv
+    _basis = "modal"
+    _harmonic_modes: tuple[float, float] | None = None
+    _model_std = MODEL_STD
+    _param_noise_max: float | None = None
+
     def __init__(self, num_envs: int = 1, max_episode_steps: int | None = None,
-                 load_case: int | str = 1, dt: float = 1e-3, episode_length: float = 1.0,
+                 load_case: int | str = 1, mesh: str = "converged", dt: float = 1e-3,
+                 episode_length: float = 1.0,
                  observer: str = "kalman", obs_mode: str = "estimate",
                  sensor_noise: float = SENSOR_NOISE_M, y_ref: float = 1e-3, lam: float = 0.01,
                  param_noise: float = 0.0, deflection_limit: float = 0.02,
@@ -75,7 +83,7 @@ class ACLDBeamVectorEnv(FigureOwner, VectorEnv):
         if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) \
                 or num_envs < 1:
             raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
-        configure(self, load_case=load_case, dt=dt, episode_length=episode_length,
+        configure(self, load_case=load_case, mesh=mesh, dt=dt, episode_length=episode_length,
                   observer=observer, obs_mode=obs_mode, sensor_noise=sensor_noise,
                   y_ref=y_ref, lam=lam, param_noise=param_noise,
                   deflection_limit=deflection_limit, render_mode=render_mode)
@@ -91,7 +99,7 @@ class ACLDBeamVectorEnv(FigureOwner, VectorEnv):
         self.horizon = steps
         self._obs = self.nom.thesis if observer == "thesis" else self.nom.kalman
         self._est = estimate_map(self._obs, self.nom.xr_scale)
-        self._tip = self.nom.design.model.tip_index
+        self._out = self.nom.output  # tip deflection = plant state @ _out
         n_obs = observation_size(self.nom, obs_mode, self.obs_hist)
         self.single_action_space = spaces.Box(-self.v_max, self.v_max, (1,), np.float32)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
@@ -139,7 +147,8 @@ class ACLDBeamVectorEnv(FigureOwner, VectorEnv):
     def _reset_env(self, i: int, case) -> None:
         """Reset sub-env i from its own generator (same draws as the single env)."""
         rng = self._rngs[i]
-        load, plant = draw_episode(rng, case, self.nom, self.episode_length, self.param_noise)
+        load, plant = draw_episode(rng, case, self.nom, self.episode_length, self.param_noise,
+                                   self.harmonic_modes)
         self._loads[i] = load
         if case == "random":
             self._grow_pool()
@@ -179,7 +188,7 @@ class ACLDBeamVectorEnv(FigureOwner, VectorEnv):
     def _infos(self) -> dict[str, Any]:
         N = self.num_envs
         ones = np.ones(N, dtype=bool)
-        vals = {"tip_deflection": self._Z[:, self._tip].copy(),
+        vals = {"tip_deflection": self._Z[:, :self._n] @ self._out,
                 "voltage": self._Z[:, self._vcol].copy(),
                 "tip_load": self._pool_tip[self._slot, self._steps],
                 "time": self._steps * self.dt,
@@ -222,7 +231,7 @@ class ACLDBeamVectorEnv(FigureOwner, VectorEnv):
         else:
             Z[:, :n + k] = np.einsum("nij,nj->ni", self._S, Z)
         self._steps += 1
-        y_true = Z[:, self._tip]
+        y_true = Z[:, :n] @ self._out
         y = y_true + self._noise[idx, np.minimum(self._steps, self.horizon)]
         Z[:, self._ycol] = y
         self._y_hist[:, :-1] = self._y_hist[:, 1:]

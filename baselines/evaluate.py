@@ -1,10 +1,12 @@
-"""Evaluate the reference policies on the thesis's three load cases in ``ACLDBeam-v0``.
+"""Evaluate the reference policies on the thesis's three load cases in ``ACLDBeam-v1``.
 
-``python -m baselines.evaluate [--json PATH] [--plots DIR]`` prints a table per case
-(peak [mm], 5 % settling [s], ISE [m^2 s], max |V| [V], return) for passive, LQR,
-SMC, MPC and the clairvoyant bound, all with the +/-120 V limit, 1 ms control and
-the default Kalman observer. Any object with SB3's ``predict`` can be evaluated
-with :func:`rollout`, so trained agents use the same code.
+``python -m baselines.evaluate [--mesh converged|thesis] [--json PATH] [--plots DIR]``
+prints a table per case (peak [mm], 5 % settling [s], ISE [m^2 s], max |V| [V],
+return) for passive, LQR, SMC, MPC and the clairvoyant bound, all with the +/-120 V
+limit, 1 ms control and the default Kalman observer. Any object with SB3's
+``predict`` can be evaluated with :func:`rollout`, so trained agents use the same
+code; a policy that records an ``observation_fingerprint`` is checked against the
+env's before it acts.
 """
 
 from __future__ import annotations
@@ -19,9 +21,12 @@ from pathlib import Path
 import numpy as np
 
 from acld_gym.env import ACLDBeamEnv, nominal, reward_of
+from acld_gym.fingerprint import fingerprint_differences, observation_fingerprint
 from acld_gym.metrics import max_abs, peak, settling_time
+from acld_gym.plant import MESHES
 
-__all__ = ["EvalRow", "Episode", "rollout", "bound_episode", "episode_rows", "evaluate",
+__all__ = ["EvalRow", "Episode", "rollout", "check_compatible", "bound_episode", "episode_rows",
+           "evaluate", "default_policies",
            "mean_rows", "format_tables", "plot_episodes"]
 
 
@@ -54,8 +59,22 @@ class EvalRow:
         return d
 
 
+def check_compatible(policy, env) -> None:
+    """``ValueError`` if ``policy`` records an observation fingerprint that ``env``'s
+    observation does not match (:mod:`acld_gym.fingerprint`)."""
+    expected = getattr(policy, "observation_fingerprint", None)
+    if expected is None:
+        return
+    diff = fingerprint_differences(expected, observation_fingerprint(env))
+    if diff:
+        name = getattr(policy, "name", type(policy).__name__)
+        raise ValueError(f"policy {name!r} was built for another observation than this env's: "
+                         + "; ".join(diff))
+
+
 def rollout(policy, env: ACLDBeamEnv, seed: int = 0, options: dict | None = None) -> Episode:
     """Run one deterministic episode of ``policy`` (SB3 ``predict``) in ``env``."""
+    check_compatible(policy, env)
     obs, _ = env.reset(seed=seed, options=options)
     t, y, v, r = [], [], [], []
     spent = 0.0
@@ -74,11 +93,13 @@ def rollout(policy, env: ACLDBeamEnv, seed: int = 0, options: dict | None = None
 
 
 def bound_episode(env: ACLDBeamEnv) -> Episode:
-    """The clairvoyant bound for ``env``'s current load and (nominal) plant."""
+    """The clairvoyant bound for ``env``'s current load and plant (the episode's own,
+    randomized with ``param_noise``)."""
     from .bound import clairvoyant_bound
 
+    env = env.unwrapped
     t0 = time.perf_counter()
-    sol = clairvoyant_bound(env._plant, env.nom.design.model.tip_index, env.load, env.max_steps)
+    sol = clairvoyant_bound(env.episode_plant, env.nom.output, env.load, env.max_steps)
     spent = time.perf_counter() - t0
     t = np.arange(1, env.max_steps + 1) * env.dt
     reward = reward_of(sol.y, sol.voltage, env.y_ref, env.lam, env.v_max)
@@ -93,11 +114,12 @@ def metrics_row(case, name: str, ep: Episode) -> EvalRow:
                    ms_per_step=1e3 * ep.seconds_per_step)
 
 
-def default_policies() -> dict:
+def default_policies(mesh: str = "converged", dt: float = 1e-3) -> dict:
+    """Passive, LQR, SMC and MPC designed on the nominal ``mesh`` plant."""
     from .policies import LQRPolicy, MPCPolicy, PassivePolicy, SMCPolicy
 
-    return {"passive": PassivePolicy(), "lqr": LQRPolicy(), "smc": SMCPolicy(),
-            "mpc": MPCPolicy()}
+    return {cls.name: cls(dt=dt, mesh=mesh)
+            for cls in (PassivePolicy, LQRPolicy, SMCPolicy, MPCPolicy)}
 
 
 def episode_rows(policies: dict, case, seed: int = 0, env_kwargs: dict | None = None,
@@ -122,7 +144,8 @@ def episode_rows(policies: dict, case, seed: int = 0, env_kwargs: dict | None = 
 def evaluate(policies: dict | None = None, cases=(1, 2, 3), seed: int = 0,
              env_kwargs: dict | None = None, episodes: dict | None = None) -> list[EvalRow]:
     """Rows for every (case, policy) plus the bound; fills ``episodes`` if given."""
-    policies = default_policies() if policies is None else policies
+    if policies is None:
+        policies = default_policies((env_kwargs or {}).get("mesh", "converged"))
     return [row for case in cases
             for row in episode_rows(policies, case, seed, env_kwargs, episodes)]
 
@@ -188,10 +211,13 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--json", metavar="PATH", help="write the rows as JSON")
     p.add_argument("--plots", metavar="DIR", help="write one figure per case to DIR")
     p.add_argument("--seed", type=int, default=0, help="episode seed (sensor noise)")
+    p.add_argument("--mesh", choices=MESHES, default="converged",
+                   help="truth plant: the mesh-converged beam (default) or the thesis mesh")
     args = p.parse_args(argv)
-    nominal()  # build the design once before timing anything
+    nominal(mesh=args.mesh)  # build the design once before timing anything
     episodes: dict = {}
-    rows = evaluate(seed=args.seed, episodes=episodes)
+    rows = evaluate(default_policies(args.mesh), seed=args.seed,
+                    env_kwargs={"mesh": args.mesh}, episodes=episodes)
     print(format_tables(rows))
     if args.json:
         path = Path(args.json)

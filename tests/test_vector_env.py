@@ -1,4 +1,4 @@
-"""ACLDBeamVectorEnv (native batched ACLDBeam-v0) and its SB3 adapter."""
+"""ACLDBeamVectorEnv (native batched ACLDBeam-v1) and its SB3 adapter."""
 
 import pickle
 
@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from gymnasium.vector import AutoresetMode
 
-import acld_gym  # noqa: F401  (registers ACLDBeam-v0)
+import acld_gym  # noqa: F401  (registers ACLDBeam-v1)
 from acld_gym.env import ACLDBeamEnv
 from acld_gym.sb3 import SB3VecEnv
 from acld_gym.vector_env import ACLDBeamVectorEnv
@@ -53,6 +53,7 @@ def _vector_rollout(kw, seed, acts):
     dict(load_case=2, obs_mode="full"),
     dict(load_case=3, sensor_noise=0.0),
     dict(load_case="random", param_noise=0.05, obs_mode="full"),
+    dict(load_case="random", mesh="thesis", param_noise=0.05),
 ])
 def test_equal_trajectories_with_single_env_across_autoresets(kw):
     kw = dict(kw, episode_length=SHORT)
@@ -139,15 +140,15 @@ def test_same_validation_errors_as_single_env():
 
 
 def test_make_vec_returns_native_class():
-    env = gym.make_vec("ACLDBeam-v0", num_envs=4, load_case="random")
+    env = gym.make_vec("ACLDBeam-v1", num_envs=4, load_case="random")
     assert type(env.unwrapped) is ACLDBeamVectorEnv
     assert env.num_envs == 4 and env.unwrapped.horizon == 1000
     obs, info = env.reset(seed=3)
-    assert obs.shape == (4, 7) and obs.dtype == np.float32
+    assert obs.shape == (4, 9) and obs.dtype == np.float32
     assert env.observation_space.contains(obs)
     obs, r, te, tr, info = env.step(env.action_space.sample())
     assert r.shape == (4,) and info["tip_deflection"].shape == (4,)
-    sync = gym.make_vec("ACLDBeam-v0", num_envs=2, vectorization_mode="sync")
+    sync = gym.make_vec("ACLDBeam-v1", num_envs=2, vectorization_mode="sync")
     assert not isinstance(sync.unwrapped, ACLDBeamVectorEnv)
 
 
@@ -176,13 +177,13 @@ def test_sb3_adapter_same_step_autoreset():
     venv = SB3VecEnv(num_envs=2, episode_length=SHORT, load_case="random")
     venv.seed(4)
     obs = venv.reset()
-    assert obs.shape == (2, 7)
+    assert obs.shape == (2, 9)
     for k in range(1, 51):
         venv.step_async(np.zeros((2, 1), np.float32))
         obs, rew, dones, infos = venv.step_wait()
         assert dones.all() == (k == 50)
     assert all(i["TimeLimit.truncated"] for i in infos)
-    assert infos[0]["terminal_observation"].shape == (7,)
+    assert infos[0]["terminal_observation"].shape == (9,)
     # the returned observation is the new episode's first one
     np.testing.assert_array_equal(venv.venv._steps, 0)
     assert venv.get_attr("dt") == [1e-3, 1e-3]

@@ -30,8 +30,11 @@ def _p(default: float, unit: str, symbol: str, doc: str, *, allow_zero: bool = F
                                             "allow_negative": allow_negative})
 
 
-def _validate(obj: Any) -> None:
-    """Check every numeric field against its sign rule; raise ``ValueError`` naming it."""
+def _validate(obj: Any, allow_zero: tuple[str, ...] = ()) -> None:
+    """Check every numeric field against its sign rule; raise ``ValueError`` naming it.
+
+    ``allow_zero`` names fields that may also be zero in this particular case.
+    """
     for f in dataclasses.fields(obj):
         value = getattr(obj, f.name)
         if isinstance(value, bool) or not isinstance(value, (int, float)):
@@ -40,7 +43,8 @@ def _validate(obj: Any) -> None:
             raise ValueError(f"{type(obj).__name__}.{f.name} must be finite, got {value!r}")
         if f.metadata.get("allow_negative"):
             continue
-        if value < 0 or (value == 0 and not f.metadata.get("allow_zero")):
+        if value < 0 or (value == 0 and not f.metadata.get("allow_zero")
+                         and f.name not in allow_zero):
             need = "non-negative" if f.metadata.get("allow_zero") else "positive"
             raise ValueError(f"{type(obj).__name__}.{f.name} must be {need} "
                              f"[{f.metadata['unit']}], got {value!r}")
@@ -54,6 +58,9 @@ class BeamParameters:
     GHM model), ``c`` = piezoelectric constraining layer (PZT, the actuator).
     The VEM is modelled in shear only (its extensional modulus is zero in the
     thesis's MATLAB, ``Es = 0*14e6``).
+
+    ``patch_length = 0`` (with ``patch_start = 0``) describes the bare beam without any
+    ACLD element; its mesh is ``Mesh(0, 0, n)`` (all elements in ``n_after``).
     """
 
     length: float = _p(0.3, "m", "L", "Length of the beam")
@@ -86,10 +93,14 @@ class BeamParameters:
     patch_start: float = _p(0.03, "m", "-", "Distance of the ACLD patch from the clamp",
                             allow_zero=True)
     patch_length: float = _p(0.09, "m", "-",
-                             "ACLD patch length (MATLAB: 30% of L; the text says 100 mm)")
+                             "ACLD patch length (MATLAB: 30% of L; the text says 100 mm)",
+                             allow_zero=True)  # 0: bare beam (see the class docstring)
 
     def __post_init__(self) -> None:
         _validate(self)
+        if self.patch_length == 0 and self.patch_start != 0:
+            raise ValueError(f"BeamParameters.patch_start must be 0 when patch_length = 0 "
+                             f"(a bare beam, no ACLD patch), got {self.patch_start!r}")
         if self.patch_start + self.patch_length > self.length * (1 + 1e-12):
             raise ValueError(
                 f"BeamParameters.patch_length: patch_start + patch_length = "
@@ -140,7 +151,11 @@ class BeamParameters:
 
 @dataclass(frozen=True)
 class Mesh:
-    """Element counts of the three beam sections (thesis: 1 + 1 + 3)."""
+    """Element counts of the three beam sections (thesis: 1 + 1 + 3).
+
+    ``n_patch = 0`` is allowed only with ``n_before = 0``: the bare beam
+    (``BeamParameters.patch_length = 0``), whose elements are all in ``n_after``.
+    """
 
     n_before: int = field(default=1, metadata={"unit": "-", "symbol": "nelL",
                                                "doc": "Timoshenko elements between clamp and patch",
@@ -157,7 +172,13 @@ class Mesh:
             if isinstance(value, bool) or not isinstance(value, numbers.Integral):
                 raise ValueError(f"Mesh.{f.name} must be an integer, got {value!r}")
             object.__setattr__(self, f.name, int(value))
-        _validate(self)
+        # A bare beam (no ACLD patch, patch_length = 0) has n_patch = 0; all its elements
+        # are then counted in n_after, so n_before = 0 as well. Otherwise n_patch >= 1.
+        if self.n_patch == 0 and self.n_before != 0:
+            raise ValueError(f"Mesh.n_patch must be positive [-], got 0 (n_patch = 0 is only "
+                             f"for a bare beam, patch_length = 0, whose elements are all in "
+                             f"n_after: set n_before = 0, not {self.n_before!r})")
+        _validate(self, allow_zero=("n_patch",))
 
     def refined(self, factor: int) -> Mesh:
         """The same mesh with every section split into ``factor`` times as many elements."""

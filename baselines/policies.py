@@ -52,6 +52,11 @@ class _Policy:
     def voltage(self, xr: np.ndarray) -> np.ndarray:  # pragma: no cover - abstract
         raise NotImplementedError
 
+    def small_signal_gain(self) -> np.ndarray:  # pragma: no cover - abstract
+        """K with V = -K x_r where no limit or switching is active (the linearization
+        about rest), for stability checks (:mod:`baselines.robustness`)."""
+        raise NotImplementedError
+
     def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
         """SB3 protocol: returns ``(actions, state)``; actions in volts, shape (n, 1) or (1,)."""
         obs = np.asarray(observation)
@@ -69,6 +74,9 @@ class PassivePolicy(_Policy):
     def voltage(self, xr):
         return np.zeros(xr.shape[0])
 
+    def small_signal_gain(self) -> np.ndarray:
+        return np.zeros(self.k)
+
 
 class LQRPolicy(_Policy):
     r"""Discrete LQR with the thesis's weights: :math:`Q = 10^{11} S_R^T S_R`, R = 1
@@ -85,6 +93,9 @@ class LQRPolicy(_Policy):
 
     def voltage(self, xr):
         return -(xr @ self.K[0])
+
+    def small_signal_gain(self) -> np.ndarray:
+        return self.K[0].copy()
 
 
 class SMCPolicy(_Policy):
@@ -127,6 +138,10 @@ class SMCPolicy(_Policy):
 
     def voltage(self, xr):
         return -(xr @ self.a) - self.c * np.clip((xr @ self.s) / self.eps, -1.0, 1.0)
+
+    def small_signal_gain(self) -> np.ndarray:
+        """Inside the boundary layer: :math:`V = -(a + c\\,s/\varepsilon)\\,x_r`."""
+        return self.a + (self.c / self.eps) * self.s
 
 
 #: MPC's fraction of the thesis LQR state weight (see :class:`MPCPolicy`): the smallest
@@ -202,6 +217,15 @@ class MPCPolicy(_Policy):
         self._solvers: dict[int, object] = {}
         self._setup = (sp.csc_matrix(np.triu(P)), sp.identity(H, format="csc"), H)
         self._osqp = osqp
+
+    def small_signal_gain(self) -> np.ndarray:
+        """The first move of the unconstrained QP (no voltage limit active), as a gain."""
+        P = self._setup[0].toarray()
+        P = 0.5 * (P + P.T - np.diag(np.diag(P)))  # the stored P is upper-triangular
+        G = self.Theta.T @ self.Psi
+        if self._Lx is not None:
+            G = G + self._Lx[0].T @ self._Lx[1]
+        return V_LIMIT * np.linalg.solve(0.5 * P, G)[0]
 
     def _linear_term(self, x: np.ndarray) -> np.ndarray:
         q = self.Theta.T @ (self.Psi @ x)

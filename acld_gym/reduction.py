@@ -167,7 +167,9 @@ def modal_form(A: np.ndarray, B: np.ndarray, C: np.ndarray,
                 np.linalg.norm(V[:, i]):
             raise np.linalg.LinAlgError(f"modal_form: the mode at {lam[i]:.6g} 1/s has no "
                                         "voltage input or no output: no sign convention")
-        t = np.sqrt(abs(gamma) / abs(beta))
+        # output row norm: |gamma| / t for a real mode, 2 |gamma| / t for a pair (x holds
+        # the mode and its conjugate); input row norm: t |beta|. Equal them.
+        t = np.sqrt((1.0 if real[i] else 2.0) * abs(gamma) / abs(beta))
         row = (t * np.conj(beta) / abs(beta)) * w.conj()
         if real[i]:
             rows.append(row.real[None, :])

@@ -213,19 +213,19 @@ class MPCPolicy(_Policy):
         P = self.Theta.T @ self.Theta + rho * np.eye(H)
         if self._Lx is not None:
             P = P + self._Lx[0].T @ self._Lx[0]
+        self._hessian = P  # the QP is min u^T P u + 2 u^T G x, G below
         P = 2.0 * P
         self._solvers: dict[int, object] = {}
         self._setup = (sp.csc_matrix(np.triu(P)), sp.identity(H, format="csc"), H)
         self._osqp = osqp
 
     def small_signal_gain(self) -> np.ndarray:
-        """The first move of the unconstrained QP (no voltage limit active), as a gain."""
-        P = self._setup[0].toarray()
-        P = 0.5 * (P + P.T - np.diag(np.diag(P)))  # the stored P is upper-triangular
+        r"""The first move of the unconstrained QP (no voltage limit active), as a gain:
+        :math:`u = -P^{-1} G x`, :math:`V = 120\,u_0`."""
         G = self.Theta.T @ self.Psi
         if self._Lx is not None:
             G = G + self._Lx[0].T @ self._Lx[1]
-        return V_LIMIT * np.linalg.solve(0.5 * P, G)[0]
+        return V_LIMIT * np.linalg.solve(self._hessian, G)[0]
 
     def _linear_term(self, x: np.ndarray) -> np.ndarray:
         q = self.Theta.T @ (self.Psi @ x)

@@ -1,4 +1,5 @@
-"""``acld-gym`` command line: ``reproduce`` (Table 2), ``model`` (model facts), ``params``."""
+"""``acld-gym`` command line: ``reproduce`` (Table 2), ``model`` (model facts), ``mesh``
+(mesh convergence, thesis mesh vs converged plant), ``params``."""
 
 from __future__ import annotations
 
@@ -86,6 +87,19 @@ def cmd_model(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_mesh(args: argparse.Namespace) -> int:
+    from .convergence import format_mesh_report, mesh_report
+
+    t0 = time.perf_counter()
+    rep = mesh_report()
+    print(format_mesh_report(rep))
+    print(f"\n({time.perf_counter() - t0:.1f} s)")
+    if args.json:
+        _write_json(args.json, rep)
+        print(f"wrote {args.json}")
+    return 0
+
+
 def cmd_params(args: argparse.Namespace) -> int:
     from .params import PRESETS, parameter_table
 
@@ -119,6 +133,10 @@ def build_parser() -> argparse.ArgumentParser:
     m.add_argument("--json", metavar="PATH", help="write the facts as JSON")
     m.add_argument("--preset", choices=sorted(PRESETS), default="matlab")
     m.set_defaults(func=cmd_model)
+    me = sub.add_parser("mesh", help="mesh convergence; the thesis mesh against the converged "
+                                     "plant (README tables)")
+    me.add_argument("--json", metavar="PATH", help="write the numbers as JSON")
+    me.set_defaults(func=cmd_mesh)
     pa = sub.add_parser("params", help="print the parameter table (Markdown)")
     pa.add_argument("--preset", choices=sorted(PRESETS), default="matlab")
     pa.set_defaults(func=cmd_params)

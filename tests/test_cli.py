@@ -98,3 +98,18 @@ def test_bad_arguments(argv, word, capsys):
     err = capsys.readouterr().err
     assert word in err
     assert "Traceback" not in err
+
+
+@pytest.mark.slow
+def test_mesh_report_json(tmp_path):
+    # The README's "Thesis mesh vs converged plant" tables come from this command.
+    import json
+
+    p = tmp_path / "mesh.json"
+    assert main(["mesh", "--json", str(p)]) == 0
+    rep = json.loads(p.read_text())
+    conv, thesis = rep["plants"]["converged"], rep["plants"]["thesis"]
+    assert max(abs(e) for e in conv["frequency_error"]) < 0.005
+    assert conv["hinf_error_voltage"] < 0.01 and conv["hinf_error_load"] < 0.01
+    assert thesis["frequency_error"][2] > 0.4  # mode 3 of the thesis mesh, +50 %
+    assert conv["designs"]["8"]["hankel_gap"] > 2 * conv["designs"]["6"]["hankel_gap"]

@@ -12,9 +12,12 @@ __version__ = "0.2.0"
 #: The current environment id.
 ENV_ID = "ACLDBeam-v1"
 
+# No max_episode_steps: the env truncates itself after episode_length / dt steps (its
+# spec reports that count), so gym.make, make_vec and the SB3 adapter all follow
+# episode_length and dt; max_episode_steps= can still shorten an episode.
 if "ACLDBeam-v1" not in registry:
     register(id="ACLDBeam-v1", entry_point="acld_gym.env:ACLDBeamEnv",
-             vector_entry_point="acld_gym.vector_env:ACLDBeamVectorEnv", max_episode_steps=1000)
+             vector_entry_point="acld_gym.vector_env:ACLDBeamVectorEnv")
 if "ACLDBeam-v0" not in registry:
     register(id="ACLDBeam-v0", entry_point="acld_gym.legacy:ACLDBeamEnvV0",
-             vector_entry_point="acld_gym.legacy:ACLDBeamVectorEnvV0", max_episode_steps=1000)
+             vector_entry_point="acld_gym.legacy:ACLDBeamVectorEnvV0")

@@ -44,7 +44,9 @@ typedef struct {
     double v, y_meas, dt, y_ref, lam, v_max, limit, y_scale;
 } StepCore;
 
-static PyObject *k_tip, *k_volt, *k_load, *k_time, *k_xr, *k_clip, *k_req;
+static PyObject *k_tip, *k_volt, *k_load, *k_time, *k_xr, *k_clip, *k_req, *k_term;
+static PyObject *s_limit, *s_nonfinite;  /* values of info["terminated_by"] */
+#define N_INFO 8
 
 /* out = G z, as a sum of G's columns: the inner loop is contiguous and
    vectorizes without reassociating a reduction. Columns with z_j = 0 (the
@@ -155,8 +157,8 @@ core_init(StepCore *self, PyObject *args, PyObject *kwds)
         for (npy_intp j = 0; j < nz; j++) Gt[j * m + i] = g[i * nz + j];
     PyObject *last = PyArray_ZEROS(1, &m, NPY_DOUBLE, 0);
     PyObject *tmpl = PyDict_New();
-    PyObject *keys[7] = {k_tip, k_volt, k_load, k_time, k_xr, k_clip, k_req};
-    for (int i = 0; tmpl != NULL && i < 7; i++) {
+    PyObject *keys[N_INFO] = {k_tip, k_volt, k_load, k_time, k_xr, k_clip, k_req, k_term};
+    for (int i = 0; tmpl != NULL && i < N_INFO; i++) {
         if (PyDict_SetItem(tmpl, keys[i], Py_None) < 0) Py_CLEAR(tmpl);
     }
     if (last == NULL || tmpl == NULL) {
@@ -231,10 +233,14 @@ core_step(StepCore *self, PyObject *action)
     self->y_meas = o[nk];
     const double y = o[nk + 1];
 
-    /* 4. reward on the true deflection, 5. limits */
+    /* 4. reward on the true deflection, 5. limits: beyond the deflection limit, or any
+       non-finite number in the new state (never passed off as a normal step) */
     const double ry = y / self->y_ref, rv = v / self->v_max;
     const double reward = -(ry * ry) - self->lam * (rv * rv);
-    const int terminated = fabs(y) > self->limit, truncated = k >= self->max_steps;
+    int finite = isfinite(reward);
+    for (npy_intp i = 0; finite && i < m; i++) finite = isfinite(o[i]);
+    const int over = !(fabs(y) <= self->limit);
+    const int terminated = over || !finite, truncated = k >= self->max_steps;
 
     PyObject *obs;
     if (self->obs_mode == OBS_ESTIMATE) {
@@ -259,12 +265,16 @@ core_step(StepCore *self, PyObject *action)
     memcpy(PyArray_DATA((PyArrayObject *)xr), o + nk + 2, (size_t)self->n_xr * sizeof(double));
     const double tip_load = ((double *)PyArray_DATA(self->tipf))[k];
     PyObject *info = PyDict_Copy(self->info_template);
-    PyObject *vals[7] = {PyFloat_FromDouble(y), PyFloat_FromDouble(v),
-                         PyFloat_FromDouble(tip_load), PyFloat_FromDouble((double)k * self->dt),
-                         xr, PyBool_FromLong(requested != v), PyFloat_FromDouble(requested)};
-    PyObject *keys[7] = {k_tip, k_volt, k_load, k_time, k_xr, k_clip, k_req};
+    PyObject *why = !finite ? s_nonfinite : (over ? s_limit : Py_None);
+    Py_INCREF(why);
+    PyObject *vals[N_INFO] = {PyFloat_FromDouble(y), PyFloat_FromDouble(v),
+                              PyFloat_FromDouble(tip_load),
+                              PyFloat_FromDouble((double)k * self->dt), xr,
+                              PyBool_FromLong(requested != v), PyFloat_FromDouble(requested),
+                              why};
+    PyObject *keys[N_INFO] = {k_tip, k_volt, k_load, k_time, k_xr, k_clip, k_req, k_term};
     int bad = info == NULL;
-    for (int i = 0; i < 7; i++) {
+    for (int i = 0; i < N_INFO; i++) {
         if (!bad && (vals[i] == NULL || PyDict_SetItem(info, keys[i], vals[i]) < 0)) bad = 1;
         Py_XDECREF(vals[i]);
     }
@@ -366,7 +376,12 @@ PyInit__stepcore(void)
     k_xr = PyUnicode_InternFromString("xr_true");
     k_clip = PyUnicode_InternFromString("clipped");
     k_req = PyUnicode_InternFromString("requested_voltage");
-    if (!k_tip || !k_volt || !k_load || !k_time || !k_xr || !k_clip || !k_req) return NULL;
+    k_term = PyUnicode_InternFromString("terminated_by");
+    s_limit = PyUnicode_InternFromString("deflection_limit");
+    s_nonfinite = PyUnicode_InternFromString("non_finite_state");
+    if (!k_tip || !k_volt || !k_load || !k_time || !k_xr || !k_clip || !k_req || !k_term
+        || !s_limit || !s_nonfinite)
+        return NULL;
     PyObject *mod = PyModule_Create(&moduledef);
     if (mod == NULL) return NULL;
     Py_INCREF(&StepCoreType);

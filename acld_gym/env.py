@@ -13,6 +13,14 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from .checks import (
+    ENV_RANGES,
+    check_actions,
+    check_choice,
+    check_episode_size,
+    check_real,
+    check_seed,
+)
 from .design import DESIGN_ORDER, Design, design
 from .discrete import SampledSystem, discretize
 from .fingerprint import observation_fingerprint
@@ -38,8 +46,8 @@ else:
 COMPILED_STEP = StepCore is not None
 
 __all__ = ["ACLDBeamEnv", "COMPILED_STEP", "Nominal", "nominal", "random_load", "LOAD_CASES",
-           "OBS_MODES", "MESHES", "PARAM_NOISE_MAX", "configure", "check_config", "check_actions",
-           "observation_size",
+           "OBS_MODES", "MESHES", "PARAM_NOISE_MAX", "configure", "check_config", "reset_options",
+           "observation_size", "episode_spec",
            "estimate_map", "step_matrix", "output_matrix", "load_schedule", "draw_episode",
            "randomized_plant", "reward_of"]
 
@@ -217,8 +225,13 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
     ## Episode End
 
     * ``terminated``: |tip deflection| > ``deflection_limit`` (20 mm by
-      default, beyond which the linear model is not valid).
-    * ``truncated``: after ``episode_length`` seconds (1 s = 1000 steps).
+      default, beyond which the linear model is not valid), or a non-finite number
+      in the new state or reward; ``info["terminated_by"]`` says which
+      (``"deflection_limit"``, ``"non_finite_state"``; None otherwise).
+    * ``truncated``: after ``episode_length`` seconds, ``round(episode_length / dt)``
+      steps (1 s = 1000 steps by default). ``gym.make`` adds no other limit, and
+      ``env.spec.max_episode_steps`` is that step count; ``max_episode_steps=n`` can
+      only shorten the episode (a ``TimeLimit`` of n steps).
 
     ## Arguments
 
@@ -284,7 +297,7 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
                   observer=observer, obs_mode=obs_mode, sensor_noise=sensor_noise,
                   y_ref=y_ref, lam=lam, param_noise=param_noise,
                   deflection_limit=deflection_limit, render_mode=render_mode)
-        self.max_steps = int(round(episode_length / dt))
+        self.max_steps = check_episode_size(self.episode_length, self.dt)
         n_obs = observation_size(self.nom, obs_mode, self.obs_hist)
         self.action_space = spaces.Box(-self.v_max, self.v_max, (1,), np.float32)
         self.observation_space = spaces.Box(-np.inf, np.inf, (n_obs,), np.float32)
@@ -293,6 +306,7 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
         self._est = estimate_map(self._obs, self.nom.xr_scale)
         self._fig = None
         self._reset_state(thesis_load(1) if load_case == "random" else thesis_load(load_case))
+        self._core = _NotReset(self._core)  # stepping before reset() raises
 
     # --- composition of a step ----------------------------------------------
     # The state lives in one buffer z = [x, xhat, y_meas, V, f0, f1, w'] (x and xhat
@@ -312,6 +326,17 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
     _last = property(lambda self: self._core.last,
                      doc="G z of the last step (:func:`output_matrix`; one buffer).")
     x = property(lambda self: self._z[:self._n], doc="True plant state [q; dq/dt] (a view).")
+    @property
+    def spec(self):
+        """The registration spec (set by ``gym.make``), with ``max_episode_steps`` the
+        episode's own length, ``episode_length / dt`` steps, unless a shorter limit was
+        asked for."""
+        return getattr(self, "_spec", None)
+
+    @spec.setter
+    def spec(self, value) -> None:
+        self._spec = episode_spec(value, self.max_steps)
+
     episode_plant = property(lambda self: self._plant,
                              doc="The sampled plant of this episode (randomized with "
                                  "``param_noise``), a :class:`acld_gym.discrete.SampledSystem`.")
@@ -373,7 +398,8 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
 
     def _voltage(self, action) -> tuple[float, float]:
         """(applied, requested) voltage; ``ValueError`` (state untouched) on bad input."""
-        if type(action) is np.ndarray and action.shape == (1,):  # fast path (SB3, policies)
+        if (type(action) is np.ndarray and action.shape == (1,)
+                and action.dtype.kind == "f"):  # fast path (SB3, policies)
             requested = float(action[0])
             if math.isfinite(requested):
                 return min(max(requested, -self.v_max), self.v_max), requested
@@ -402,15 +428,13 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
                 "tip_load": tip_load, "time": k * self.dt,
                 "xr_true": self._last[nk + 2:nk + 2 + self.nom.design.reduced.order].copy(),
                 "clipped": requested is not None and requested != self.v,
-                "requested_voltage": self.v if requested is None else requested}
+                "requested_voltage": self.v if requested is None else requested,
+                "terminated_by": None}
 
     # --- Gymnasium API -------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict | None = None):
-        super().reset(seed=seed)
-        options = dict(options or {})
-        case = options.pop("load_case", self.load_case)
-        if options:
-            raise ValueError(f"options: unknown key(s) {sorted(options)}; expected 'load_case'")
+        case = reset_options(options, self.load_case)  # validated before seeding:
+        super().reset(seed=check_seed(seed))  # a rejected reset leaves the RNG as it was
         load, self._plant = draw_episode(self.np_random, case, self.nom, self.episode_length,
                                          self.param_noise, self.harmonic_modes)
         self._reset_state(load)
@@ -430,6 +454,8 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
         """The step in numpy: the reference for :class:`acld_gym._stepcore.StepCore`, and
         the path for actions of other types, bad actions, rendering and steps past the
         tabulated episode."""
+        if isinstance(self._core, _NotReset):
+            raise RuntimeError("ACLDBeamEnv: call reset() before step()")
         v, requested = self._voltage(action)
         c, z, nk = self._core, self._z, self._nk
         k = c.k
@@ -446,13 +472,16 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
             self.y_hist[:-1] = self.y_hist[1:]
             self.y_hist[-1] = c.y_meas
         reward = reward_of(y, v, self.y_ref, self.lam, self.v_max)  # 4. on the true deflection
-        terminated = abs(y) > self.deflection_limit  # 5. physical limit
+        why = termination(y, reward, out, self.deflection_limit)  # 5. limits
+        terminated = why is not None
         truncated = k >= self.max_steps
         if self.render_mode is not None:  # the history is only drawn, never observed
             self.history.append((k * self.dt, y, v))
             if self.render_mode == "human":
                 self.render()
-        return self._observation(), reward, terminated, truncated, self._info(requested)
+        info = self._info(requested)
+        info["terminated_by"] = why
+        return self._observation(), reward, terminated, truncated, info
 
     def render(self):
         if self.render_mode is None:
@@ -472,6 +501,19 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
         self._close_figure()
 
 
+class _NotReset:
+    """Stands in for the step's core until the first ``reset()`` (Gymnasium's order)."""
+
+    def __init__(self, core):
+        self._inner = core
+
+    def __getattr__(self, name):
+        return getattr(self._inner, name)
+
+    def step(self, action):
+        raise RuntimeError("ACLDBeamEnv: call reset() before step()")
+
+
 class _NumpyCore:
     """The state :class:`acld_gym._stepcore.StepCore` keeps, without a compiled step
     (every step goes to ``ACLDBeamEnv._step``)."""
@@ -485,30 +527,16 @@ class _NumpyCore:
         return None
 
 
-def _check_choice(name: str, value, choices) -> None:
-    if isinstance(value, bool) or value not in choices:
-        raise ValueError(f"{name} must be one of {list(choices)}, got {value!r}")
-
-
-def _check_positive(name: str, value, allow_zero: bool = False) -> None:
-    ok = (isinstance(value, (int, float)) and not isinstance(value, bool) and np.isfinite(value)
-          and (value >= 0 if allow_zero else value > 0))
-    if not ok:
-        need = "a non-negative" if allow_zero else "a positive"
-        raise ValueError(f"{name} must be {need} finite number, got {value!r}")
-
-
-
 # --- pieces shared by ACLDBeamEnv and ACLDBeamVectorEnv ------------------------
 def configure(env, *, load_case, mesh, dt, episode_length, observer, obs_mode, sensor_noise,
-              y_ref, lam, param_noise, deflection_limit, render_mode) -> None:
+              y_ref, lam, param_noise, deflection_limit, render_mode, num_envs: int = 1) -> None:
     """Validate the keyword arguments shared by the single and the vector env
     (``ValueError`` naming a bad one) and set them, with the nominal design, on ``env``."""
     check_config(load_case=load_case, mesh=mesh, dt=dt, episode_length=episode_length,
                  observer=observer, obs_mode=obs_mode, sensor_noise=sensor_noise, y_ref=y_ref,
                  lam=lam, param_noise=param_noise, deflection_limit=deflection_limit,
                  render_mode=render_mode, render_modes=env.metadata["render_modes"],
-                 param_noise_max=env._param_noise_max)
+                 param_noise_max=env._param_noise_max, num_envs=num_envs)
     env.load_case = load_case
     env.mesh = mesh
     env.dt = float(dt)
@@ -531,39 +559,41 @@ def configure(env, *, load_case, mesh, dt, episode_length, observer, obs_mode, s
 
 def check_config(*, load_case, mesh, dt, episode_length, observer, obs_mode, sensor_noise, y_ref,
                  lam, param_noise, deflection_limit, render_mode, render_modes,
-                 param_noise_max: float | None = None) -> None:
-    """Validate the environment's keyword arguments (``ValueError`` on a bad one)."""
-    _check_choice("load_case", load_case, LOAD_CASES)
-    _check_choice("mesh", mesh, MESHES)
-    _check_choice("observer", observer, OBSERVERS)
-    _check_choice("obs_mode", obs_mode, OBS_MODES)
-    for name, value in (("dt", dt), ("episode_length", episode_length), ("y_ref", y_ref),
-                        ("deflection_limit", deflection_limit)):
-        _check_positive(name, value)
-    for name, value in (("sensor_noise", sensor_noise), ("lam", lam),
-                        ("param_noise", param_noise)):
-        _check_positive(name, value, allow_zero=True)
-    if episode_length < dt:
-        raise ValueError(f"episode_length must be at least dt, got {episode_length!r}")
+                 param_noise_max: float | None = None, num_envs: int = 1) -> None:
+    """Validate the environment's keyword arguments (``ValueError`` naming a bad one):
+    choices, the ranges of :data:`acld_gym.checks.ENV_RANGES`, the ``param_noise`` bound
+    of the mesh and the episode's size (:func:`acld_gym.checks.check_episode_size`)."""
+    check_choice("load_case", load_case, LOAD_CASES)
+    check_choice("mesh", mesh, MESHES)
+    check_choice("observer", observer, OBSERVERS)
+    check_choice("obs_mode", obs_mode, OBS_MODES)
+    values = {"dt": dt, "episode_length": episode_length, "sensor_noise": sensor_noise,
+              "y_ref": y_ref, "lam": lam, "deflection_limit": deflection_limit}
+    for name, value in values.items():
+        low, high, unit, _ = ENV_RANGES[name]
+        check_real(name, value, low, high, unit=unit)
     limit = param_noise_max if param_noise_max is not None else PARAM_NOISE_MAX.get(mesh, 0.0)
+    check_real("param_noise", param_noise, 0.0)
     if param_noise > limit:
         raise ValueError(f"param_noise must be at most {limit} for mesh={mesh!r} (relative std; "
                          f"beyond it the nominal observer and baselines are not validated), got "
                          f"{param_noise!r}")
+    check_episode_size(float(episode_length), float(dt), num_envs)
     if render_mode is not None and render_mode not in render_modes:
         raise ValueError(f"render_mode must be one of {list(render_modes)} or "
                          f"None, got {render_mode!r}")
 
 
-def check_actions(action, n: int, v_max: float) -> tuple[np.ndarray, np.ndarray]:
-    """``n`` requested voltages as float64 and their clipped values; ``ValueError``
-    on a wrong size or a non-finite voltage (before any state changes)."""
-    a = np.asarray(action, dtype=np.float64).reshape(-1)
-    if a.size != n:
-        raise ValueError(f"action must hold {n} voltage(s) [V], got shape {np.shape(action)}")
-    if not np.isfinite(a).all():
-        raise ValueError(f"action must be finite, got {a[~np.isfinite(a)][0]!r}")
-    return a, np.clip(a, -v_max, v_max)
+def reset_options(options, default_case):
+    """The load case of ``reset(options=...)`` (``ValueError`` on anything else)."""
+    if options is not None and not isinstance(options, dict):
+        raise ValueError(f"options must be a dict or None, got {options!r}")
+    options = dict(options or {})
+    case = options.pop("load_case", default_case)
+    if options:
+        raise ValueError(f"options: unknown key(s) {sorted(options)}; expected 'load_case'")
+    check_choice("load_case", case, LOAD_CASES)
+    return case
 
 
 def observation_size(nom: Nominal, obs_mode: str, hist: int) -> int:
@@ -635,7 +665,7 @@ def draw_episode(rng: np.random.Generator, case, nom: Nominal, episode_length: f
                  harmonic_modes: tuple[float, float]) -> tuple[TipLoad, SampledSystem]:
     """The load and the (possibly randomized) plant of an episode, drawn from ``rng``
     in a fixed order: load first, then parameters."""
-    _check_choice("load_case", case, LOAD_CASES)
+    check_choice("load_case", case, LOAD_CASES)
     plant = nom.plant
     load = (random_load(rng, episode_length, plant.dt / plant.substeps, harmonic_modes)
             if case == "random" else thesis_load(case))
@@ -664,6 +694,28 @@ def randomized_plant(rng: np.random.Generator, param_noise: float,
     truth = nom.truth
     A, B, E, _ = truth.state_space(randomized_parameters(rng, param_noise, truth.params))
     return discretize(A, B, E, nom.plant.dt, nom.plant.substeps)
+
+
+def episode_spec(spec, steps: int):
+    """``spec`` with ``max_episode_steps`` set to the env's ``steps`` when it has none (the
+    env truncates itself there) or a larger one (the env still ends at ``steps``)."""
+    if spec is None:
+        return None
+    limit = spec.max_episode_steps
+    if limit is None or limit > steps:
+        spec = replace(spec, max_episode_steps=int(steps))
+    return spec
+
+
+def termination(y: float, reward: float, state: np.ndarray, limit: float) -> str | None:
+    """Why a step ends the episode: ``"non_finite_state"`` if the new state or the reward
+    is not finite (never passed off as a normal step), ``"deflection_limit"`` if
+    |y| > ``limit``; else None."""
+    if not (math.isfinite(reward) and np.isfinite(state).all()):
+        return "non_finite_state"
+    if not abs(y) <= limit:
+        return "deflection_limit"
+    return None
 
 
 def reward_of(y, v, y_ref: float, lam: float, v_max: float):

@@ -30,8 +30,18 @@ def _p(default: float, unit: str, symbol: str, doc: str, *, allow_zero: bool = F
                                             "allow_negative": allow_negative})
 
 
+#: Physically plausible magnitudes per unit (nonzero values): generous, but they keep the
+#: finite-element matrices and their solves finite (a density of 1e-300 kg/m^3 or a shear
+#: factor of 1e308 is an input error, not a beam).
+MAGNITUDES: dict[str, tuple[float, float]] = {
+    "m": (1e-7, 100.0), "N/m^2": (1e-3, 1e13), "kg/m^3": (1e-6, 1e5), "m/V": (1e-18, 1e-6),
+    "rad/s": (1e-3, 1e9), "1/s": (1e-9, 1e6), "s": (1e-15, 1.0), "-": (1e-6, 1e6),
+}
+
+
 def _validate(obj: Any, allow_zero: tuple[str, ...] = ()) -> None:
-    """Check every numeric field against its sign rule; raise ``ValueError`` naming it.
+    """Check every numeric field against its sign rule and the plausible magnitudes of
+    its unit (:data:`MAGNITUDES`); raise ``ValueError`` naming it.
 
     ``allow_zero`` names fields that may also be zero in this particular case.
     """
@@ -41,13 +51,19 @@ def _validate(obj: Any, allow_zero: tuple[str, ...] = ()) -> None:
             raise ValueError(f"{type(obj).__name__}.{f.name} must be a real number, got {value!r}")
         if value != value or value in (float("inf"), float("-inf")):
             raise ValueError(f"{type(obj).__name__}.{f.name} must be finite, got {value!r}")
-        if f.metadata.get("allow_negative"):
-            continue
-        if value < 0 or (value == 0 and not f.metadata.get("allow_zero")
-                         and f.name not in allow_zero):
+        if not f.metadata.get("allow_negative") and (
+                value < 0 or (value == 0 and not f.metadata.get("allow_zero")
+                              and f.name not in allow_zero)):
             need = "non-negative" if f.metadata.get("allow_zero") else "positive"
             raise ValueError(f"{type(obj).__name__}.{f.name} must be {need} "
                              f"[{f.metadata['unit']}], got {value!r}")
+        unit = f.metadata.get("unit")
+        if value != 0 and unit in MAGNITUDES and isinstance(value, float | int) \
+                and not isinstance(obj, Mesh):
+            lo, hi = MAGNITUDES[unit]
+            if not lo <= abs(value) <= hi:
+                raise ValueError(f"{type(obj).__name__}.{f.name} must have a magnitude in "
+                                 f"[{lo:g}, {hi:g}] {unit} (a physical value), got {value!r}")
 
 
 @dataclass(frozen=True)

@@ -27,9 +27,20 @@ from typing import Any
 import numpy as np
 from stable_baselines3.common.vec_env import VecEnv
 
+from .checks import check_choice, check_seed
+from .env import LOAD_CASES
 from .vector_env import INFO_KEYS, ACLDBeamVectorEnv
 
+#: Attributes the env derives its tables and design from at construction.
+_CONFIGURED = ("mesh", "dt", "episode_length", "observer_kind", "obs_mode", "sensor_noise",
+               "param_noise", "num_envs", "nom", "horizon")
+
 __all__ = ["SB3VecEnv"]
+
+
+def _scalar(x):
+    """A numpy scalar as a Python value (``None`` and other objects as they are)."""
+    return x.item() if isinstance(x, np.generic) else x
 
 
 class SB3VecEnv(VecEnv):
@@ -58,6 +69,8 @@ class SB3VecEnv(VecEnv):
         return obs
 
     def step_async(self, actions: np.ndarray) -> None:
+        if self.venv._needs_reset:
+            raise RuntimeError("SB3VecEnv: call reset() before step()")
         self._actions = np.asarray(actions)
 
     def step_wait(self):
@@ -68,14 +81,13 @@ class SB3VecEnv(VecEnv):
         self._actions = None
         done = terminated | truncated
         infos: list[dict[str, Any]] = [
-            {key: info[key][i].item() for key in INFO_KEYS} for i in range(self.num_envs)]
+            {key: _scalar(info[key][i]) for key in INFO_KEYS} for i in range(self.num_envs)]
         if done.any():
-            for i in np.flatnonzero(done):
+            ended = np.flatnonzero(done)
+            for i in ended:
                 infos[i]["terminal_observation"] = obs[i].copy()
                 infos[i]["TimeLimit.truncated"] = bool(truncated[i] and not terminated[i])
-                v._reset_env(int(i), v.load_case)
-            v._prev_done[:] = False
-            obs = v._observations()
+            obs = v.reset_done(ended)
         return obs, rewards.astype(np.float32), done, infos
 
     def close(self) -> None:
@@ -83,7 +95,7 @@ class SB3VecEnv(VecEnv):
 
     def seed(self, seed: int | None = None) -> Sequence[None | int]:
         """Seeds the next ``reset()``: sub-env i gets ``seed + i``."""
-        self._seed = seed
+        self._seed = check_seed(seed)
         return [None if seed is None else seed + i for i in range(self.num_envs)]
 
     def set_options(self, options: list[dict] | dict | None = None) -> None:
@@ -110,9 +122,19 @@ class SB3VecEnv(VecEnv):
         return [value for _ in self._indices(indices)]
 
     def set_attr(self, attr_name: str, value: Any, indices=None) -> None:
+        """Set an attribute of the (shared) vector env, validated now: ``load_case`` (takes
+        effect at the next reset) is the one meant to change; anything else that the env
+        validates at construction is refused rather than left to fail later."""
         idx = self._indices(indices)
         if idx != list(range(self.num_envs)):
             raise ValueError("SB3VecEnv: attributes are shared; set them for all sub-envs")
+        if attr_name == "load_case":
+            check_choice("load_case", value, LOAD_CASES)
+        elif attr_name in _CONFIGURED:
+            raise ValueError(f"SB3VecEnv: {attr_name} is fixed at construction; build a new "
+                             "env to change it")
+        elif not hasattr(self.venv, attr_name):
+            raise ValueError(f"SB3VecEnv: the vector env has no attribute {attr_name!r}")
         setattr(self.venv, attr_name, value)
 
     def env_method(self, method_name: str, *method_args, indices=None, **method_kwargs):

@@ -30,17 +30,17 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
+from .checks import check_actions, check_int, check_seed
 from .env import (
-    LOAD_CASES,
     SENSOR_NOISE_M,
     Y_SCALE,
-    _check_choice,
-    check_actions,
     configure,
     draw_episode,
+    episode_spec,
     estimate_map,
     load_schedule,
     observation_size,
+    reset_options,
     reward_of,
     step_matrix,
 )
@@ -50,7 +50,7 @@ from .render import FigureOwner
 
 __all__ = ["ACLDBeamVectorEnv"]
 
-INFO_KEYS = ("tip_deflection", "voltage", "tip_load", "time", "clipped")
+INFO_KEYS = ("tip_deflection", "voltage", "tip_load", "time", "clipped", "terminated_by")
 
 
 class ACLDBeamVectorEnv(FigureOwner, VectorEnv):
@@ -80,20 +80,15 @@ class ACLDBeamVectorEnv(FigureOwner, VectorEnv):
                  sensor_noise: float = SENSOR_NOISE_M, y_ref: float = 1e-3, lam: float = 0.01,
                  param_noise: float = 0.0, deflection_limit: float = 0.02,
                  render_mode: str | None = None):
-        if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) \
-                or num_envs < 1:
-            raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
-        configure(self, load_case=load_case, mesh=mesh, dt=dt, episode_length=episode_length,
+        num_envs = check_int("num_envs", num_envs, 1)
+        configure(self, num_envs=num_envs, load_case=load_case, mesh=mesh, dt=dt,
+                  episode_length=episode_length,
                   observer=observer, obs_mode=obs_mode, sensor_noise=sensor_noise,
                   y_ref=y_ref, lam=lam, param_noise=param_noise,
                   deflection_limit=deflection_limit, render_mode=render_mode)
-        steps = int(round(episode_length / dt))
+        steps = int(round(self.episode_length / self.dt))
         if max_episode_steps is not None:
-            if isinstance(max_episode_steps, bool) or not isinstance(
-                    max_episode_steps, (int, np.integer)) or max_episode_steps < 1:
-                raise ValueError("max_episode_steps must be a positive integer or None, got "
-                                 f"{max_episode_steps!r}")
-            steps = min(steps, int(max_episode_steps))
+            steps = min(steps, check_int("max_episode_steps", max_episode_steps, 1))
         self.num_envs = int(num_envs)
         self.max_episode_steps = max_episode_steps
         self.horizon = steps
@@ -128,12 +123,23 @@ class ACLDBeamVectorEnv(FigureOwner, VectorEnv):
         self._noise = np.zeros((N, steps + 1))
         self._y_hist = np.zeros((N, self.obs_hist))
         self._clipped = np.zeros(N, dtype=bool)
+        self._why = np.full(N, None, dtype=object)  # info["terminated_by"]
         self._prev_done = np.zeros(N, dtype=bool)
         self._idx = np.arange(N)
         self._rngs: list[np.random.Generator] = [seeding.np_random(None)[0] for _ in range(N)]
         self._loads: list = [thesis_load(1)] * N
         self._fig = None
-        self._viewer = None
+        self._needs_reset = True
+
+    @property
+    def spec(self):
+        """The registration spec with ``max_episode_steps`` the episode's step count
+        (see :func:`acld_gym.env.episode_spec`)."""
+        return getattr(self, "_spec", None)
+
+    @spec.setter
+    def spec(self, value) -> None:
+        self._spec = episode_spec(value, self.horizon)
 
     # --- helpers -------------------------------------------------------------
     def _grow_pool(self) -> None:
@@ -169,6 +175,7 @@ class ACLDBeamVectorEnv(FigureOwner, VectorEnv):
         self._y_hist[i] = 0.0
         self._y_hist[i, -1] = y
         self._clipped[i] = False
+        self._why[i] = None
 
     def _observations(self) -> np.ndarray:
         Z, n, k = self._Z, self._n, self._k
@@ -192,7 +199,8 @@ class ACLDBeamVectorEnv(FigureOwner, VectorEnv):
                 "voltage": self._Z[:, self._vcol].copy(),
                 "tip_load": self._pool_tip[self._slot, self._steps],
                 "time": self._steps * self.dt,
-                "clipped": self._clipped.copy()}
+                "clipped": self._clipped.copy(),
+                "terminated_by": self._why.copy()}
         info: dict[str, Any] = {}
         for key in INFO_KEYS:
             info[key] = vals[key]
@@ -202,26 +210,29 @@ class ACLDBeamVectorEnv(FigureOwner, VectorEnv):
     # --- Gymnasium API -------------------------------------------------------
     def reset(self, *, seed: int | list[int | None] | None = None,
               options: dict | None = None):
-        super().reset(seed=seed if isinstance(seed, (int, np.integer)) else None)
         N = self.num_envs
-        if seed is not None:
-            seeds = ([int(seed) + i for i in range(N)] if isinstance(seed, (int, np.integer))
-                     else list(seed))
-            if len(seeds) != N:
+        case = reset_options(options, self.load_case)  # validated before any seeding
+        if seed is None or isinstance(seed, (list, tuple, np.ndarray)):
+            seeds = None if seed is None else [check_seed(s) for s in seed]
+            if seeds is not None and len(seeds) != N:
                 raise ValueError(f"seed: expected an int or {N} seeds, got {len(seeds)}")
+            first = None
+        else:
+            first = check_seed(seed)
+            seeds = [first + i for i in range(N)]
+        super().reset(seed=first)
+        if seeds is not None:
             self._rngs = [seeding.np_random(s)[0] for s in seeds]
-        options = dict(options or {})
-        case = options.pop("load_case", self.load_case)
-        if options:
-            raise ValueError(f"options: unknown key(s) {sorted(options)}; expected 'load_case'")
-        _check_choice("load_case", case, LOAD_CASES)
         for i in range(N):
             self._reset_env(i, case)
         self._prev_done[:] = False
+        self._needs_reset = False
         return self._observations(), self._infos()
 
     def step(self, actions):
-        requested, v = check_actions(actions, self.num_envs, self.v_max)
+        if self._needs_reset:
+            raise RuntimeError("ACLDBeamVectorEnv: call reset() before step()")
+        requested, v = check_actions(actions, self.num_envs, self.v_max, vector=True)
         Z, n, k, idx = self._Z, self._n, self._k, self._idx
         reset = self._prev_done
         Z[:, self._vcol] = v
@@ -238,16 +249,35 @@ class ACLDBeamVectorEnv(FigureOwner, VectorEnv):
         self._y_hist[:, -1] = y
         self._clipped = requested != v
         rewards = reward_of(y_true, v, self.y_ref, self.lam, self.v_max)
-        terminated = np.abs(y_true) > self.deflection_limit
         truncated = self._steps >= self.horizon
         if reset.any():  # NEXT_STEP autoreset: these sub-envs ignore their action
             for i in np.flatnonzero(reset):
                 self._reset_env(int(i), self.load_case)
             rewards[reset] = 0.0
-            terminated[reset] = False
             truncated[reset] = False
+        obs = self._observations()
+        # Limits: the deflection, and any non-finite reward or observation (a NaN in the
+        # plant reaches the tip, hence the reward, within a step) -- never a normal step.
+        finite = np.isfinite(rewards) & np.isfinite(obs).all(axis=1)
+        over = ~(np.abs(y_true) <= self.deflection_limit) & ~reset
+        terminated = over | ~finite
+        self._why[:] = None
+        self._why[over] = "deflection_limit"
+        self._why[~finite] = "non_finite_state"
         self._prev_done = terminated | truncated
-        return self._observations(), rewards, terminated, truncated, self._infos()
+        return obs, rewards, terminated, truncated, self._infos()
+
+    def reset_done(self, indices) -> np.ndarray:
+        """Reset the sub-envs ``indices`` now (each from its own generator, with the env's
+        load case) and return the whole batch's observation: the same-step autoreset of
+        SB3 (:class:`acld_gym.sb3.SB3VecEnv`) instead of the NEXT_STEP one."""
+        idx = np.atleast_1d(np.asarray(indices, dtype=np.intp))
+        if idx.size and (idx.min() < 0 or idx.max() >= self.num_envs):
+            raise ValueError(f"indices must be in [0, {self.num_envs}), got {idx.tolist()}")
+        for i in idx:
+            self._reset_env(int(i), self.load_case)
+        self._prev_done[idx] = False
+        return self._observations()
 
     def render(self):
         if self.render_mode is None:

@@ -53,6 +53,9 @@ def _assert_same(rows_c, rows_p):
         assert type(tec) is type(tep) is bool and type(trc) is type(trp) is bool
         assert ic.keys() == ip.keys()
         for key in ic:  # rounding relative to the vector's size (xr_true components cancel)
+            if key == "terminated_by":
+                assert ic[key] == ip[key]
+                continue
             scale = np.abs(ip[key]).max()
             np.testing.assert_allclose(ic[key], ip[key], rtol=1e-9, atol=1e-12 * scale + 1e-15,
                                        err_msg=key)
@@ -84,10 +87,9 @@ def test_compiled_and_numpy_steps_give_the_same_episode(kw):
 
 @needs_core
 @pytest.mark.parametrize("action", [
-    [35.0], (35.0,), np.array([35.0]), np.array([35]), np.array([[35.0]], np.float32),
-    np.array([35.0], np.float32)[::1], np.float32(35.0), np.array([35.0], ">f4"),
-    np.array([35.0], np.float16),
-], ids=["list", "tuple", "float64", "int", "2d", "view", "scalar", "big-endian", "float16"])
+    [35.0], (35.0,), np.array([35.0]), np.array([35]), np.array([35.0], np.float32)[::1],
+    np.array([35.0], ">f4"), np.array([35.0], np.float16), [np.int8(35)],
+], ids=["list", "tuple", "float64", "int", "view", "big-endian", "float16", "int8"])
 def test_every_action_type_steps_alike(action):
     # float32/float64 1-element arrays take the compiled path, the rest the numpy path
     ref = _env(True, load_case=2)
@@ -208,3 +210,35 @@ def test_pure_python_switch_is_read_at_import():
                          check=True, env={**os.environ, "ACLD_GYM_PURE_PYTHON": "1"})
     assert out.stdout.strip() == "False"
     assert env_module.COMPILED_STEP is (env_module.StepCore is not None)
+
+
+@pytest.mark.parametrize("compiled", [True, False] if COMPILED_STEP else [False])
+def test_non_finite_state_terminates_and_says_why(compiled):
+    # Issue 14: a NaN must end the episode (abs(nan) > limit is False), with the reason.
+    env = _env(compiled, load_case=1)
+    env.reset(seed=0)
+    env.step(np.zeros(1, np.float32))
+    env._z[0] = np.nan  # a plant state gone bad, however it happened
+    _, reward, terminated, truncated, info = env.step(np.zeros(1, np.float32))
+    assert terminated and not truncated and info["terminated_by"] == "non_finite_state"
+    env.reset(seed=0)
+    *_, info = env.step(np.zeros(1, np.float32))
+    assert info["terminated_by"] is None
+
+
+@pytest.mark.parametrize("compiled", [True, False] if COMPILED_STEP else [False])
+@pytest.mark.parametrize("action", [
+    "60", b"60", [True], np.array([True]), np.array([60 + 1j]), np.float32(60.0), 60.0,
+    np.array([[60.0]], np.float32), np.array([60.0, 1.0]), [None], np.array([np.nan]),
+], ids=["str", "bytes", "bool", "bool-array", "complex", "np-scalar", "float", "2d", "two",
+        "none", "nan"])
+def test_bad_actions_are_rejected_and_leave_the_state_intact(compiled, action):
+    # Issue 14: only real numbers of shape (1,) are an action.
+    env = _env(compiled, load_case=2)
+    env.reset(seed=3)
+    env.step(np.array([10.0], np.float32))
+    before = (env._z.copy(), env.k, env.v, env.np_random.bit_generator.state)
+    with pytest.raises(ValueError, match="action"):
+        env.step(action)
+    assert np.array_equal(env._z, before[0]) and (env.k, env.v) == before[1:3]
+    assert env.np_random.bit_generator.state == before[3]

@@ -10,16 +10,16 @@ import torch
 from acld_gym.env import ACLDBeamEnv
 from baselines.evaluate import metrics_row, rollout
 from baselines.policies import LQRPolicy
-from train.agent import NumpyActor, TrainedAgent
+from train.agent import TrainedAgent, export_sb3
 from train.cli import make_model
-from train.config import TrainConfig, load_config
+from train.config import TrainConfig, config_path, load_config
 from train.distill import DistillConfig, distill, fit_sign
 from train.features import DirectionFeatures, direction_features
 from train.vec import make_vec_env
 
 
 def test_direction_features_are_scale_free():
-    z = np.random.default_rng(0).normal(size=(50, 7))
+    z = np.random.default_rng(0).normal(size=(50, 7))  # any width
     f, f3 = direction_features(z), direction_features(1e-3 * z)
     assert np.allclose(f[:, :7], f3[:, :7])  # the direction does not see the amplitude
     assert np.allclose(f[:, 7] - f3[:, 7], np.log(1e3))  # the log-norm does
@@ -75,7 +75,8 @@ def test_distill_config_validation():
 def distilled():
     """PPO's shipped config, two DAgger iterations on 2 sub-envs (4000 MPC labels)."""
     torch.set_num_threads(1)
-    cfg = load_config("ppo").with_overrides(n_envs=2)
+    cfg = load_config("ppo", config_path("ppo").with_name("ppo_dagger.yaml")).with_overrides(
+        n_envs=2)
     cfg = cfg.with_overrides(model={**cfg.model, "batch_size": 512})
     venv = make_vec_env(cfg, seed=3)
     model = make_model(cfg, venv, seed=3)
@@ -91,17 +92,17 @@ def test_dagger_imitates_the_mpc(distilled):
     assert history[-1]["agreement"] > 0.9
     # as a policy in volts it beats LQR clearly on thesis case 1 (MPC: 0.44 x LQR)
     venv.training = False
-    agent = TrainedAgent(model, venv, cfg.residual, "distilled")
+    agent = TrainedAgent(export_sb3(model, venv), {"residual": cfg.residual}, "distilled")
     ise = {name: metrics_row(1, name, rollout(p, ACLDBeamEnv(load_case=1), seed=0)).ise
            for name, p in [("lqr", LQRPolicy()), ("distilled", agent)]}
     assert ise["distilled"] < 0.6 * ise["lqr"]
 
 
-def test_numpy_actor_with_direction_features(distilled):
+def test_exported_actor_with_direction_features(distilled):
     _, _, model, _ = distilled
-    obs = np.random.default_rng(2).normal(0.0, 0.3, (128, 7)).astype(np.float32)
+    obs = np.random.default_rng(2).normal(0.0, 0.3, (128, 9)).astype(np.float32)
     sb3, _ = model.predict(obs, deterministic=True)
-    assert np.allclose(NumpyActor(model)(obs), sb3, atol=1e-5)
+    assert np.allclose(export_sb3(model)(obs), sb3, atol=1e-5)
 
 
 def test_distill_refuses_the_residual_map():

@@ -11,7 +11,7 @@ from train.vec import VecAgentEnv, VoltageMap, lq_potential, make_vec_env
 
 
 def test_voltage_map_plain_and_residual():
-    obs = np.random.default_rng(0).normal(size=(5, 7))
+    obs = np.random.default_rng(0).normal(size=(5, 9))
     a = np.array([[-1.0], [-0.5], [0.0], [0.5], [2.0]])
     assert np.allclose(VoltageMap()(a, obs)[:, 0], [-120, -60, 0, 60, 120])  # 2.0 -> clipped
     lqr = LQRPolicy()
@@ -49,7 +49,7 @@ def test_lq_potential_solves_the_discounted_riccati_equation():
 
 def test_shaping_is_potential_based():
     """Shaped minus raw reward is gamma Phi(s') - Phi(s) step by step (terminal obs at the end)."""
-    cfg = load_config("ppo").with_overrides(n_envs=2, load_case=1)
+    cfg = load_config("ppo").with_overrides(n_envs=2, load_case=1, shaping=0.01)
     raw = VecAgentEnv(_base(cfg), None, cfg.gamma, None)
     shaped = VecAgentEnv(_base(cfg), None, cfg.gamma, cfg.shaping)
     o_raw, o_sh = raw.reset(), shaped.reset()
@@ -83,7 +83,7 @@ def test_make_vec_env_is_seeded_and_normalized():
     cfg = load_config("ppo").with_overrides(n_envs=3)
     a, b = make_vec_env(cfg, seed=5), make_vec_env(cfg, seed=5)
     oa, ob = a.reset(), b.reset()
-    assert np.array_equal(oa, ob) and oa.shape == (3, 7)
+    assert np.array_equal(oa, ob) and oa.shape == (3, 9)
     assert a.action_space.low[0] == -1 and a.action_space.high[0] == 1
     act = np.full((3, 1), 0.3, np.float32)
     for _ in range(20):

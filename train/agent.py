@@ -1,140 +1,260 @@
 """A trained agent as a policy with SB3's ``predict`` protocol in volts, so
-:mod:`baselines.evaluate` treats it exactly like LQR, SMC and MPC."""
+:mod:`baselines.evaluate` treats it exactly like LQR, SMC and MPC.
+
+An agent directory holds what the policy needs in formats that cannot execute
+anything when read:
+
+* ``policy.npz``: the deterministic actor as numpy arrays (the observation
+  normalization, the layers' weights), read with ``allow_pickle=False``;
+* ``metadata.json``: how it was made (algorithm, teacher or none, command, config,
+  versions), the actor's program (which operation uses which arrays), and the
+  **observation fingerprint** of the env it was trained on
+  (:mod:`acld_gym.fingerprint`).
+
+:meth:`TrainedAgent.load` reads only those two files. It refuses an agent whose
+fingerprint does not match what that env's observation is today, on this machine
+(another basis, mesh, observer or scaling), and :func:`baselines.evaluate.rollout`
+refuses to run it in an env whose observation differs: an agent never acts on
+coordinates it was not trained on. Training runs also keep SB3's ``model.zip`` and
+``vecnormalize.pkl`` for resuming training; loading *those* unpickles code, so only
+load them from a source you trust (``TrainedAgent`` never does).
+"""
 
 from __future__ import annotations
 
 import json
-import pickle
+import zipfile
 from pathlib import Path
 
 import numpy as np
 
+from acld_gym.atomic import write_atomic, write_json
+
 from .features import direction_features
 from .vec import VoltageMap
 
-__all__ = ["TrainedAgent", "NumpyActor", "MODEL_FILE", "STATS_FILE", "META_FILE"]
+__all__ = ["TrainedAgent", "ActorProgram", "AgentFileError", "export_sb3", "POLICY_FILE",
+           "META_FILE", "MODEL_FILE", "STATS_FILE"]
 
+POLICY_FILE = "policy.npz"
+META_FILE = "metadata.json"
+#: SB3's files, for resuming training only (pickled: never read by TrainedAgent).
 MODEL_FILE = "model.zip"
 STATS_FILE = "vecnormalize.pkl"
-META_FILE = "metadata.json"
+#: Version of the agent format.
+FORMAT = 2
 
 
-def _algo_class(algo: str):
-    from stable_baselines3 import PPO, SAC
-
-    classes = {"ppo": PPO, "sac": SAC}
-    if algo not in classes:
-        raise ValueError(f"algo must be one of {list(classes)}, got {algo!r}")
-    return classes[algo]
+class AgentFileError(ValueError):
+    """An agent directory's file is missing, damaged or inconsistent (names the file)."""
 
 
+class ActorProgram:
+    """The deterministic actor as a list of numpy operations on the raw observation.
 
-class NumpyActor:
-    """The deterministic actor of an SB3 ``MlpPolicy`` (PPO or SAC) as numpy layers.
-
-    SB3's ``predict`` costs about 0.2 ms per call (tensor conversion, checks); the
-    network itself is a few small matrix-vector products. This evaluates exactly
-    SB3's deterministic action -- PPO: the Gaussian mean clipped to the action box;
-    SAC: tanh of the mean -- in float64 (the tests compare it with ``predict``), with
-    the flatten or :class:`train.features.DirectionFeatures` extractor.
+    ``ops`` is JSON-able: ``{"op": "normalize", "clip": c, "eps": e}`` (arrays
+    ``mean``, ``var``), ``{"op": "direction"}`` (:func:`train.features.direction_features`),
+    ``{"op": "linear"}`` (arrays ``W{i}``, ``b{i}``), ``{"op": "tanh" | "relu"}``,
+    ``{"op": "clip", "low": l, "high": h}``. The output is the action in [-1, 1].
     """
 
-    def __init__(self, model):
-        import torch.nn as nn
-        from stable_baselines3 import SAC
-        from stable_baselines3.common.torch_layers import FlattenExtractor
+    _KINDS = ("normalize", "direction", "linear", "tanh", "relu", "clip")
 
-        pol = model.policy
-        if isinstance(model, SAC):
-            extractor = pol.actor.features_extractor
-            mu = pol.actor.mu
-            layers = [*pol.actor.latent_pi, *(mu if isinstance(mu, nn.Sequential) else [mu])]
-            self.squash = True
-        else:
-            extractor = pol.pi_features_extractor
-            layers = [*pol.mlp_extractor.policy_net, pol.action_net]
-            self.squash = bool(pol.squash_output)
-        from .features import DirectionFeatures
-
-        self.ops: list[tuple] = []
-        if isinstance(extractor, DirectionFeatures):
-            self.ops.append(("direction",))
-        elif not isinstance(extractor, FlattenExtractor):
-            raise TypeError(f"NumpyActor supports MlpPolicy with the flatten or direction "
-                            f"features only, got {type(extractor).__name__}")
-        for layer in layers:
-            if isinstance(layer, nn.Linear):
-                self.ops.append(("linear", layer.weight.detach().double().numpy().T.copy(),
-                                 layer.bias.detach().double().numpy().copy()))
-            elif isinstance(layer, nn.Tanh):
-                self.ops.append(("tanh",))
-            elif isinstance(layer, nn.ReLU):
-                self.ops.append(("relu",))
-            elif isinstance(layer, nn.Hardtanh):
-                self.ops.append(("clip", float(layer.min_val), float(layer.max_val)))
-            else:
-                raise TypeError(f"NumpyActor: unsupported layer {layer!r}")
+    def __init__(self, ops: list[dict], arrays: dict[str, np.ndarray]):
+        self.ops = [dict(op) for op in ops]
+        self.arrays = {k: np.asarray(v, dtype=np.float64) for k, v in arrays.items()}
+        layer = 0
+        for op in self.ops:
+            kind = op.get("op")
+            if kind not in self._KINDS:
+                raise AgentFileError(f"actor: unknown operation {kind!r}")
+            if kind == "linear":
+                op.setdefault("layer", layer)
+                layer += 1
+                for key in (f"W{op['layer']}", f"b{op['layer']}"):
+                    if key not in self.arrays:
+                        raise AgentFileError(f"{POLICY_FILE}: missing array {key!r}")
+            if kind == "normalize" and not {"mean", "var"} <= set(self.arrays):
+                raise AgentFileError(f"{POLICY_FILE}: normalize needs 'mean' and 'var'")
 
     def __call__(self, obs: np.ndarray) -> np.ndarray:
-        """Actions in [-1, 1], shape (n, 1), for normalized observations (n, d)."""
+        """Actions in [-1, 1], shape (n, 1), for raw observations (n, d)."""
         z = np.asarray(obs, dtype=np.float64)
+        a = self.arrays
         for op in self.ops:
-            if op[0] == "linear":
-                z = z @ op[1] + op[2]
-            elif op[0] == "tanh":
-                z = np.tanh(z)
-            elif op[0] == "direction":
+            kind = op["op"]
+            if kind == "normalize":
+                z = np.clip((z - a["mean"]) / np.sqrt(a["var"] + op["eps"]), -op["clip"],
+                            op["clip"])
+            elif kind == "direction":
                 z = direction_features(z)
-            elif op[0] == "relu":
+            elif kind == "linear":
+                z = z @ a[f"W{op['layer']}"] + a[f"b{op['layer']}"]
+            elif kind == "tanh":
+                z = np.tanh(z)
+            elif kind == "relu":
                 z = np.maximum(z, 0.0)
             else:
-                z = np.clip(z, op[1], op[2])
-        return np.clip(np.tanh(z) if self.squash else z, -1.0, 1.0)
+                z = np.clip(z, op["low"], op["high"])
+        return np.clip(z, -1.0, 1.0).reshape(-1, 1)
+
+
+def export_sb3(model, obs_norm=None) -> ActorProgram:
+    """The deterministic actor of an SB3 ``MlpPolicy`` (PPO, SAC, TD3, TQC, ...) and its
+    ``VecNormalize`` observation statistics as an :class:`ActorProgram` (equal to SB3's
+    ``predict`` to float32 round-off; tests/test_train_agents.py)."""
+    import torch.nn as nn
+    from stable_baselines3.common.torch_layers import FlattenExtractor
+
+    from .features import DirectionFeatures
+
+    pol = model.policy
+    ops: list[dict] = []
+    arrays: dict[str, np.ndarray] = {}
+    if obs_norm is not None and getattr(obs_norm, "norm_obs", False):
+        ops.append({"op": "normalize", "clip": float(obs_norm.clip_obs),
+                    "eps": float(obs_norm.epsilon)})
+        arrays["mean"] = obs_norm.obs_rms.mean.copy()
+        arrays["var"] = obs_norm.obs_rms.var.copy()
+    actor = getattr(pol, "actor", None)
+    if actor is not None and hasattr(actor, "latent_pi"):  # SAC, TQC: tanh(mu(latent))
+        extractor = actor.features_extractor
+        mu = actor.mu
+        layers = [*actor.latent_pi, *(mu if isinstance(mu, nn.Sequential) else [mu])]
+        squash = True
+    elif actor is not None and hasattr(actor, "mu"):  # TD3: mu is the whole net, Tanh last
+        extractor = actor.features_extractor
+        layers = list(actor.mu)
+        squash = False
+    else:  # PPO / A2C: Gaussian mean, clipped to the box
+        extractor = pol.pi_features_extractor
+        layers = [*pol.mlp_extractor.policy_net, pol.action_net]
+        squash = bool(pol.squash_output)
+    if isinstance(extractor, DirectionFeatures):
+        ops.append({"op": "direction"})
+    elif not isinstance(extractor, FlattenExtractor):
+        raise TypeError(f"export_sb3 supports the flatten or direction features only, got "
+                        f"{type(extractor).__name__}")
+    layer = 0
+    for m in layers:
+        if isinstance(m, nn.Linear):
+            arrays[f"W{layer}"] = m.weight.detach().double().numpy().T.copy()
+            arrays[f"b{layer}"] = m.bias.detach().double().numpy().copy()
+            ops.append({"op": "linear", "layer": layer})
+            layer += 1
+        elif isinstance(m, nn.Tanh):
+            ops.append({"op": "tanh"})
+        elif isinstance(m, nn.ReLU):
+            ops.append({"op": "relu"})
+        elif isinstance(m, nn.Hardtanh):
+            ops.append({"op": "clip", "low": float(m.min_val), "high": float(m.max_val)})
+        else:
+            raise TypeError(f"export_sb3: unsupported layer {m!r}")
+    if squash:
+        ops.append({"op": "tanh"})
+    return ActorProgram(ops, arrays)
 
 
 class TrainedAgent:
-    """An agent directory (``model.zip``, ``vecnormalize.pkl``, ``metadata.json``)
-    as a policy on the env's raw ``"estimate"`` observation.
+    """An agent directory (module docstring) as a policy on the env's raw observation.
 
-    ``predict`` normalizes the observation with the frozen ``VecNormalize``
-    statistics, runs the actor network deterministically (:class:`NumpyActor`) and
-    maps its action to volts with the same :class:`train.vec.VoltageMap` as in
-    training. ``model`` is the SB3 model (``model.predict`` gives the same actions).
+    ``predict`` runs the :class:`ActorProgram` and maps its action to volts with the
+    same :class:`train.vec.VoltageMap` as in training.
     """
 
-    def __init__(self, model, obs_norm, residual: str | None, name: str = "agent",
-                 metadata: dict | None = None, directory: Path | None = None):
-        self.directory = directory
-        self.model = model
-        self.actor = NumpyActor(model)
-        self.obs_norm = obs_norm
-        self.map = VoltageMap(residual)
+    def __init__(self, actor: ActorProgram, metadata: dict, name: str = "agent",
+                 directory: Path | None = None):
+        self.actor = actor
+        self.metadata = dict(metadata)
         self.name = name
-        self.metadata = dict(metadata or {})
+        self.directory = directory
+        self.map = VoltageMap(self.metadata.get("residual"))
+
+    # --- what it was trained on --------------------------------------------------------
+    @property
+    def observation_fingerprint(self) -> dict:
+        """The observation it was trained on (checked by :func:`baselines.evaluate.rollout`)."""
+        return self.metadata["observation"]
+
+    @property
+    def training(self) -> str:
+        """How it was trained: ``"from scratch"`` or ``"DAgger from <teacher> + RL"``."""
+        return self.metadata.get("training", "unknown")
+
+    # --- files ------------------------------------------------------------------------
+    def save(self, directory: str | Path) -> Path:
+        """Write ``policy.npz`` and ``metadata.json`` (atomically) to ``directory``."""
+        d = Path(directory)
+        meta = dict(self.metadata, format=FORMAT, actor=self.actor.ops)
+        write_atomic(d / POLICY_FILE, lambda fh: np.savez(fh, **self.actor.arrays))
+        write_json(d / META_FILE, meta)
+        return d
 
     @classmethod
-    def load(cls, directory: str | Path, name: str | None = None) -> TrainedAgent:
-        """Load an agent directory written by ``python -m train``."""
-        d = Path(directory)
-        for f in (META_FILE, MODEL_FILE, STATS_FILE):
-            if not (d / f).is_file():
-                raise FileNotFoundError(f"agent directory {str(d)!r} lacks {f}")
-        meta = json.loads((d / META_FILE).read_text())
-        algo = meta.get("algo")
-        model = _algo_class(algo).load(str(d / MODEL_FILE), device="cpu")
-        with (d / STATS_FILE).open("rb") as fh:
-            obs_norm = pickle.load(fh)  # a VecNormalize without its venv
-        obs_norm.training = False
-        residual = meta.get("config", {}).get("residual")
-        return cls(model, obs_norm, residual, name or algo, meta, d)
+    def load(cls, directory: str | Path, name: str | None = None,
+             check: bool = True) -> TrainedAgent:
+        """Load an agent directory without executing anything from it.
 
+        With ``check`` (default), the recorded observation fingerprint is compared with
+        the observation of the env it names, as defined by this installation on this
+        machine; a mismatch raises :class:`AgentFileError` saying what differs.
+        """
+        d = Path(directory)
+        if not d.is_dir():
+            raise FileNotFoundError(f"agent directory {str(d)!r} does not exist")
+        meta_path, pol_path = d / META_FILE, d / POLICY_FILE
+        for f in (meta_path, pol_path):
+            if not f.is_file():
+                raise FileNotFoundError(f"agent directory {str(d)!r} lacks {f.name}")
+        try:
+            meta = json.loads(meta_path.read_text())
+        except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+            raise AgentFileError(f"{meta_path}: not valid JSON ({exc})") from None
+        if not isinstance(meta, dict) or not {"actor", "observation", "env"} <= set(meta):
+            raise AgentFileError(f"{meta_path}: expected an agent's metadata with 'actor', "
+                                 "'observation' and 'env'")
+        try:
+            with np.load(pol_path, allow_pickle=False) as z:
+                arrays = {k: z[k] for k in z.files}
+        except (OSError, ValueError, zipfile.BadZipFile, EOFError) as exc:
+            raise AgentFileError(f"{pol_path}: not a readable numpy archive ({exc})") from None
+        try:
+            actor = ActorProgram(meta["actor"], arrays)
+        except AgentFileError as exc:
+            raise AgentFileError(f"{d}: {exc}") from None
+        agent = cls(actor, meta, name or meta.get("algo", "agent"), d)
+        if check:
+            agent.check_current()
+        return agent
+
+    def check_current(self) -> None:
+        """Raise :class:`AgentFileError` if the env the agent names observes differently
+        today (:mod:`acld_gym.fingerprint`)."""
+        import gymnasium as gym
+
+        import acld_gym  # noqa: F401  (registers the ids)
+        from acld_gym.fingerprint import fingerprint_differences, observation_fingerprint
+
+        env_meta = self.metadata["env"]
+        env = gym.make(env_meta["id"], **env_meta.get("kwargs", {}))
+        try:
+            diff = fingerprint_differences(self.observation_fingerprint,
+                                           observation_fingerprint(env))
+        finally:
+            env.close()
+        if diff:
+            where = self.directory if self.directory is not None else self.name
+            raise AgentFileError(f"agent {str(where)!r} was trained on another observation "
+                                 f"than {env_meta['id']}'s today: " + "; ".join(diff))
+
+    # --- policy -----------------------------------------------------------------------
     def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
         """SB3 protocol: ``(voltages, state)``, shape (n, 1) for a batch or (1,)."""
+        if not deterministic:
+            raise ValueError("deterministic must be True: TrainedAgent evaluates the "
+                             "deterministic policy")
         obs = np.asarray(observation, dtype=np.float32)
         batched = obs.ndim == 2
         obs2 = np.atleast_2d(obs)
-        if not deterministic:
-            raise ValueError("deterministic must be True: TrainedAgent evaluates the "
-                             "deterministic policy (use .model.predict to sample)")
-        v = self.map(self.actor(self.obs_norm.normalize_obs(obs2)), obs2)
+        v = self.map(self.actor(obs2), obs2)
         return (v if batched else v[0]), state

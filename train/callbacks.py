@@ -82,25 +82,29 @@ class ThesisCaseMonitor(gym.Wrapper):
         return obs, -(y * y) * self.metrics.dt / self.lqr_ise, terminated, truncated, info
 
 
-def lqr_reference_ise(cases=THESIS_CASES, seed: int = 0) -> dict:
-    """ISE [m^2 s] of the discrete LQR baseline on each case (the eval's yardstick)."""
+def lqr_reference_ise(cases=THESIS_CASES, seed: int = 0, mesh: str = "converged") -> dict:
+    """ISE [m^2 s] of the discrete LQR baseline on each case (the eval's yardstick; it
+    normalizes the evaluation, it is not part of the training signal)."""
     from baselines.evaluate import metrics_row, rollout
     from baselines.policies import LQRPolicy
 
-    lqr = LQRPolicy()
-    return {c: metrics_row(c, "lqr", rollout(lqr, ACLDBeamEnv(load_case=c), seed=seed)).ise
+    lqr = LQRPolicy(mesh=mesh)
+    return {c: metrics_row(c, "lqr", rollout(lqr, ACLDBeamEnv(load_case=c, mesh=mesh),
+                                             seed=seed)).ise
             for c in cases}
 
 
 def thesis_eval_env(cfg, lqr_ise: dict | None = None) -> VecNormalize:
     """The three thesis cases as one ``VecEnv`` wrapped like the training env
     (statistics frozen; ``EvalCallback`` copies them from the training env)."""
-    lqr_ise = lqr_reference_ise() if lqr_ise is None else lqr_ise
+    lqr_ise = lqr_reference_ise(mesh=cfg.mesh) if lqr_ise is None else lqr_ise
 
     def make(case):
-        return lambda: Monitor(ThesisCaseMonitor(ACLDBeamEnv(load_case=case), lqr_ise[case]))
+        return lambda: Monitor(ThesisCaseMonitor(ACLDBeamEnv(load_case=case, mesh=cfg.mesh),
+                                                 lqr_ise[case]))
 
-    venv = VecAgentEnv(DummyVecEnv([make(c) for c in THESIS_CASES]), cfg.residual, cfg.gamma)
+    venv = VecAgentEnv(DummyVecEnv([make(c) for c in THESIS_CASES]), cfg.residual, cfg.gamma,
+                       mesh=cfg.mesh)
     vn = VecNormalize(venv, gamma=cfg.gamma, **cfg.normalize)
     vn.training, vn.norm_reward = False, False
     return vn

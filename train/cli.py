@@ -1,23 +1,27 @@
-"""``python -m train ppo|sac``: train an agent on ``ACLDBeam-v0``.
+"""``python -m train ppo|sac``: train an agent on ``ACLDBeam-v1``.
 
-Writes to ``--out`` (default ``runs/<algo>-<load case>-s<seed>``): ``model.zip`` and
-``vecnormalize.pkl`` (final), ``best/`` (best on the thesis cases, with its
-statistics), ``checkpoints/``, ``tb/`` (TensorBoard), ``learning_curve.csv`` and
-``metadata.json`` (command, seed, config, versions). The final directory loads
-with :meth:`train.agent.TrainedAgent.load`.
+Writes to ``--out`` (default ``runs/<algo>-<load case>-s<seed>``): the agent as
+``policy.npz`` + ``metadata.json`` (loads with :meth:`train.agent.TrainedAgent.load`;
+the metadata records the command, seed, config, versions, the teacher if any, and the
+observation fingerprint), ``best/`` (the same for the best checkpoint on the thesis
+cases), ``model.zip`` + ``vecnormalize.pkl`` (SB3's files, to resume training),
+``checkpoints/``, ``tb/`` (TensorBoard) and ``learning_curve.csv``.
+
+No teacher by default: ``train/ppo.yaml`` and ``train/sac.yaml`` learn from the env's
+reward alone. ``train/ppo_dagger.yaml`` and ``train/sac_dagger.yaml`` (``--config``)
+first distill the MPC into the actor by DAgger; the output and metadata say so.
 """
 
 from __future__ import annotations
 
 import argparse
-import json
 import platform
 import shlex
 import sys
 import time
 from pathlib import Path
 
-from .config import ALGOS, TrainConfig, load_config
+from .config import ALGOS, TrainConfig, algo_class, load_config
 
 __all__ = ["main", "train", "make_model", "versions", "parse_load_case"]
 
@@ -39,8 +43,6 @@ def versions() -> dict[str, str]:
 def make_model(cfg: TrainConfig, venv, seed: int, **kwargs):
     """The (untrained) SB3 model of ``cfg`` on ``venv``: the config's keyword
     arguments with its ``features`` extractor, CPU, seeded; ``kwargs`` add to them."""
-    from .agent import _algo_class
-
     model_kwargs = dict(cfg.model)
     policy = model_kwargs.pop("policy")
     if cfg.features is not None:
@@ -48,7 +50,7 @@ def make_model(cfg: TrainConfig, venv, seed: int, **kwargs):
 
         model_kwargs["policy_kwargs"] = {**model_kwargs.get("policy_kwargs", {}),
                                          "features_extractor_class": FEATURES[cfg.features]}
-    return _algo_class(cfg.algo)(policy, venv, seed=seed, device="cpu",
+    return algo_class(cfg.algo)(policy, venv, seed=seed, device="cpu",
                                  **{**model_kwargs, **kwargs})
 
 
@@ -62,7 +64,7 @@ def train(cfg: TrainConfig, seed: int, out: Path, progress_bar: bool = False,
     import torch
     from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback
 
-    from .agent import META_FILE, MODEL_FILE, STATS_FILE
+    from .agent import MODEL_FILE, STATS_FILE
     from .callbacks import PhysicsRolloutLogger, make_eval_callback
     from .vec import make_vec_env
 
@@ -88,15 +90,47 @@ def train(cfg: TrainConfig, seed: int, out: Path, progress_bar: bool = False,
     model.learn(cfg.n_timesteps, callback=callbacks, progress_bar=progress_bar,
                 tb_log_name=cfg.algo)
     seconds = time.perf_counter() - t0
+    # SB3's own files, to resume training (pickled: load them only from trusted sources)
     model.save(str(out / MODEL_FILE))
     venv.save(str(out / STATS_FILE))
     meta = {"algo": cfg.algo, "seed": seed, "command": command, "config": cfg.as_dict(),
+            "training": cfg.training, "teacher": cfg.teacher, "residual": cfg.residual,
             "timesteps": int(model.num_timesteps), "train_seconds": round(seconds, 1),
-            "distill": distilled,
-            "backend": backend, "versions": versions()}
-    (out / META_FILE).write_text(json.dumps(meta, indent=2) + "\n")
+            "distill": distilled, "backend": backend, "versions": versions()}
+    export_run(out, cfg, meta, model, venv)
     venv.close()
     return model
+
+
+def export_run(out: Path, cfg: TrainConfig, meta: dict, model=None, venv=None) -> None:
+    """Write the run's agent (``policy.npz`` + ``metadata.json``) for the final model and,
+    if the ``EvalCallback`` saved one, for the best checkpoint in ``out/best``. ``meta``
+    gets the env and its observation fingerprint. ``model``/``venv`` default to the run's
+    own ``model.zip``/``vecnormalize.pkl`` (written by this package: trusted)."""
+    import gymnasium as gym
+    from stable_baselines3.common.vec_env import VecNormalize
+
+    from acld_gym.fingerprint import observation_fingerprint
+
+    from .agent import MODEL_FILE, STATS_FILE, TrainedAgent, export_sb3
+
+    env_meta = {"id": "ACLDBeam-v1", "kwargs": {"mesh": cfg.mesh}}
+    probe = gym.make(env_meta["id"], **env_meta["kwargs"])  # the observation it trained on
+    meta = dict(meta, env=env_meta, observation=observation_fingerprint(probe))
+    probe.close()
+
+    def stats(path: Path):
+        return VecNormalize.load(str(path), None) if path.is_file() else None
+
+    if model is None:
+        model = algo_class(cfg.algo).load(str(out / MODEL_FILE), device="cpu")
+        venv = stats(out / STATS_FILE)
+    TrainedAgent(export_sb3(model, venv), meta, cfg.algo).save(out)
+    best = out / "best"
+    if (best / "best_model.zip").is_file():
+        best_model = algo_class(cfg.algo).load(str(best / "best_model.zip"), device="cpu")
+        TrainedAgent(export_sb3(best_model, stats(best / STATS_FILE) or venv), meta,
+                     cfg.algo).save(best)
 
 
 def parse_load_case(text: str):
@@ -163,7 +197,14 @@ def main(argv: list[str] | None = None) -> int:
     out = Path(args.out or f"runs/{cfg.algo}-{cfg.load_case}-s{args.seed}")
     command = "python -m train " + " ".join(shlex.quote(a) for a in
                                             (sys.argv[1:] if argv is None else argv))
+    print(f"training {cfg.algo.upper()} {cfg.training}: "
+          + ("no teacher -- it learns from the env's observation and reward only"
+             if cfg.teacher is None else
+             f"the actor first imitates the {cfg.teacher.upper()} (DAgger, opt-in via the "
+             "config's distill:), then RL"))
     train(cfg, args.seed, out, progress_bar=not args.no_progress, backend=args.backend,
           command=command)
-    print(f"wrote {out}/: model.zip, vecnormalize.pkl, best/, learning_curve.csv, tb/")
+    print(f"wrote {out}/: policy.npz + metadata.json (the agent), best/ (the same for the best "
+          "checkpoint), model.zip + vecnormalize.pkl (to resume training), learning_curve.csv, "
+          "tb/")
     return 0

@@ -21,6 +21,8 @@ import json
 import sys
 from pathlib import Path
 
+from acld_gym.atomic import write_json, write_text
+from acld_gym.plant import MESHES
 from baselines.evaluate import (
     EvalRow,
     default_policies,
@@ -30,20 +32,48 @@ from baselines.evaluate import (
     plot_episodes,
 )
 
-__all__ = ["AGENTS_DIR", "HELDOUT_SEEDS", "load_agents", "compare", "relative", "markdown_table",
-           "plot_learning_curves", "main"]
+__all__ = ["AGENTS_DIR", "HELDOUT_SEEDS", "agent_names", "load_agents", "training_labels",
+           "compare", "relative", "markdown_table", "plot_learning_curves", "main"]
 
 AGENTS_DIR = Path(__file__).resolve().parent / "agents"
 #: Seeds of the held-out random-load episodes (training uses seeds < 1000 per sub-env).
 HELDOUT_SEEDS = tuple(range(100_000, 100_020))
 
 
-def load_agents(directory: str | Path = AGENTS_DIR, names=("ppo", "sac")) -> dict:
-    """The agents ``directory/<name>/`` as policies (``FileNotFoundError`` if one is missing)."""
+def agent_names(directory: str | Path = AGENTS_DIR, mesh: str = "converged") -> list[str]:
+    """The agent directories under ``directory`` trained on ``mesh`` (sorted)."""
+    from .agent import META_FILE
+
+    out = []
+    for d in sorted(Path(directory).iterdir()) if Path(directory).is_dir() else []:
+        meta = d / META_FILE
+        if meta.is_file():
+            try:
+                rec = json.loads(meta.read_text())
+            except json.JSONDecodeError:
+                continue  # TrainedAgent.load reports it when asked for it by name
+            if rec.get("env", {}).get("kwargs", {}).get("mesh") == mesh:
+                out.append(d.name)
+    return out
+
+
+def load_agents(directory: str | Path = AGENTS_DIR, names=None, mesh: str = "converged") -> dict:
+    """The agents ``directory/<name>/`` as policies (default: every agent trained on
+    ``mesh``); ``FileNotFoundError`` / :class:`train.agent.AgentFileError` if one is
+    missing or does not match its env."""
     from .agent import TrainedAgent
 
     directory = Path(directory)
+    names = agent_names(directory, mesh) if names is None else names
     return {name: TrainedAgent.load(directory / name, name) for name in names}
+
+
+def training_labels(policies: dict) -> dict[str, str]:
+    """How each policy came about, for the tables: an agent's ``training`` ("from
+    scratch" or "DAgger from MPC + RL"); "designed" for the reference policies."""
+    out = {name: getattr(p, "training", "designed") for name, p in policies.items()}
+    out["bound"] = "clairvoyant"
+    return out
 
 
 def compare(policies: dict, cases=(1, 2, 3), random_seeds=HELDOUT_SEEDS, seed: int = 0,
@@ -57,12 +87,15 @@ def compare(policies: dict, cases=(1, 2, 3), random_seeds=HELDOUT_SEEDS, seed: i
     return rows
 
 
-def relative(rows: list[EvalRow]) -> list[dict]:
-    """Rows as dicts with ``ise_rel_lqr`` and ``ise_rel_bound`` (per case)."""
+def relative(rows: list[EvalRow], labels: dict | None = None) -> list[dict]:
+    """Rows as dicts with ``ise_rel_lqr`` and ``ise_rel_bound`` (per case) and, with
+    ``labels`` (:func:`training_labels`), how each policy was trained."""
     out = []
     for r in rows:
         same = {x.policy: x.ise for x in rows if x.case == r.case}
         d = r.as_dict()
+        if labels is not None:
+            d["training"] = labels.get(r.policy, "")
         d["ise_rel_lqr"] = r.ise / same["lqr"] if "lqr" in same else None
         d["ise_rel_bound"] = r.ise / same["bound"] if "bound" in same else None
         out.append(d)
@@ -71,11 +104,12 @@ def relative(rows: list[EvalRow]) -> list[dict]:
 
 def markdown_table(rows: list[dict]) -> str:
     """The comparison as one markdown table (rows from :func:`relative`)."""
-    head = ("| case | policy | peak [mm] | settling [s] | ISE [m^2 s] | ISE / LQR | ISE / bound "
-            "| max abs V [V] | ms / step |")
-    out = [head, "|---|---|---|---|---|---|---|---|---|"]
+    head = ("| case | policy | trained | peak [mm] | settling [s] | ISE [m^2 s] | ISE / LQR "
+            "| ISE / bound | max abs V [V] | ms / step |")
+    out = [head, "|---|---|---|---|---|---|---|---|---|---|"]
     for d in rows:
-        out.append(f"| {d['case']} | {d['policy']} | {d['peak_mm']:.3f} | {d['settling_s']:.3f} "
+        out.append(f"| {d['case']} | {d['policy']} | {d.get('training', '')} "
+                   f"| {d['peak_mm']:.3f} | {d['settling_s']:.3f} "
                    f"| {d['ise']:.3e} | {d['ise_rel_lqr']:.2f} | {d['ise_rel_bound']:.2f} "
                    f"| {d['max_voltage_V']:.0f} | {d['ms_per_step']:.3f} |")
     return "\n".join(out)
@@ -129,14 +163,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--plots", metavar="DIR", help="write the figures to DIR")
     p.add_argument("--markdown", metavar="PATH", help="write the table as markdown")
     p.add_argument("--agents", metavar="DIR", default=str(AGENTS_DIR),
-                   help="directory with ppo/ and sac/ agent directories (default: shipped)")
-    p.add_argument("--extra-agents", metavar="NAME", nargs="*", default=(),
-                   help="further agent directories under --agents to include (e.g. ppo_robust)")
+                   help="directory of agent directories (default: the shipped train/agents)")
+    p.add_argument("--only", metavar="NAME", nargs="*", default=(),
+                   help="these agents only (default: every agent trained on --mesh)")
     p.add_argument("--random-episodes", type=int, default=len(HELDOUT_SEEDS),
                    help="held-out random-load episodes (default 20; 0 for none)")
     p.add_argument("--param-noise", type=float, default=0.0,
                    help="per-episode parameter randomization of the plant (default 0)")
     p.add_argument("--seed", type=int, default=0, help="seed of the thesis-case episodes")
+    p.add_argument("--mesh", choices=MESHES, default="converged",
+                   help="truth plant (default: the converged beam); the agents trained on it")
     return p
 
 
@@ -148,14 +184,17 @@ def main(argv: list[str] | None = None) -> int:
     if not args.param_noise >= 0:
         parser.error(f"--param-noise must be >= 0, got {args.param_noise}")
     try:
-        agents = load_agents(args.agents, ("ppo", "sac", *args.extra_agents))
+        names = None if not args.only else args.only
+        agents = load_agents(args.agents, names, mesh=args.mesh)
     except (OSError, ValueError) as exc:
         parser.error(str(exc))
-    policies = {**default_policies(), **agents}
+    policies = {**default_policies(args.mesh), **agents}
     seeds = tuple(range(HELDOUT_SEEDS[0], HELDOUT_SEEDS[0] + args.random_episodes))
     episodes: dict = {}
     rows = compare(policies, random_seeds=seeds, seed=args.seed,
-                   env_kwargs={"param_noise": args.param_noise}, episodes=episodes)
+                   env_kwargs={"param_noise": args.param_noise, "mesh": args.mesh},
+                   episodes=episodes)
+    labels = training_labels(policies)
     title = f" (param_noise = {args.param_noise})" if args.param_noise else ""
     print(f"Agents vs reference policies{title}; 'random' = mean over {len(seeds)} "
           "held-out random-load episodes")
@@ -163,12 +202,12 @@ def main(argv: list[str] | None = None) -> int:
     if args.json:
         path = Path(args.json)
         path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(json.dumps(relative(rows), indent=2) + "\n")
+        write_json(path, relative(rows, labels))
         print(f"\nwrote {path}")
     if args.markdown:
         path = Path(args.markdown)
         path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(markdown_table(relative(rows)) + "\n")
+        write_text(path, markdown_table(relative(rows, labels)) + "\n")
         print(f"wrote {path}")
     if args.plots:
         plot_episodes(episodes, Path(args.plots))

@@ -9,9 +9,10 @@ from typing import Any
 
 import yaml
 
-from acld_gym.env import LOAD_CASES
+from acld_gym.env import LOAD_CASES, PARAM_NOISE_MAX
+from acld_gym.plant import MESHES
 
-__all__ = ["ALGOS", "TrainConfig", "load_config", "config_path"]
+__all__ = ["ALGOS", "TrainConfig", "load_config", "config_path", "algo_class"]
 
 ALGOS = ("ppo", "sac")
 RESIDUALS = (None, "lqr")
@@ -33,6 +34,8 @@ class TrainConfig:
         Sub-envs of the native batched env.
     load_case : int or str
         Training loads: 1, 2, 3 or ``"random"``.
+    mesh : str
+        Truth plant of ``ACLDBeam-v1``: ``"converged"`` (default) or ``"thesis"``.
     param_noise : float
         Relative std of per-episode parameter randomization (0: nominal plant).
     residual : str or None
@@ -59,6 +62,7 @@ class TrainConfig:
     n_timesteps: int
     n_envs: int
     load_case: int | str = "random"
+    mesh: str = "converged"
     param_noise: float = 0.0
     residual: str | None = None
     shaping: float | None = None
@@ -79,9 +83,12 @@ class TrainConfig:
         if isinstance(self.load_case, bool) or self.load_case not in LOAD_CASES:
             raise ValueError(f"load_case must be one of {list(LOAD_CASES)}, "
                              f"got {self.load_case!r}")
-        if not (isinstance(self.param_noise, (int, float)) and self.param_noise >= 0):
-            raise ValueError(f"param_noise must be a non-negative number, "
-                             f"got {self.param_noise!r}")
+        if self.mesh not in MESHES:
+            raise ValueError(f"mesh must be one of {list(MESHES)}, got {self.mesh!r}")
+        if not (isinstance(self.param_noise, (int, float)) and not isinstance(
+                self.param_noise, bool) and 0 <= self.param_noise <= PARAM_NOISE_MAX[self.mesh]):
+            raise ValueError(f"param_noise must be a number in [0, {PARAM_NOISE_MAX[self.mesh]}] "
+                             f"for mesh {self.mesh!r}, got {self.param_noise!r}")
         if self.residual not in RESIDUALS:
             raise ValueError(f"residual must be one of {list(RESIDUALS)}, got {self.residual!r}")
         if self.shaping is not None and not (isinstance(self.shaping, (int, float))
@@ -99,6 +106,19 @@ class TrainConfig:
                                  f"voltage's), got residual {self.residual!r}")
         if "policy" not in self.model:
             raise ValueError("model must name the SB3 policy (e.g. policy: MlpPolicy)")
+
+    @property
+    def teacher(self) -> str | None:
+        """The teacher the actor imitates before RL (``distill.teacher``), or None."""
+        return None if self.distill is None else self.distill_config.teacher
+
+    @property
+    def training(self) -> str:
+        """The label of the agents in every table: ``"from scratch"`` or
+        ``"DAgger from MPC + RL"``."""
+        if self.teacher is None:
+            return "from scratch"
+        return f"DAgger from {self.teacher.upper()} + RL"
 
     @property
     def gamma(self) -> float:
@@ -149,3 +169,13 @@ def load_config(algo: str, path: str | Path | None = None) -> TrainConfig:
     if missing:
         raise ValueError(f"{path}: missing key(s) {missing}")
     return TrainConfig(algo=algo, **data)
+
+
+def algo_class(algo: str):
+    """The stable-baselines3 class of ``algo`` (:data:`ALGOS`)."""
+    from stable_baselines3 import PPO, SAC
+
+    classes = {"ppo": PPO, "sac": SAC}
+    if algo not in classes:
+        raise ValueError(f"algo must be one of {list(classes)}, got {algo!r}")
+    return classes[algo]

@@ -1,16 +1,16 @@
 """``python -m train.ship RUN NAME``: copy a training run's best checkpoint into
-``train/agents/NAME/`` (``model.zip``, ``vecnormalize.pkl``, ``learning_curve.csv``
-and ``metadata.json`` with the command, seed and versions of the run)."""
+``train/agents/NAME/`` (``policy.npz``, ``metadata.json`` with the command, seed,
+versions, teacher and observation fingerprint of the run, and ``learning_curve.csv``)."""
 
 from __future__ import annotations
 
 import argparse
-import json
-import shutil
 import sys
 from pathlib import Path
 
-from .agent import META_FILE, MODEL_FILE, STATS_FILE
+from acld_gym.atomic import write_text
+
+from .agent import META_FILE, MODEL_FILE, POLICY_FILE, STATS_FILE, TrainedAgent
 from .compare import AGENTS_DIR
 
 __all__ = ["ship", "best_timesteps", "main"]
@@ -33,23 +33,22 @@ def best_timesteps(curve: str | Path) -> int:
 
 
 def ship(run: str | Path, name: str, agents_dir: str | Path = AGENTS_DIR) -> Path:
-    """Copy ``run``'s ``best/`` checkpoint (the ``EvalCallback`` best on the thesis
-    cases) and its records to ``agents_dir/name``; returns that directory."""
+    """Copy ``run``'s ``best/`` agent (the ``EvalCallback`` best on the thesis cases:
+    ``policy.npz`` and ``metadata.json``, nothing pickled) and its learning curve to
+    ``agents_dir/name``, atomically per file; returns that directory."""
     run = Path(run)
-    needed = [run / "best" / "best_model.zip", run / "best" / STATS_FILE, run / META_FILE,
-              run / "learning_curve.csv"]
+    needed = [run / "best" / POLICY_FILE, run / "best" / META_FILE, run / "learning_curve.csv"]
     for f in needed:
         if not f.is_file():
             raise FileNotFoundError(f"run directory {str(run)!r} lacks {f.relative_to(run)}")
+    agent = TrainedAgent.load(run / "best", check=False)
+    agent.metadata["checkpoint"] = "best on the thesis cases (EvalCallback)"
+    agent.metadata["best_timesteps"] = best_timesteps(needed[2])
     dst = Path(agents_dir) / name
-    dst.mkdir(parents=True, exist_ok=True)
-    shutil.copy(needed[0], dst / MODEL_FILE)
-    shutil.copy(needed[1], dst / STATS_FILE)
-    shutil.copy(needed[3], dst / "learning_curve.csv")
-    meta = json.loads(needed[2].read_text())
-    meta["checkpoint"] = "best on the thesis cases (EvalCallback)"
-    meta["best_timesteps"] = best_timesteps(needed[3])
-    (dst / META_FILE).write_text(json.dumps(meta, indent=2) + "\n")
+    agent.save(dst)
+    write_text(dst / "learning_curve.csv", needed[2].read_text())
+    for stale in (MODEL_FILE, STATS_FILE):  # pickled files of an older format
+        (dst / stale).unlink(missing_ok=True)
     return dst
 
 

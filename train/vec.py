@@ -13,10 +13,11 @@ import numpy as np
 from gymnasium import spaces
 from stable_baselines3.common.vec_env import VecEnv, VecEnvWrapper, VecNormalize
 
+from acld_gym.control import discrete_lqr_gain
 from acld_gym.env import nominal
 from acld_gym.sb3 import SB3VecEnv
 from acld_gym.thesis import V_LIMIT
-from baselines.policies import LQRPolicy, discrete_lqr_gain
+from baselines.policies import LQRPolicy
 
 __all__ = ["VoltageMap", "VecAgentEnv", "lq_potential", "make_vec_env"]
 
@@ -35,11 +36,11 @@ class VoltageMap:
     agent (:class:`train.agent.TrainedAgent`).
     """
 
-    def __init__(self, residual: str | None = None):
+    def __init__(self, residual: str | None = None, mesh: str = "converged"):
         if residual not in (None, "lqr"):
             raise ValueError(f"residual must be None or 'lqr', got {residual!r}")
         self.residual = residual
-        self._lqr = LQRPolicy() if residual == "lqr" else None
+        self._lqr = LQRPolicy(mesh=mesh) if residual == "lqr" else None
 
     def __call__(self, action: np.ndarray, obs: np.ndarray) -> np.ndarray:
         """Volts, shape (n, 1), for actions (n, 1) and raw observations (n, 7)."""
@@ -50,8 +51,10 @@ class VoltageMap:
         return (V_LIMIT * a).astype(np.float32)
 
 
-def lq_potential(gamma: float, lam: float, y_ref: float = 1e-3, dt: float = 1e-3) -> np.ndarray:
-    r"""Matrix P of the shaping potential :math:`\Phi(z) = -z^T P z`, z = obs[:6].
+def lq_potential(gamma: float, lam: float, y_ref: float = 1e-3, dt: float = 1e-3,
+                 mesh: str = "converged") -> np.ndarray:
+    r"""Matrix P of the shaping potential :math:`\Phi(z) = -z^T P z`, z = the observation's
+    reduced-state part.
 
     P is the value of the discounted LQ problem with the env's reward weights on
     the nominal reduced model, :math:`\min \sum_k \gamma^k ((y_k/y_\mathrm{ref})^2
@@ -59,7 +62,7 @@ def lq_potential(gamma: float, lam: float, y_ref: float = 1e-3, dt: float = 1e-3
     :math:`(\sqrt\gamma A_d, \sqrt\gamma B_d)`, solved in the observation's scaled
     coordinates (entries of order one instead of 1e-6 .. 1e4).
     """
-    nom = nominal(dt)
+    nom = nominal(dt, mesh=mesh)
     sr, C = nom.reduced, nom.design.reduced.C
     S = np.diag(nom.xr_scale)
     Si = np.diag(1.0 / nom.xr_scale)
@@ -76,7 +79,7 @@ class VecAgentEnv(VecEnvWrapper):
 
     .. math:: r' = r + \gamma \Phi(s') - \Phi(s), \qquad \Phi(z) = -z^T P z,
 
-    with P from :func:`lq_potential` and z the observer's estimate (``obs[:6]``).
+    with P from :func:`lq_potential` and z the observer's estimate (``obs[:-1]``).
     With the algorithm's own :math:`\gamma` shaping leaves the optimal policy
     unchanged; it gives each action immediate credit for the vibration energy it
     removes. At an episode's end s' is the terminal observation. One class for
@@ -84,11 +87,11 @@ class VecAgentEnv(VecEnvWrapper):
     are synchronized level by level)."""
 
     def __init__(self, venv: VecEnv, residual: str | None = None, gamma: float = 0.99,
-                 shaping: float | None = None):
+                 shaping: float | None = None, mesh: str = "converged"):
         super().__init__(venv, action_space=spaces.Box(-1.0, 1.0, (1,), np.float32))
-        self.map = VoltageMap(residual)
+        self.map = VoltageMap(residual, mesh)
         self.gamma = float(gamma)
-        self.P = None if shaping is None else lq_potential(self.gamma, shaping)
+        self.P = None if shaping is None else lq_potential(self.gamma, shaping, mesh=mesh)
         self._obs: np.ndarray | None = None
 
     def potential(self, obs: np.ndarray) -> np.ndarray:
@@ -123,17 +126,17 @@ def make_vec_env(cfg, seed: int, n_envs: int | None = None, backend: str = "nati
     """
     n = cfg.n_envs if n_envs is None else n_envs
     kw = dict(load_case=cfg.load_case if load_case is None else load_case,
-              param_noise=cfg.param_noise)
+              param_noise=cfg.param_noise, mesh=cfg.mesh)
     if backend == "native":
         venv: VecEnv = SB3VecEnv(num_envs=n, **kw)
     elif backend == "subproc":
         from stable_baselines3.common.env_util import make_vec_env as sb3_make_vec_env
         from stable_baselines3.common.vec_env import SubprocVecEnv
 
-        venv = sb3_make_vec_env("acld_gym:ACLDBeam-v0", n_envs=n, env_kwargs=kw,
+        venv = sb3_make_vec_env("acld_gym:ACLDBeam-v1", n_envs=n, env_kwargs=kw,
                                 vec_env_cls=SubprocVecEnv)
     else:
         raise ValueError(f"backend must be 'native' or 'subproc', got {backend!r}")
     venv.seed(seed)
-    venv = VecAgentEnv(venv, cfg.residual, cfg.gamma, cfg.shaping)
+    venv = VecAgentEnv(venv, cfg.residual, cfg.gamma, cfg.shaping, mesh=cfg.mesh)
     return VecNormalize(venv, gamma=cfg.gamma, **cfg.normalize)

@@ -17,7 +17,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import IO, Any
 
-__all__ = ["write_atomic", "write_text", "write_json", "check_writable"]
+__all__ = ["write_atomic", "write_text", "write_json", "check_writable", "check_directory",
+           "save_figure"]
 
 
 def write_atomic(path: str | Path, write: Callable[[IO[bytes]], Any]) -> Path:
@@ -62,6 +63,12 @@ def check_writable(path: str | Path, what: str = "output") -> Path:
     if path.is_dir():
         raise ValueError(f"{what}: {str(path)!r} is a directory, expected a file path")
     parent = path.parent
+    for p in (parent, *parent.parents):
+        if p.exists():
+            if not p.is_dir():
+                raise ValueError(f"{what}: cannot write {str(path)!r} ({str(p)!r} is not a "
+                                 "directory)")
+            break
     try:
         parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=parent, prefix=f".{path.name}.", suffix=".probe")
@@ -70,3 +77,19 @@ def check_writable(path: str | Path, what: str = "output") -> Path:
     except OSError as exc:
         raise ValueError(f"{what}: cannot write {str(path)!r} ({exc.strerror or exc})") from None
     return path
+
+
+def check_directory(path: str | Path, what: str = "output directory") -> Path:
+    """``ValueError`` naming ``what`` unless ``path`` is (or can be made) a directory that
+    accepts files; call it before computing anything."""
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise ValueError(f"{what}: {str(path)!r} exists and is not a directory")
+    return check_writable(path / "probe", what).parent
+
+
+def save_figure(fig, path: str | Path, **kwargs) -> Path:
+    """``fig.savefig`` to ``path`` atomically (the format from the file's suffix)."""
+    path = Path(path)
+    fmt = path.suffix.lstrip(".") or "png"
+    return write_atomic(path, lambda fh: fig.savefig(fh, format=fmt, **kwargs))

@@ -15,8 +15,9 @@ import numbers
 
 import numpy as np
 
-__all__ = ["check_real", "check_int", "check_choice", "check_seed", "check_actions",
-           "check_episode_size", "ENV_RANGES", "MAX_EPISODE_STEPS", "MAX_TABLE_STEPS"]
+__all__ = ["check_real", "check_int", "check_choice", "check_seed", "check_actions", "arg_type",
+           "check_episode_size", "closed_pipe_is_fine", "run_main", "ENV_RANGES",
+           "MAX_EPISODE_STEPS", "MAX_TABLE_STEPS"]
 
 #: Accepted ranges of the env's numeric arguments: (low, high, unit, why).
 ENV_RANGES: dict[str, tuple[float, float, str, str]] = {
@@ -115,3 +116,48 @@ def check_actions(action, n: int, v_max: float, vector: bool = False):
     if not np.isfinite(a).all():
         raise ValueError(f"action must be finite, got {a[~np.isfinite(a)][0]!r}")
     return a, np.clip(a, -v_max, v_max)
+
+
+def arg_type(kind: type, low=None, high=None, *, low_open: bool = False):
+    """An argparse ``type=`` that parses ``kind`` (int or float) and applies
+    :func:`check_int` / :func:`check_real` with these bounds: one validation for every
+    command line of the package."""
+    import argparse
+
+    def parse(text: str):
+        try:
+            value = int(text) if kind is int else float(text)
+            if kind is int:
+                return check_int("value", value, low, high)
+            return check_real("value", value, low, high, low_open=low_open)
+        except ValueError as exc:
+            msg = str(exc).replace("value must be", "expected").split(", got")[0]
+            raise argparse.ArgumentTypeError(f"{msg}, got {text!r}") from None
+
+    return parse
+
+
+class closed_pipe_is_fine:  # noqa: N801 (a context manager used like a function)
+    """Context manager for a command's output: a reader that closes the pipe early
+    (``acld-gym params | head -1``) ends the command quietly instead of with a
+    ``BrokenPipeError`` traceback (Python's documented recipe: point stdout at devnull)."""
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, exc, tb) -> bool:
+        if kind is not None and issubclass(kind, BrokenPipeError):
+            import os
+            import sys
+
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+            return True
+        return False
+
+
+def run_main(main) -> int:
+    """``main()`` with :class:`closed_pipe_is_fine` (for ``python -m`` entry points)."""
+    with closed_pipe_is_fine():
+        return main()
+    return 0

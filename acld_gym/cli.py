@@ -4,13 +4,14 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
+from .atomic import check_directory, check_writable, write_json
+from .checks import arg_type, closed_pipe_is_fine
 from .design import design
 from .loads import thesis_load
 from .metrics import peak
@@ -22,9 +23,18 @@ __all__ = ["main"]
 
 
 def _write_json(path: str, obj) -> None:
-    p = Path(path)
-    p.parent.mkdir(parents=True, exist_ok=True)
-    p.write_text(json.dumps(obj, indent=2) + "\n")
+    write_json(path, obj)
+
+
+def _check_outputs(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    """Refuse unusable ``--json`` / ``--plots`` paths before any computing (exit 2)."""
+    try:
+        if getattr(args, "json", None):
+            check_writable(args.json, "--json")
+        if getattr(args, "plots", None):
+            check_directory(args.plots, "--plots")
+    except ValueError as exc:
+        parser.error(str(exc))
 
 
 def cmd_reproduce(args: argparse.Namespace) -> int:
@@ -107,16 +117,6 @@ def cmd_params(args: argparse.Namespace) -> int:
     return 0
 
 
-def _positive_float(s: str) -> float:
-    try:
-        v = float(s)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a positive number, got {s!r}") from None
-    if not v > 0 or not np.isfinite(v):
-        raise argparse.ArgumentTypeError(f"expected a positive number, got {s!r}")
-    return v
-
-
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="acld-gym", description=__doc__)
     sub = p.add_subparsers(dest="command", required=True)
@@ -126,7 +126,8 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--preset", choices=sorted(PRESETS), default="matlab")
     r.add_argument("--observer", choices=["thesis", "thesis-unfed", "kalman"], default="thesis",
                    help="'thesis' = the thesis observer fed the tip load (reproduces Table 2)")
-    r.add_argument("--t-end", type=_positive_float, default=T_END, help="simulated window [s]")
+    r.add_argument("--t-end", type=arg_type(float, 0.0, 100.0, low_open=True), default=T_END,
+                   help="simulated window [s]")
     r.add_argument("--quiet", action="store_true", help="no progress bar")
     r.set_defaults(func=cmd_reproduce)
     m = sub.add_parser("model", help="natural frequencies, Hankel values, passive peak")
@@ -144,8 +145,12 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
-    return args.func(args)
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    _check_outputs(parser, args)
+    with closed_pipe_is_fine():
+        return args.func(args)
+    return 0  # the reader closed the pipe (acld-gym params | head -1)
 
 
 if __name__ == "__main__":

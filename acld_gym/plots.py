@@ -6,6 +6,8 @@ from pathlib import Path
 
 import matplotlib
 
+from .atomic import save_figure
+
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
@@ -31,7 +33,7 @@ def plot_response(path: Path, t, y, v, title: str, load=None) -> None:
     for a in ax:
         a.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
 
 
@@ -50,7 +52,7 @@ def plot_hankel(path: Path, d: Design) -> None:
     ax.grid(alpha=0.3, which="both")
     ax.legend()
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
 
 
@@ -71,5 +73,5 @@ def plot_frequency_response(path: Path, d: Design) -> None:
     ax[-1].set_xlabel("frequency [rad/s]")
     ax[0].set_title("Frequency response to the tip deflection (thesis Fig. 20)")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)

@@ -12,7 +12,6 @@ env's before it acts.
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import time
 from dataclasses import asdict, dataclass
@@ -20,6 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
+from acld_gym.atomic import check_directory, check_writable, save_figure, write_json
+from acld_gym.checks import arg_type
 from acld_gym.env import ACLDBeamEnv, nominal, reward_of
 from acld_gym.fingerprint import fingerprint_differences, observation_fingerprint
 from acld_gym.metrics import max_abs, peak, settling_time
@@ -201,7 +202,7 @@ def plot_episodes(episodes: dict, directory: Path) -> None:
         for a in ax:
             a.grid(alpha=0.3)
         fig.tight_layout()
-        fig.savefig(directory / f"policies_case{case}.png", dpi=110)
+        save_figure(fig, directory / f"policies_case{case}.png", dpi=110)
         plt.close(fig)
 
 
@@ -210,20 +211,26 @@ def main(argv: list[str] | None = None) -> int:
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--json", metavar="PATH", help="write the rows as JSON")
     p.add_argument("--plots", metavar="DIR", help="write one figure per case to DIR")
-    p.add_argument("--seed", type=int, default=0, help="episode seed (sensor noise)")
+    p.add_argument("--seed", type=arg_type(int, 0, 2**63 - 1), default=0,
+                   help="episode seed (sensor noise)")
     p.add_argument("--mesh", choices=MESHES, default="converged",
                    help="truth plant: the mesh-converged beam (default) or the thesis mesh")
     args = p.parse_args(argv)
+    try:  # unusable output paths fail now, before any computing
+        if args.json:
+            check_writable(args.json, "--json")
+        if args.plots:
+            check_directory(args.plots, "--plots")
+    except ValueError as exc:
+        p.error(str(exc))
     nominal(mesh=args.mesh)  # build the design once before timing anything
     episodes: dict = {}
     rows = evaluate(default_policies(args.mesh), seed=args.seed,
                     env_kwargs={"mesh": args.mesh}, episodes=episodes)
     print(format_tables(rows))
     if args.json:
-        path = Path(args.json)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(json.dumps([r.as_dict() for r in rows], indent=2) + "\n")
-        print(f"\nwrote {path}")
+        write_json(args.json, [r.as_dict() for r in rows])
+        print(f"\nwrote {args.json}")
     if args.plots:
         plot_episodes(episodes, Path(args.plots))
         print(f"wrote figures to {args.plots}/")
@@ -231,4 +238,6 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from acld_gym.checks import run_main
+
+    sys.exit(run_main(main))

@@ -1,5 +1,7 @@
 import sys
 
+from acld_gym.checks import run_main
+
 from .cli import main
 
-sys.exit(main())
+sys.exit(run_main(main))

@@ -5,6 +5,7 @@ of training and evaluation episodes, and a learning-curve CSV."""
 from __future__ import annotations
 
 import csv
+import io
 from pathlib import Path
 
 import gymnasium as gym
@@ -13,6 +14,7 @@ from stable_baselines3.common.callbacks import BaseCallback, EvalCallback
 from stable_baselines3.common.monitor import Monitor
 from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
 
+from acld_gym.atomic import write_text
 from acld_gym.env import ACLDBeamEnv
 
 from .vec import VecAgentEnv
@@ -148,25 +150,26 @@ class PhysicsRolloutLogger(BaseCallback):
 
 class EvalPhysicsLogger(BaseCallback):
     """``callback_after_eval``: logs each thesis case's metrics of the evaluation just
-    run (``eval/case{c}/...``) and appends them to ``csv_path`` (the learning curve)."""
+    run (``eval/case{c}/...``) and rewrites ``csv_path`` (the learning curve) with them,
+    atomically: a reader never sees a half-written curve."""
 
     def __init__(self, csv_path: str | Path):
         super().__init__()
         self.csv_path = Path(csv_path)
+        self._rows: list[dict] = []
 
     def _on_step(self) -> bool:
         eval_env = self.parent.eval_env
-        rows = [m for m in eval_env.get_attr("last_metrics") if m is not None]
-        new = not self.csv_path.exists()
-        with self.csv_path.open("a", newline="") as fh:
-            writer = csv.DictWriter(fh, fieldnames=CURVE_FIELDS)
-            if new:
-                writer.writeheader()
-            for m in rows:
-                for key in CURVE_FIELDS[2:]:
-                    self.logger.record(f"eval/case{m['case']}/{key}", m[key])
-                writer.writerow({"timesteps": self.num_timesteps,
-                                 **{k: m[k] for k in CURVE_FIELDS[1:]}})
+        for m in (m for m in eval_env.get_attr("last_metrics") if m is not None):
+            for key in CURVE_FIELDS[2:]:
+                self.logger.record(f"eval/case{m['case']}/{key}", m[key])
+            self._rows.append({"timesteps": self.num_timesteps,
+                               **{k: m[k] for k in CURVE_FIELDS[1:]}})
+        buf = io.StringIO()
+        writer = csv.DictWriter(buf, fieldnames=CURVE_FIELDS, lineterminator="\n")
+        writer.writeheader()
+        writer.writerows(self._rows)
+        write_text(self.csv_path, buf.getvalue())
         return True
 
 

@@ -21,6 +21,10 @@ import sys
 import time
 from pathlib import Path
 
+from acld_gym.atomic import check_writable
+from acld_gym.checks import arg_type
+from acld_gym.env import PARAM_NOISE_MAX
+
 from .config import ALGOS, TrainConfig, algo_class, load_config
 
 __all__ = ["main", "train", "make_model", "versions", "parse_load_case"]
@@ -142,24 +146,11 @@ def parse_load_case(text: str):
     raise argparse.ArgumentTypeError(f"expected 1, 2, 3 or random, got {text!r}")
 
 
-def _bounded(kind: type, minimum, what: str):
-    """argparse ``type=``: ``kind(text)`` at least ``minimum``, else a message with ``what``."""
-
-    def parse(text: str):
-        try:
-            value = kind(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected {what}, got {text!r}") from None
-        if not value >= minimum:  # also rejects NaN
-            raise argparse.ArgumentTypeError(f"expected {what}, got {text!r}")
-        return value
-
-    return parse
-
-
-_positive_int = _bounded(int, 1, "a positive integer")
-_non_negative_int = _bounded(int, 0, "an integer >= 0")
-_non_negative_float = _bounded(float, 0.0, "a number >= 0")
+#: Seeds: numpy's legacy seeding (used by SB3) takes integers below 2**32.
+MAX_SEED = 2**32 - 1
+_positive_int = arg_type(int, 1, 10**12)
+_seed = arg_type(int, 0, MAX_SEED)
+_param_noise = arg_type(float, 0.0, max(PARAM_NOISE_MAX.values()))
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -170,10 +161,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="training loads: 1, 2, 3 or random (default: the config's)")
     p.add_argument("--timesteps", type=_positive_int, default=None,
                    help="env steps in total (default: the config's n_timesteps)")
-    p.add_argument("--seed", type=_non_negative_int, default=0, help="seed (default 0)")
+    p.add_argument("--seed", type=_seed, default=0, help=f"seed in [0, {MAX_SEED}] (default 0)")
     p.add_argument("--n-envs", type=_positive_int, default=None,
                    help="sub-envs of the batched env (default: the config's)")
-    p.add_argument("--param-noise", type=_non_negative_float, default=None,
+    p.add_argument("--param-noise", type=_param_noise, default=None,
                    help="per-episode parameter randomization (default: the config's)")
     p.add_argument("--config", metavar="YAML", default=None,
                    help="hyperparameter file (default: train/<algo>.yaml)")
@@ -195,6 +186,12 @@ def main(argv: list[str] | None = None) -> int:
     except (OSError, ValueError) as exc:
         parser.error(str(exc))  # exit status 2, no traceback
     out = Path(args.out or f"runs/{cfg.algo}-{cfg.load_case}-s{args.seed}")
+    if out.exists() and not out.is_dir():
+        parser.error(f"--out: {str(out)!r} exists and is not a directory")
+    try:  # before any training: an unusable --out fails now, not after the run
+        check_writable(out / "metadata.json", "--out")
+    except ValueError as exc:
+        parser.error(str(exc))
     command = "python -m train " + " ".join(shlex.quote(a) for a in
                                             (sys.argv[1:] if argv is None else argv))
     print(f"training {cfg.algo.upper()} {cfg.training}: "

@@ -21,7 +21,8 @@ import json
 import sys
 from pathlib import Path
 
-from acld_gym.atomic import write_json, write_text
+from acld_gym.atomic import check_directory, check_writable, save_figure, write_json, write_text
+from acld_gym.checks import arg_type
 from acld_gym.plant import MESHES
 from baselines.evaluate import (
     EvalRow,
@@ -151,7 +152,7 @@ def plot_learning_curves(agents: dict, directory: Path) -> Path | None:
     fig.tight_layout()
     directory.mkdir(parents=True, exist_ok=True)
     out = directory / "learning_curves.png"
-    fig.savefig(out, dpi=110)
+    save_figure(fig, out, dpi=110)
     plt.close(fig)
     return out
 
@@ -166,11 +167,12 @@ def build_parser() -> argparse.ArgumentParser:
                    help="directory of agent directories (default: the shipped train/agents)")
     p.add_argument("--only", metavar="NAME", nargs="*", default=(),
                    help="these agents only (default: every agent trained on --mesh)")
-    p.add_argument("--random-episodes", type=int, default=len(HELDOUT_SEEDS),
+    p.add_argument("--random-episodes", type=arg_type(int, 0, 1000), default=len(HELDOUT_SEEDS),
                    help="held-out random-load episodes (default 20; 0 for none)")
-    p.add_argument("--param-noise", type=float, default=0.0,
+    p.add_argument("--param-noise", type=arg_type(float, 0.0, 0.1), default=0.0,
                    help="per-episode parameter randomization of the plant (default 0)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the thesis-case episodes")
+    p.add_argument("--seed", type=arg_type(int, 0, 2**63 - 1), default=0,
+                   help="seed of the thesis-case episodes")
     p.add_argument("--mesh", choices=MESHES, default="converged",
                    help="truth plant (default: the converged beam); the agents trained on it")
     return p
@@ -179,10 +181,14 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    if args.random_episodes < 0 or args.random_episodes > 1000:
-        parser.error(f"--random-episodes must be in 0..1000, got {args.random_episodes}")
-    if not args.param_noise >= 0:
-        parser.error(f"--param-noise must be >= 0, got {args.param_noise}")
+    try:  # unusable output paths fail now, before any computing
+        for flag, path in (("--json", args.json), ("--markdown", args.markdown)):
+            if path:
+                check_writable(path, flag)
+        if args.plots:
+            check_directory(args.plots, "--plots")
+    except ValueError as exc:
+        parser.error(str(exc))
     try:
         names = None if not args.only else args.only
         agents = load_agents(args.agents, names, mesh=args.mesh)
@@ -200,15 +206,11 @@ def main(argv: list[str] | None = None) -> int:
           "held-out random-load episodes")
     print(format_tables(rows))
     if args.json:
-        path = Path(args.json)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        write_json(path, relative(rows, labels))
-        print(f"\nwrote {path}")
+        write_json(args.json, relative(rows, labels))
+        print(f"\nwrote {args.json}")
     if args.markdown:
-        path = Path(args.markdown)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        write_text(path, markdown_table(relative(rows, labels)) + "\n")
-        print(f"wrote {path}")
+        write_text(args.markdown, markdown_table(relative(rows, labels)) + "\n")
+        print(f"wrote {args.markdown}")
     if args.plots:
         plot_episodes(episodes, Path(args.plots))
         plot_learning_curves(agents, Path(args.plots))
@@ -217,4 +219,6 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from acld_gym.checks import run_main
+
+    sys.exit(run_main(main))

@@ -9,6 +9,7 @@ from typing import Any
 
 import yaml
 
+from acld_gym.checks import check_int, check_real
 from acld_gym.env import LOAD_CASES, PARAM_NOISE_MAX
 from acld_gym.plant import MESHES
 
@@ -77,23 +78,17 @@ class TrainConfig:
         if self.algo not in ALGOS:
             raise ValueError(f"algo must be one of {list(ALGOS)}, got {self.algo!r}")
         for name in ("n_timesteps", "n_envs", "eval_freq", "checkpoint_freq"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise ValueError(f"{name} must be a positive integer, got {value!r}")
+            check_int(name, getattr(self, name), 1, 10**12)
         if isinstance(self.load_case, bool) or self.load_case not in LOAD_CASES:
             raise ValueError(f"load_case must be one of {list(LOAD_CASES)}, "
                              f"got {self.load_case!r}")
         if self.mesh not in MESHES:
             raise ValueError(f"mesh must be one of {list(MESHES)}, got {self.mesh!r}")
-        if not (isinstance(self.param_noise, (int, float)) and not isinstance(
-                self.param_noise, bool) and 0 <= self.param_noise <= PARAM_NOISE_MAX[self.mesh]):
-            raise ValueError(f"param_noise must be a number in [0, {PARAM_NOISE_MAX[self.mesh]}] "
-                             f"for mesh {self.mesh!r}, got {self.param_noise!r}")
+        check_real("param_noise", self.param_noise, 0.0, PARAM_NOISE_MAX[self.mesh])
         if self.residual not in RESIDUALS:
             raise ValueError(f"residual must be one of {list(RESIDUALS)}, got {self.residual!r}")
-        if self.shaping is not None and not (isinstance(self.shaping, (int, float))
-                                             and self.shaping > 0):
-            raise ValueError(f"shaping must be a positive number or null, got {self.shaping!r}")
+        if self.shaping is not None:
+            check_real("shaping", self.shaping, 0.0, 1e6, low_open=True)
         if self.features is not None and self.features not in FEATURE_NAMES:
             raise ValueError(f"features must be one of {list(FEATURE_NAMES)} or null, "
                              f"got {self.features!r}")
@@ -104,8 +99,20 @@ class TrainConfig:
             if self.residual is not None:
                 raise ValueError("distill needs residual: null (the action's sign is the "
                                  f"voltage's), got residual {self.residual!r}")
-        if "policy" not in self.model:
+        if not isinstance(self.model, dict) or "policy" not in self.model:
             raise ValueError("model must name the SB3 policy (e.g. policy: MlpPolicy)")
+        check_model_kwargs(self.algo, self.model)
+        if not isinstance(self.normalize, dict):
+            raise ValueError(f"normalize must be a mapping, got {self.normalize!r}")
+        import inspect
+
+        from stable_baselines3.common.vec_env import VecNormalize
+
+        allowed = set(inspect.signature(VecNormalize).parameters) - {"venv", "gamma"}
+        bad = sorted(set(self.normalize) - allowed)
+        if bad:
+            raise ValueError(f"normalize: unknown key(s) {bad}; expected some of "
+                             f"{sorted(allowed)}")
 
     @property
     def teacher(self) -> str | None:
@@ -153,12 +160,40 @@ def config_path(algo: str) -> Path:
     return _HERE / f"{algo}.yaml"
 
 
+def check_model_kwargs(algo: str, model: dict) -> None:
+    """``ValueError`` naming a key of ``model`` that ``algo``'s class does not take, or a
+    number given as something else (``learning_rate: fast``), before anything runs."""
+    import inspect
+
+    sig = inspect.signature(algo_class(algo))
+    params = sig.parameters
+    unknown = sorted(k for k in model if k not in params)
+    if unknown:
+        raise ValueError(f"model: unknown key(s) {unknown} for {algo.upper()}; expected some "
+                         f"of {sorted(k for k in params if k not in ('env', 'self'))}")
+    for key, value in model.items():
+        default = params[key].default
+        if isinstance(default, bool) or default is None or key == "policy":
+            continue
+        if isinstance(default, (int, float)) and not isinstance(value, bool):
+            if isinstance(default, int) and key not in ("learning_rate", "clip_range"):
+                check_int(f"model.{key}", value, 0 if key == "seed" else 1)
+            else:
+                check_real(f"model.{key}", value, 0.0)
+
+
 def load_config(algo: str, path: str | Path | None = None) -> TrainConfig:
-    """Read and validate ``algo``'s hyperparameters (``path`` or the shipped file)."""
+    """Read and validate ``algo``'s hyperparameters (``path`` or the shipped file);
+    ``ValueError`` (naming the file and the key) on a malformed file or a bad value."""
     path = config_path(algo) if path is None else Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"config file {str(path)!r} does not exist")
-    data = yaml.safe_load(path.read_text()) or {}
+    try:
+        data = yaml.safe_load(path.read_text()) or {}
+    except yaml.YAMLError as exc:
+        where = getattr(exc, "problem_mark", None)
+        at = f" (line {where.line + 1}, column {where.column + 1})" if where else ""
+        raise ValueError(f"{path}: not valid YAML{at}: {getattr(exc, 'problem', exc)}") from None
     if not isinstance(data, dict):
         raise ValueError(f"{path}: expected a mapping of hyperparameters")
     known = set(TrainConfig.__dataclass_fields__) - {"algo"}
@@ -168,7 +203,10 @@ def load_config(algo: str, path: str | Path | None = None) -> TrainConfig:
     missing = sorted({"n_timesteps", "n_envs"} - set(data))
     if missing:
         raise ValueError(f"{path}: missing key(s) {missing}")
-    return TrainConfig(algo=algo, **data)
+    try:
+        return TrainConfig(algo=algo, **data)
+    except ValueError as exc:
+        raise ValueError(f"{path}: {exc}") from None
 
 
 def algo_class(algo: str):

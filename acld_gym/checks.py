@@ -157,7 +157,10 @@ class closed_pipe_is_fine:  # noqa: N801 (a context manager used like a function
 
 
 def run_main(main) -> int:
-    """``main()`` with :class:`closed_pipe_is_fine` (for ``python -m`` entry points)."""
-    with closed_pipe_is_fine():
+    """``main()`` for a ``python -m`` entry point: one BLAS thread
+    (:mod:`acld_gym.blas`) and a quiet end when the reader closes the pipe."""
+    from .blas import one_blas_thread
+
+    with closed_pipe_is_fine(), one_blas_thread():
         return main()
     return 0

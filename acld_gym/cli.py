@@ -11,11 +11,13 @@ from pathlib import Path
 import numpy as np
 
 from .atomic import check_directory, check_writable, write_json
+from .blas import one_blas_thread
 from .checks import arg_type, closed_pipe_is_fine
 from .design import design
 from .loads import thesis_load
 from .metrics import peak
 from .params import PRESETS
+from .progress import Progress
 from .reproduce import T_END, format_table2, run_cases
 from .simulate import simulate
 
@@ -38,8 +40,6 @@ def _check_outputs(parser: argparse.ArgumentParser, args: argparse.Namespace) ->
 
 
 def cmd_reproduce(args: argparse.Namespace) -> int:
-    from tqdm import tqdm
-
     t0 = time.perf_counter()
     d = design(preset=args.preset)
     plots = Path(args.plots) if args.plots else None
@@ -49,11 +49,11 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
         plots.mkdir(parents=True, exist_ok=True)
         plot_hankel(plots / "hankel_singular_values.png", d)
         plot_frequency_response(plots / "frequency_response.png", d)
-    bar = tqdm(total=18, desc="simulating", unit="run", file=sys.stderr,
-               disable=args.quiet or None)
+    bar = Progress(18, "reproduce", args.quiet)
 
     def on_result(row, res):
-        bar.update(1)
+        bar.stage(f"case {row.case} · {row.controller} · "
+                  f"{'saturated' if row.saturation else 'unsaturated'}")
         if plots is not None:
             sat = "sat" if row.saturation else "nosat"
             title = (f"Case {row.case}: {row.controller.upper()} "
@@ -148,7 +148,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     _check_outputs(parser, args)
-    with closed_pipe_is_fine():
+    with closed_pipe_is_fine(), one_blas_thread():
         return args.func(args)
     return 0  # the reader closed the pipe (acld-gym params | head -1)
 

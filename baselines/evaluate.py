@@ -20,11 +20,13 @@ from pathlib import Path
 import numpy as np
 
 from acld_gym.atomic import check_directory, check_writable, save_figure, write_json
+from acld_gym.blas import one_blas_thread
 from acld_gym.checks import arg_type
 from acld_gym.env import ACLDBeamEnv, nominal, reward_of
 from acld_gym.fingerprint import fingerprint_differences, observation_fingerprint
 from acld_gym.metrics import max_abs, peak, settling_time
 from acld_gym.plant import MESHES
+from acld_gym.progress import Progress
 
 __all__ = ["EvalRow", "Episode", "rollout", "check_compatible", "bound_episode", "episode_rows",
            "evaluate", "default_policies",
@@ -100,7 +102,8 @@ def bound_episode(env: ACLDBeamEnv) -> Episode:
 
     env = env.unwrapped
     t0 = time.perf_counter()
-    sol = clairvoyant_bound(env.episode_plant, env.nom.output, env.load, env.max_steps)
+    with one_blas_thread():  # small dense problems (acld_gym.blas)
+        sol = clairvoyant_bound(env.episode_plant, env.nom.output, env.load, env.max_steps)
     spent = time.perf_counter() - t0
     t = np.arange(1, env.max_steps + 1) * env.dt
     reward = reward_of(sol.y, sol.voltage, env.y_ref, env.lam, env.v_max)
@@ -124,16 +127,22 @@ def default_policies(mesh: str = "converged", dt: float = 1e-3) -> dict:
 
 
 def episode_rows(policies: dict, case, seed: int = 0, env_kwargs: dict | None = None,
-                 episodes: dict | None = None) -> list[EvalRow]:
+                 episodes: dict | None = None, progress: Progress | None = None,
+                 episode: str = "") -> list[EvalRow]:
     """One episode of ``case`` (seeded: load, parameters, sensor noise) per policy, plus
-    the clairvoyant bound for the same load and plant; fills ``episodes`` if given."""
+    the clairvoyant bound for the same load and plant; fills ``episodes`` if given and
+    reports each policy's episode to ``progress`` (labelled with ``episode``)."""
     env = ACLDBeamEnv(load_case=case, **(env_kwargs or {}))
     rows = []
     for name, pol in policies.items():
+        if progress is not None:
+            progress.stage(f"case {case} · {name}{episode}")
         ep = rollout(pol, env, seed=seed)
         rows.append(metrics_row(case, name, ep))
         if episodes is not None:
             episodes[case, name] = ep
+    if progress is not None:
+        progress.stage(f"case {case} · bound{episode}")
     env.reset(seed=seed)
     ep = bound_episode(env)
     rows.append(metrics_row(case, "bound", ep))
@@ -143,12 +152,15 @@ def episode_rows(policies: dict, case, seed: int = 0, env_kwargs: dict | None = 
 
 
 def evaluate(policies: dict | None = None, cases=(1, 2, 3), seed: int = 0,
-             env_kwargs: dict | None = None, episodes: dict | None = None) -> list[EvalRow]:
-    """Rows for every (case, policy) plus the bound; fills ``episodes`` if given."""
+             env_kwargs: dict | None = None, episodes: dict | None = None,
+             quiet: bool = True) -> list[EvalRow]:
+    """Rows for every (case, policy) plus the bound; fills ``episodes`` if given; a
+    progress line on a terminal unless ``quiet``."""
     if policies is None:
         policies = default_policies((env_kwargs or {}).get("mesh", "converged"))
-    return [row for case in cases
-            for row in episode_rows(policies, case, seed, env_kwargs, episodes)]
+    with Progress(len(cases) * (len(policies) + 1), "evaluate", quiet) as progress:
+        return [row for case in cases
+                for row in episode_rows(policies, case, seed, env_kwargs, episodes, progress)]
 
 
 def mean_rows(rows: list[EvalRow], case) -> list[EvalRow]:
@@ -215,6 +227,7 @@ def main(argv: list[str] | None = None) -> int:
                    help="episode seed (sensor noise)")
     p.add_argument("--mesh", choices=MESHES, default="converged",
                    help="truth plant: the mesh-converged beam (default) or the thesis mesh")
+    p.add_argument("--quiet", action="store_true", help="no progress line")
     args = p.parse_args(argv)
     try:  # unusable output paths fail now, before any computing
         if args.json:
@@ -226,7 +239,7 @@ def main(argv: list[str] | None = None) -> int:
     nominal(mesh=args.mesh)  # build the design once before timing anything
     episodes: dict = {}
     rows = evaluate(default_policies(args.mesh), seed=args.seed,
-                    env_kwargs={"mesh": args.mesh}, episodes=episodes)
+                    env_kwargs={"mesh": args.mesh}, episodes=episodes, quiet=args.quiet)
     print(format_tables(rows))
     if args.json:
         write_json(args.json, [r.as_dict() for r in rows])

@@ -111,8 +111,9 @@ def export_run(out: Path, cfg: TrainConfig, meta: dict, model=None, venv=None) -
     if the ``EvalCallback`` saved one, for the best checkpoint in ``out/best``. ``meta``
     gets the env and its observation fingerprint. ``model``/``venv`` default to the run's
     own ``model.zip``/``vecnormalize.pkl`` (written by this package: trusted)."""
+    import pickle
+
     import gymnasium as gym
-    from stable_baselines3.common.vec_env import VecNormalize
 
     from acld_gym.fingerprint import observation_fingerprint
 
@@ -124,7 +125,10 @@ def export_run(out: Path, cfg: TrainConfig, meta: dict, model=None, venv=None) -
     probe.close()
 
     def stats(path: Path):
-        return VecNormalize.load(str(path), None) if path.is_file() else None
+        if not path.is_file():
+            return None
+        with path.open("rb") as fh:  # this run's own file (trusted); SB3's format
+            return pickle.load(fh)
 
     if model is None:
         model = algo_class(cfg.algo).load(str(out / MODEL_FILE), device="cpu")

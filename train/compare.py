@@ -24,6 +24,7 @@ from pathlib import Path
 from acld_gym.atomic import check_directory, check_writable, save_figure, write_json, write_text
 from acld_gym.checks import arg_type
 from acld_gym.plant import MESHES
+from acld_gym.progress import Progress
 from baselines.evaluate import (
     EvalRow,
     default_policies,
@@ -78,13 +79,21 @@ def training_labels(policies: dict) -> dict[str, str]:
 
 
 def compare(policies: dict, cases=(1, 2, 3), random_seeds=HELDOUT_SEEDS, seed: int = 0,
-            env_kwargs: dict | None = None, episodes: dict | None = None) -> list[EvalRow]:
+            env_kwargs: dict | None = None, episodes: dict | None = None,
+            quiet: bool = True) -> list[EvalRow]:
     """Rows per thesis case (episode ``seed``) and the mean over the held-out random
-    episodes (``case="random"``); every policy sees the same episodes."""
-    rows = [r for case in cases for r in episode_rows(policies, case, seed, env_kwargs, episodes)]
-    if random_seeds:
-        held = [r for s in random_seeds for r in episode_rows(policies, "random", s, env_kwargs)]
-        rows += mean_rows(held, "random")
+    episodes (``case="random"``); every policy sees the same episodes. A progress line
+    on a terminal unless ``quiet``."""
+    stages = (len(cases) + len(random_seeds)) * (len(policies) + 1)
+    with Progress(stages, "compare", quiet) as progress:
+        rows = [r for case in cases
+                for r in episode_rows(policies, case, seed, env_kwargs, episodes, progress)]
+        if random_seeds:
+            n = len(random_seeds)
+            held = [r for k, s in enumerate(random_seeds)
+                    for r in episode_rows(policies, "random", s, env_kwargs, progress=progress,
+                                          episode=f" · episode {k + 1}/{n}")]
+            rows += mean_rows(held, "random")
     return rows
 
 
@@ -175,6 +184,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="seed of the thesis-case episodes")
     p.add_argument("--mesh", choices=MESHES, default="converged",
                    help="truth plant (default: the converged beam); the agents trained on it")
+    p.add_argument("--quiet", action="store_true", help="no progress line")
     return p
 
 
@@ -199,7 +209,7 @@ def main(argv: list[str] | None = None) -> int:
     episodes: dict = {}
     rows = compare(policies, random_seeds=seeds, seed=args.seed,
                    env_kwargs={"param_noise": args.param_noise, "mesh": args.mesh},
-                   episodes=episodes)
+                   episodes=episodes, quiet=args.quiet)
     labels = training_labels(policies)
     title = f" (param_noise = {args.param_noise})" if args.param_noise else ""
     print(f"Agents vs reference policies{title}; 'random' = mean over {len(seeds)} "

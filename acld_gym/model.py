@@ -124,6 +124,14 @@ class BeamModel:
         w2 = sla.eigh(self.K, self.M, eigvals_only=True)
         return np.sqrt(np.clip(w2, 0.0, None))
 
+    def to_statespace(self):
+        """The model as a ``control.StateSpace`` (inputs voltage [V] and tip load [N],
+        output tip deflection [m]; :mod:`acld_gym.interop`)."""
+        from .interop import statespace
+
+        A, B, E, C = self.state_space()
+        return statespace(A, B, E, C, "beam")
+
     def static_tip_deflection(self, force: float = 1.0) -> float:
         """Static tip deflection [m] under a tip load ``force`` [N] (K q = F_d f)."""
         return float(np.linalg.solve(self.K, self.Fd * force)[self.tip_index])

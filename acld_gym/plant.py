@@ -147,6 +147,13 @@ class Plant:
         M, C, K, Pc = self.matrices()
         return first_order(M, C, K, Pc, self.Fd, self.c)
 
+    def to_statespace(self, params: BeamParameters | None = None):
+        """The plant as a ``control.StateSpace`` (:mod:`acld_gym.interop`)."""
+        from .interop import statespace
+
+        A, B, E, C = self.state_space(params)
+        return statespace(A, B, E, C, f"plant-{self.name}")
+
     def physical_state(self) -> np.ndarray:
         """(38, 2 r) map from the state x to the thesis mesh's state [q; dq/dt]."""
         return sla.block_diag(self.physical, self.physical)

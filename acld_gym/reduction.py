@@ -213,6 +213,13 @@ class ReducedModel:
         """:math:`2 \\sum_{i>k} \\sigma_i`, the H-infinity bound on the truncation error."""
         return 2.0 * float(np.sum(self.hsv[self.order:]))
 
+    def to_statespace(self):
+        """The reduced model as a ``control.StateSpace`` (inputs voltage [V] and, when
+        the reduction kept it, tip load [N]; :mod:`acld_gym.interop`)."""
+        from .interop import statespace
+
+        return statespace(self.A, self.B, self.E, self.C, f"reduced-{self.order}")
+
     @property
     def hankel_gap(self) -> float:
         """:math:`\\sigma_k / \\sigma_{k+1}`: how clearly the kept states dominate."""

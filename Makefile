@@ -6,14 +6,14 @@ STAMP   := $(VENV)/.installed-stamp
 
 .PHONY: install run test test-slow lint format bench agents clean
 
-$(STAMP): pyproject.toml constraints.txt setup.py acld_gym/_stepcore.c
+$(STAMP): pyproject.toml constraints.txt setup.py acld_gym/envs/_stepcore.c
 	$(PY) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
 	# The build needs (setup.py: numpy's headers for the compiled step) come from the
 	# constraints too, so the package is built without an isolated build environment.
 	$(BIN)/pip install --quiet -c constraints.txt setuptools numpy
 	# torch is pinned (constraints.txt) to the CPU build; an unpinned torch pulls CUDA.
-	$(BIN)/pip install --quiet --no-build-isolation -c constraints.txt -e ".[dev]"
+	$(BIN)/pip install --quiet --no-build-isolation -c constraints.txt -e ".[all,dev]"
 	touch $(STAMP)
 
 install: $(STAMP)

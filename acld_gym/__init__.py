@@ -3,6 +3,11 @@
 Importing the package registers ``ACLDBeam-v1`` (the mesh-converged beam, canonical
 observation) and ``ACLDBeam-v0`` (the thesis mesh, legacy coordinates);
 ``gym.make("acld_gym:ACLDBeam-v1")`` imports it by itself.
+
+The subpackages follow the pipeline: :mod:`acld_gym.physics` (parameters, finite
+elements, the truth plants) -> :mod:`acld_gym.design.pipeline` (reduction, observers, feedback,
+sampling, simulation) -> :mod:`acld_gym.envs` (the Gymnasium environments);
+:mod:`acld_gym.thesis.table2` reproduces the thesis; :mod:`acld_gym.util` holds the tools.
 """
 
 from gymnasium.envs.registration import register, registry
@@ -16,8 +21,8 @@ ENV_ID = "ACLDBeam-v1"
 # spec reports that count), so gym.make, make_vec and the SB3 adapter all follow
 # episode_length and dt; max_episode_steps= can still shorten an episode.
 if "ACLDBeam-v1" not in registry:
-    register(id="ACLDBeam-v1", entry_point="acld_gym.env:ACLDBeamEnv",
-             vector_entry_point="acld_gym.vector_env:ACLDBeamVectorEnv")
+    register(id="ACLDBeam-v1", entry_point="acld_gym.envs.beam_env:ACLDBeamEnv",
+             vector_entry_point="acld_gym.envs.vector_env:ACLDBeamVectorEnv")
 if "ACLDBeam-v0" not in registry:
-    register(id="ACLDBeam-v0", entry_point="acld_gym.legacy:ACLDBeamEnvV0",
-             vector_entry_point="acld_gym.legacy:ACLDBeamVectorEnvV0")
+    register(id="ACLDBeam-v0", entry_point="acld_gym.envs.legacy:ACLDBeamEnvV0",
+             vector_entry_point="acld_gym.envs.legacy:ACLDBeamVectorEnvV0")

@@ -45,9 +45,9 @@ from numpy.lib.stride_tricks import as_strided, sliding_window_view
 from scipy.linalg.lapack import dtrtrs
 from scipy.optimize import lsq_linear
 
-from acld_gym.discrete import SampledSystem
-from acld_gym.loads import TipLoad
-from acld_gym.thesis import V_LIMIT
+from acld_gym.design.discrete import SampledSystem
+from acld_gym.physics.loads import TipLoad
+from acld_gym.thesis.table2 import V_LIMIT
 
 __all__ = ["ATOL", "BoundSolution", "KKTCheck", "METHODS", "RTOL", "clairvoyant_bound",
            "convolution_matrix", "free_response", "impulse_response", "kkt_check",

@@ -19,14 +19,16 @@ from pathlib import Path
 
 import numpy as np
 
-from acld_gym.atomic import check_directory, check_writable, save_figure, write_json
-from acld_gym.blas import one_blas_thread
-from acld_gym.checks import arg_type
-from acld_gym.env import ACLDBeamEnv, nominal, reward_of
-from acld_gym.fingerprint import fingerprint_differences, observation_fingerprint
-from acld_gym.metrics import max_abs, peak, settling_time
-from acld_gym.plant import MESHES
-from acld_gym.progress import Progress
+from acld_gym.envs.beam_env import ACLDBeamEnv
+from acld_gym.envs.episode import nominal
+from acld_gym.envs.fingerprint import fingerprint_differences, observation_fingerprint
+from acld_gym.envs.step import reward_of
+from acld_gym.physics.truth import MESHES
+from acld_gym.thesis.metrics import max_abs, peak, settling_time
+from acld_gym.util.atomic import check_directory, check_writable, save_figure, write_json
+from acld_gym.util.blas import one_blas_thread
+from acld_gym.util.progress import Progress
+from acld_gym.util.validate import arg_type
 
 __all__ = ["EvalRow", "Episode", "rollout", "check_compatible", "bound_episode", "episode_rows",
            "evaluate", "default_policies",
@@ -64,7 +66,7 @@ class EvalRow:
 
 def check_compatible(policy, env) -> None:
     """``ValueError`` if ``policy`` records an observation fingerprint that ``env``'s
-    observation does not match (:mod:`acld_gym.fingerprint`)."""
+    observation does not match (:mod:`acld_gym.envs.fingerprint`)."""
     expected = getattr(policy, "observation_fingerprint", None)
     if expected is None:
         return
@@ -102,7 +104,7 @@ def bound_episode(env: ACLDBeamEnv) -> Episode:
 
     env = env.unwrapped
     t0 = time.perf_counter()
-    with one_blas_thread():  # small dense problems (acld_gym.blas)
+    with one_blas_thread():  # small dense problems (acld_gym.util.blas)
         sol = clairvoyant_bound(env.episode_plant, env.nom.output, env.load, env.max_steps)
     spent = time.perf_counter() - t0
     t = np.arange(1, env.max_steps + 1) * env.dt
@@ -251,6 +253,6 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    from acld_gym.checks import run_main
+    from acld_gym.util.validate import run_main
 
     sys.exit(run_main(main))

@@ -1,7 +1,7 @@
 """Reference policies for ``ACLDBeam-v0`` with stable-baselines3's ``predict`` protocol.
 
 They are designed on the nominal reduced model sampled at the env's control
-period (:func:`acld_gym.env.nominal`) and read the reduced-state estimate
+period (:func:`acld_gym.envs.episode.nominal`) and read the reduced-state estimate
 from the ``"estimate"`` observation (``obs[:6] * xr_scale``), so
 ``evaluate_policy`` and :mod:`baselines.evaluate` treat them like agents.
 
@@ -14,10 +14,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from acld_gym.control import THESIS_LQR_WEIGHT, THESIS_SMC_WEIGHT, discrete_lqr_gain
-from acld_gym.env import Nominal, nominal
-from acld_gym.fingerprint import design_fingerprint
-from acld_gym.thesis import V_LIMIT
+from acld_gym.design.feedback import (
+    THESIS_LQR_WEIGHT,
+    THESIS_SMC_WEIGHT,
+    discrete_lqr_gain,
+)
+from acld_gym.envs.episode import Nominal, nominal
+from acld_gym.envs.fingerprint import design_fingerprint
+from acld_gym.thesis.table2 import V_LIMIT
 
 __all__ = ["PassivePolicy", "LQRPolicy", "SMCPolicy", "MPCPolicy", "discrete_lqr_gain"]
 
@@ -39,7 +43,7 @@ class _Policy:
     @property
     def observation_fingerprint(self) -> dict:
         """The design the policy decodes the observation with
-        (:func:`acld_gym.fingerprint.design_fingerprint`)."""
+        (:func:`acld_gym.envs.fingerprint.design_fingerprint`)."""
         return design_fingerprint(self.nom)
 
     def reduced_state(self, obs: np.ndarray) -> np.ndarray:

@@ -2,7 +2,7 @@ r"""Small-signal stability of the reference policies on randomized plants.
 
 About rest no voltage limit or switching is active, and every reference policy is a
 linear law :math:`V = -K \hat x_r` (:meth:`small_signal_gain`). With the env's observer
-(:class:`acld_gym.observer.DiscreteObserver`: measurement update :math:`L_c`,
+(:class:`acld_gym.design.observer.DiscreteObserver`: measurement update :math:`L_c`,
 prediction gain :math:`L_p`) and a sampled plant :math:`(A_d, B_d, c)`, one period of
 the loop is linear in :math:`(x, \hat x)`:
 
@@ -28,10 +28,10 @@ from dataclasses import replace
 
 import numpy as np
 
-from acld_gym.discrete import SampledSystem, discretize
-from acld_gym.env import PARAM_NOISE_CLIP, PARAM_NOISE_MAX, RANDOMIZED, Nominal, nominal
-from acld_gym.observer import DiscreteObserver
-from acld_gym.plant import MESHES
+from acld_gym.design.discrete import SampledSystem, discretize
+from acld_gym.design.observer import DiscreteObserver
+from acld_gym.envs.episode import PARAM_NOISE_CLIP, PARAM_NOISE_MAX, RANDOMIZED, Nominal, nominal
+from acld_gym.physics.truth import MESHES
 
 __all__ = ["closed_loop_matrix", "spectral_radius", "corner_plants", "corner_study", "main"]
 
@@ -63,7 +63,7 @@ def spectral_radius(plant: SampledSystem, nom: Nominal, gain: np.ndarray,
 
 def corner_plants(nom: Nominal, param_noise: float):
     """The sampled plants at the corners of the parameter box: each of
-    :data:`acld_gym.env.RANDOMIZED` times :math:`e^{\\pm 3\\sigma}` (generator)."""
+    :data:`acld_gym.envs.episode.RANDOMIZED` times :math:`e^{\\pm 3\\sigma}` (generator)."""
     truth = nom.truth
     f = float(np.exp(PARAM_NOISE_CLIP * param_noise))
     for signs in itertools.product((-1, 1), repeat=len(RANDOMIZED)):
@@ -111,6 +111,6 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    from acld_gym.checks import run_main
+    from acld_gym.util.validate import run_main
 
     sys.exit(run_main(main))

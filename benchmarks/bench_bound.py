@@ -59,8 +59,8 @@ def _blas_threads() -> str:
 def _worker(args) -> None:
     import numpy as np
 
-    from acld_gym.env import nominal, random_load
-    from acld_gym.loads import thesis_load
+    from acld_gym.envs.episode import nominal, random_load
+    from acld_gym.physics.loads import thesis_load
     from baselines.bound import clairvoyant_bound
 
     nom = nominal()

@@ -22,9 +22,9 @@ import gymnasium as gym
 import numpy as np
 
 import acld_gym  # noqa: F401  (registers ACLDBeam-v0)
-from acld_gym.env import COMPILED_STEP, ACLDBeamEnv
-from acld_gym.sb3 import SB3VecEnv
-from acld_gym.vector_env import ACLDBeamVectorEnv
+from acld_gym.envs.beam_env import COMPILED_STEP, ACLDBeamEnv
+from acld_gym.envs.sb3 import SB3VecEnv
+from acld_gym.envs.vector_env import ACLDBeamVectorEnv
 
 KW = dict(load_case="random")
 

@@ -15,11 +15,11 @@ import time
 
 import numpy as np
 
-from acld_gym.design import design
-from acld_gym.loads import thesis_load
-from acld_gym.metrics import peak
-from acld_gym.reproduce import run_cases
-from acld_gym.simulate import ClosedLoop, simulate
+from acld_gym.design.pipeline import design
+from acld_gym.design.simulate import ClosedLoop, simulate
+from acld_gym.physics.loads import thesis_load
+from acld_gym.thesis.metrics import peak
+from acld_gym.thesis.reproduce import run_cases
 
 WINDOW = 0.02  # s, the RK4 comparison window (covers the pulse and many saturation switches)
 

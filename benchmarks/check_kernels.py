@@ -32,9 +32,10 @@ KERNELS = ["default", "Nehalem", "Sandybridge", "Haswell"]
 _CHILD = r"""
 import json, sys
 import numpy as np
-from acld_gym.env import ACLDBeamEnv, nominal
-from acld_gym.reduction import schur_balanced_truncation
-from acld_gym.plant import plant
+from acld_gym.envs.beam_env import ACLDBeamEnv
+from acld_gym.envs.episode import nominal
+from acld_gym.design.reduction import schur_balanced_truncation
+from acld_gym.physics.truth import plant
 
 out = {}
 for mesh in ("converged", "thesis"):

@@ -1,6 +1,6 @@
 import sys
 
-from acld_gym.checks import run_main
+from acld_gym.util.validate import run_main
 
 from .cli import main
 

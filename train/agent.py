@@ -9,7 +9,7 @@ anything when read:
 * ``metadata.json``: how it was made (algorithm, teacher or none, command, config,
   versions), the actor's program (which operation uses which arrays), and the
   **observation fingerprint** of the env it was trained on
-  (:mod:`acld_gym.fingerprint`).
+  (:mod:`acld_gym.envs.fingerprint`).
 
 :meth:`TrainedAgent.load` reads only those two files. It refuses an agent whose
 fingerprint does not match what that env's observation is today, on this machine
@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from acld_gym.atomic import write_atomic, write_json
+from acld_gym.util.atomic import write_atomic, write_json
 
 from .features import direction_features
 from .vec import VoltageMap
@@ -172,9 +172,10 @@ class TrainedAgent:
 
     # --- what it was trained on --------------------------------------------------------
     @property
-    def observation_fingerprint(self) -> dict:
-        """The observation it was trained on (checked by :func:`baselines.evaluate.rollout`)."""
-        return self.metadata["observation"]
+    def observation_fingerprint(self) -> dict | None:
+        """The observation it was trained on (checked by :func:`baselines.evaluate.rollout`;
+        None for an agent built in memory without one)."""
+        return self.metadata.get("observation")
 
     @property
     def training(self) -> str:
@@ -229,11 +230,11 @@ class TrainedAgent:
 
     def check_current(self) -> None:
         """Raise :class:`AgentFileError` if the env the agent names observes differently
-        today (:mod:`acld_gym.fingerprint`)."""
+        today (:mod:`acld_gym.envs.fingerprint`)."""
         import gymnasium as gym
 
         import acld_gym  # noqa: F401  (registers the ids)
-        from acld_gym.fingerprint import fingerprint_differences, observation_fingerprint
+        from acld_gym.envs.fingerprint import fingerprint_differences, observation_fingerprint
 
         env_meta = self.metadata["env"]
         env = gym.make(env_meta["id"], **env_meta.get("kwargs", {}))

@@ -14,8 +14,8 @@ from stable_baselines3.common.callbacks import BaseCallback, EvalCallback
 from stable_baselines3.common.monitor import Monitor
 from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
 
-from acld_gym.atomic import write_text
-from acld_gym.env import ACLDBeamEnv
+from acld_gym.envs.beam_env import ACLDBeamEnv
+from acld_gym.util.atomic import write_text
 
 from .vec import VecAgentEnv
 

@@ -21,9 +21,9 @@ import sys
 import time
 from pathlib import Path
 
-from acld_gym.atomic import check_writable
-from acld_gym.checks import arg_type
-from acld_gym.env import PARAM_NOISE_MAX
+from acld_gym.envs.episode import PARAM_NOISE_MAX
+from acld_gym.util.atomic import check_writable
+from acld_gym.util.validate import arg_type
 
 from .config import ALGOS, TrainConfig, algo_class, load_config
 
@@ -115,7 +115,7 @@ def export_run(out: Path, cfg: TrainConfig, meta: dict, model=None, venv=None) -
 
     import gymnasium as gym
 
-    from acld_gym.fingerprint import observation_fingerprint
+    from acld_gym.envs.fingerprint import observation_fingerprint
 
     from .agent import MODEL_FILE, STATS_FILE, TrainedAgent, export_sb3
 

@@ -21,10 +21,16 @@ import json
 import sys
 from pathlib import Path
 
-from acld_gym.atomic import check_directory, check_writable, save_figure, write_json, write_text
-from acld_gym.checks import arg_type
-from acld_gym.plant import MESHES
-from acld_gym.progress import Progress
+from acld_gym.physics.truth import MESHES
+from acld_gym.util.atomic import (
+    check_directory,
+    check_writable,
+    save_figure,
+    write_json,
+    write_text,
+)
+from acld_gym.util.progress import Progress
+from acld_gym.util.validate import arg_type
 from baselines.evaluate import (
     EvalRow,
     default_policies,
@@ -229,6 +235,6 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    from acld_gym.checks import run_main
+    from acld_gym.util.validate import run_main
 
     sys.exit(run_main(main))

@@ -9,9 +9,9 @@ from typing import Any
 
 import yaml
 
-from acld_gym.checks import check_int, check_real
-from acld_gym.env import LOAD_CASES, PARAM_NOISE_MAX
-from acld_gym.plant import MESHES
+from acld_gym.envs.episode import LOAD_CASES, PARAM_NOISE_MAX
+from acld_gym.physics.truth import MESHES
+from acld_gym.util.validate import check_int, check_real
 
 __all__ = ["ALGOS", "TrainConfig", "load_config", "config_path", "algo_class"]
 

@@ -8,7 +8,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from acld_gym.atomic import write_text
+from acld_gym.util.atomic import write_text
 
 from .agent import META_FILE, MODEL_FILE, POLICY_FILE, STATS_FILE, TrainedAgent
 from .compare import AGENTS_DIR
@@ -69,6 +69,6 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    from acld_gym.checks import run_main
+    from acld_gym.util.validate import run_main
 
     sys.exit(run_main(main))

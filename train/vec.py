@@ -13,10 +13,10 @@ import numpy as np
 from gymnasium import spaces
 from stable_baselines3.common.vec_env import VecEnv, VecEnvWrapper, VecNormalize
 
-from acld_gym.control import discrete_lqr_gain
-from acld_gym.env import nominal
-from acld_gym.sb3 import SB3VecEnv
-from acld_gym.thesis import V_LIMIT
+from acld_gym.design.feedback import discrete_lqr_gain
+from acld_gym.envs.episode import nominal
+from acld_gym.envs.sb3 import SB3VecEnv
+from acld_gym.thesis.table2 import V_LIMIT
 from baselines.policies import LQRPolicy
 
 __all__ = ["VoltageMap", "VecAgentEnv", "lq_potential", "make_vec_env"]

@@ -1,0 +1,146 @@
+"""Stable-Baselines3 adapter for :class:`acld_gym.envs.vector_env.ACLDBeamVectorEnv`.
+
+SB3 does not take a :class:`gymnasium.vector.VectorEnv`; :class:`SB3VecEnv` is
+an SB3 ``VecEnv`` over the native batched env. It converts the gymnasium
+``NEXT_STEP`` autoreset to SB3's same-step autoreset: a sub-env that ends is
+reset at once (the vector env's ``reset`` path for that sub-env) and its
+final observation is in ``infos[i]["terminal_observation"]``;
+``infos[i]["TimeLimit.truncated"]`` is ``truncated and not terminated``.
+
+Example::
+
+    from stable_baselines3 import PPO
+    from acld_gym.sb3 import SB3VecEnv
+
+    venv = SB3VecEnv(num_envs=16, load_case="random")
+    PPO("MlpPolicy", venv).learn(100_000)
+
+Actions are volts (+/-120); wrap with ``VecNormalize`` as usual, and rescale
+the policy output yourself if you want [-1, 1] actions.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from stable_baselines3.common.vec_env import VecEnv
+
+from acld_gym.envs.episode import LOAD_CASES
+from acld_gym.envs.vector_env import INFO_KEYS, ACLDBeamVectorEnv
+from acld_gym.util.validate import check_choice, check_seed
+
+#: Attributes the env derives its tables and design from at construction.
+_CONFIGURED = ("mesh", "dt", "episode_length", "observer_kind", "obs_mode", "sensor_noise",
+               "param_noise", "num_envs", "nom", "horizon")
+
+__all__ = ["SB3VecEnv"]
+
+
+def _scalar(x):
+    """A numpy scalar as a Python value (``None`` and other objects as they are)."""
+    return x.item() if isinstance(x, np.generic) else x
+
+
+class SB3VecEnv(VecEnv):
+    """SB3 ``VecEnv`` over :class:`ACLDBeamVectorEnv` (``num_envs`` and the env's kwargs,
+    or an existing ``venv=``)."""
+
+    def __init__(self, num_envs: int = 1, venv: ACLDBeamVectorEnv | None = None,
+                 **env_kwargs):
+        if venv is None:
+            venv = ACLDBeamVectorEnv(num_envs=num_envs, **env_kwargs)
+        elif env_kwargs:
+            raise ValueError("pass either venv= or the env's keyword arguments, not both")
+        self.venv = venv
+        super().__init__(venv.num_envs, venv.single_observation_space,
+                         venv.single_action_space)
+        self.render_mode = venv.render_mode
+        self._actions: np.ndarray | None = None
+        self._seed: int | None = None
+        self._reset_options: dict = {}
+
+    def reset(self) -> np.ndarray:
+        obs, _ = self.venv.reset(seed=self._seed, options=self._reset_options or None)
+        self._seed = None
+        self._reset_options = {}
+        self.reset_infos = [{} for _ in range(self.num_envs)]
+        return obs
+
+    def step_async(self, actions: np.ndarray) -> None:
+        if self.venv._needs_reset:
+            raise RuntimeError("SB3VecEnv: call reset() before step()")
+        self._actions = np.asarray(actions)
+
+    def step_wait(self):
+        if self._actions is None:
+            raise RuntimeError("step_wait() called without step_async()")
+        v = self.venv
+        obs, rewards, terminated, truncated, info = v.step(self._actions)
+        self._actions = None
+        done = terminated | truncated
+        infos: list[dict[str, Any]] = [
+            {key: _scalar(info[key][i]) for key in INFO_KEYS} for i in range(self.num_envs)]
+        if done.any():
+            ended = np.flatnonzero(done)
+            for i in ended:
+                infos[i]["terminal_observation"] = obs[i].copy()
+                infos[i]["TimeLimit.truncated"] = bool(truncated[i] and not terminated[i])
+            obs = v.reset_done(ended)
+        return obs, rewards.astype(np.float32), done, infos
+
+    def close(self) -> None:
+        self.venv.close()
+
+    def seed(self, seed: int | None = None) -> Sequence[None | int]:
+        """Seeds the next ``reset()``: sub-env i gets ``seed + i``."""
+        self._seed = check_seed(seed)
+        return [None if seed is None else seed + i for i in range(self.num_envs)]
+
+    def set_options(self, options: list[dict] | dict | None = None) -> None:
+        if isinstance(options, list):
+            if any(o != options[0] for o in options):
+                raise ValueError("SB3VecEnv: options must be the same for all sub-envs")
+            options = options[0] if options else None
+        self._reset_options = dict(options or {})
+
+    def get_images(self) -> Sequence[np.ndarray | None]:
+        frame = self.venv.render() if self.render_mode == "rgb_array" else None
+        return [frame] + [None] * (self.num_envs - 1)
+
+    def _indices(self, indices) -> list[int]:
+        if indices is None:
+            return list(range(self.num_envs))
+        if isinstance(indices, int):
+            return [indices]
+        return list(indices)
+
+    def get_attr(self, attr_name: str, indices=None) -> list[Any]:
+        """The attribute of the (shared) vector env, once per requested index."""
+        value = getattr(self.venv, attr_name)
+        return [value for _ in self._indices(indices)]
+
+    def set_attr(self, attr_name: str, value: Any, indices=None) -> None:
+        """Set an attribute of the (shared) vector env, validated now: ``load_case`` (takes
+        effect at the next reset) is the one meant to change; anything else that the env
+        validates at construction is refused rather than left to fail later."""
+        idx = self._indices(indices)
+        if idx != list(range(self.num_envs)):
+            raise ValueError("SB3VecEnv: attributes are shared; set them for all sub-envs")
+        if attr_name == "load_case":
+            check_choice("load_case", value, LOAD_CASES)
+        elif attr_name in _CONFIGURED:
+            raise ValueError(f"SB3VecEnv: {attr_name} is fixed at construction; build a new "
+                             "env to change it")
+        elif not hasattr(self.venv, attr_name):
+            raise ValueError(f"SB3VecEnv: the vector env has no attribute {attr_name!r}")
+        setattr(self.venv, attr_name, value)
+
+    def env_method(self, method_name: str, *method_args, indices=None, **method_kwargs):
+        """Calls the vector env's method once per requested index."""
+        method = getattr(self.venv, method_name)
+        return [method(*method_args, **method_kwargs) for _ in self._indices(indices)]
+
+    def env_is_wrapped(self, wrapper_class, indices=None) -> list[bool]:
+        return [False for _ in self._indices(indices)]

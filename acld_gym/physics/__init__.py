@@ -1,0 +1,2 @@
+"""The beam's physics: parameters, finite elements, assembly, the clamped model, tip loads,
+and the truth plants the env simulates."""

@@ -1,0 +1,157 @@
+"""``acld-gym`` command line: ``reproduce`` (Table 2), ``model`` (model facts), ``mesh``
+(mesh convergence, thesis mesh vs converged plant), ``params``."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from acld_gym.design.pipeline import design
+from acld_gym.design.simulate import simulate
+from acld_gym.physics.loads import thesis_load
+from acld_gym.physics.params import PRESETS
+from acld_gym.thesis.metrics import peak
+from acld_gym.thesis.reproduce import T_END, format_table2, run_cases
+from acld_gym.util.atomic import check_directory, check_writable, write_json
+from acld_gym.util.blas import one_blas_thread
+from acld_gym.util.progress import Progress
+from acld_gym.util.validate import arg_type, closed_pipe_is_fine
+
+__all__ = ["main"]
+
+
+def _write_json(path: str, obj) -> None:
+    write_json(path, obj)
+
+
+def _check_outputs(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    """Refuse unusable ``--json`` / ``--plots`` paths before any computing (exit 2)."""
+    try:
+        if getattr(args, "json", None):
+            check_writable(args.json, "--json")
+        if getattr(args, "plots", None):
+            check_directory(args.plots, "--plots")
+    except ValueError as exc:
+        parser.error(str(exc))
+
+
+def cmd_reproduce(args: argparse.Namespace) -> int:
+    t0 = time.perf_counter()
+    d = design(preset=args.preset)
+    plots = Path(args.plots) if args.plots else None
+    if plots is not None:
+        from acld_gym.thesis.plots import plot_frequency_response, plot_hankel, plot_response
+
+        plots.mkdir(parents=True, exist_ok=True)
+        plot_hankel(plots / "hankel_singular_values.png", d)
+        plot_frequency_response(plots / "frequency_response.png", d)
+    bar = Progress(18, "reproduce", args.quiet)
+
+    def on_result(row, res):
+        bar.stage(f"case {row.case} · {row.controller} · "
+                  f"{'saturated' if row.saturation else 'unsaturated'}")
+        if plots is not None:
+            sat = "sat" if row.saturation else "nosat"
+            title = (f"Case {row.case}: {row.controller.upper()} "
+                     f"{'with' if row.saturation else 'without'} saturation")
+            plot_response(plots / f"case{row.case}_{row.controller}_{sat}.png", res.t, res.y,
+                          res.voltage, title, load=res.load)
+
+    rows = run_cases(d, observer=args.observer, t_end=args.t_end, on_result=on_result)
+    bar.close()
+    print(format_table2(rows, t_end=args.t_end))
+    print(f"\n{len(rows)} rows in {time.perf_counter() - t0:.2f} s "
+          f"(observer: {args.observer}; settling = last exit from the 5% band of the peak "
+          f"within {args.t_end:g} s)")
+    if args.json:
+        _write_json(args.json, [r.as_dict() for r in rows])
+        print(f"wrote {args.json}")
+    if plots is not None:
+        print(f"wrote figures to {plots}/")
+    return 0
+
+
+def cmd_model(args: argparse.Namespace) -> int:
+    d = design(preset=args.preset)
+    m = d.truth
+    A, B, E, Cy = d.plant
+    res = simulate(A, B, E, Cy, d.observer("thesis"), d.passive, thesis_load(1), t_end=T_END,
+                   v_max=None)
+    out = {
+        "preset": args.preset,
+        "n_states": m.n_states,
+        "natural_frequencies_rad_s": m.natural_frequencies().tolist(),
+        "hankel_singular_values": d.reduced.hsv.tolist(),
+        "passive_case1_peak_mm": peak(res.y) * 1e3,
+    }
+    print(f"preset {args.preset}: {m.n_states} states; first natural frequencies "
+          f"{np.array2string(m.natural_frequencies()[:4], precision=1)} rad/s; "
+          f"passive case-1 peak {out['passive_case1_peak_mm']:.4f} mm")
+    if args.json:
+        _write_json(args.json, out)
+        print(f"wrote {args.json}")
+    return 0
+
+
+def cmd_mesh(args: argparse.Namespace) -> int:
+    from acld_gym.physics.convergence import format_mesh_report, mesh_report
+
+    t0 = time.perf_counter()
+    rep = mesh_report()
+    print(format_mesh_report(rep))
+    print(f"\n({time.perf_counter() - t0:.1f} s)")
+    if args.json:
+        _write_json(args.json, rep)
+        print(f"wrote {args.json}")
+    return 0
+
+
+def cmd_params(args: argparse.Namespace) -> int:
+    from acld_gym.physics.params import PRESETS, parameter_table
+
+    print(parameter_table(PRESETS[args.preset]()))
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="acld-gym", description=__doc__)
+    sub = p.add_subparsers(dest="command", required=True)
+    r = sub.add_parser("reproduce", help="reproduce the thesis's Table 2 (and figures)")
+    r.add_argument("--json", metavar="PATH", help="write the rows as JSON")
+    r.add_argument("--plots", metavar="DIR", help="write figures (PNG) to DIR")
+    r.add_argument("--preset", choices=sorted(PRESETS), default="matlab")
+    r.add_argument("--observer", choices=["thesis", "thesis-unfed", "kalman"], default="thesis",
+                   help="'thesis' = the thesis observer fed the tip load (reproduces Table 2)")
+    r.add_argument("--t-end", type=arg_type(float, 0.0, 100.0, low_open=True), default=T_END,
+                   help="simulated window [s]")
+    r.add_argument("--quiet", action="store_true", help="no progress bar")
+    r.set_defaults(func=cmd_reproduce)
+    m = sub.add_parser("model", help="natural frequencies, Hankel values, passive peak")
+    m.add_argument("--json", metavar="PATH", help="write the facts as JSON")
+    m.add_argument("--preset", choices=sorted(PRESETS), default="matlab")
+    m.set_defaults(func=cmd_model)
+    me = sub.add_parser("mesh", help="mesh convergence; the thesis mesh against the converged "
+                                     "plant (README tables)")
+    me.add_argument("--json", metavar="PATH", help="write the numbers as JSON")
+    me.set_defaults(func=cmd_mesh)
+    pa = sub.add_parser("params", help="print the parameter table (Markdown)")
+    pa.add_argument("--preset", choices=sorted(PRESETS), default="matlab")
+    pa.set_defaults(func=cmd_params)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    _check_outputs(parser, args)
+    with closed_pipe_is_fine(), one_blas_thread():
+        return args.func(args)
+    return 0  # the reader closed the pipe (acld-gym params | head -1)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,1 @@
+"""Tools every layer uses: validation, atomic files, BLAS threads, progress lines."""

@@ -1,0 +1,152 @@
+"""The shipped agents (train/agents/) and the agent format.
+
+The agents load without executing anything, refuse observations they were not trained
+on, act in volts, and reproduce the rows of ``train/agents/compare.json`` -- the README's
+table, written by ``python -m train.compare --json train/agents/compare.json`` -- on the
+three thesis cases and the held-out random set. Tolerance 1e-2 relative on ISE and
+peak: the evaluation is deterministic, and the observation is the same on every machine
+(canonical basis, shipped plant); the slack covers BLAS round-off in the agents'
+switching decisions, which a near-tie can amplify.
+"""
+
+from __future__ import annotations
+
+import json
+import pickle
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from acld_gym.envs.beam_env import ACLDBeamEnv
+from baselines.evaluate import mean_rows, metrics_row, rollout
+from train.agent import META_FILE, POLICY_FILE, AgentFileError, TrainedAgent
+from train.compare import AGENTS_DIR, HELDOUT_SEEDS, agent_names, load_agents
+
+RTOL = 1e-2
+ROWS = json.loads((AGENTS_DIR / "compare.json").read_text())
+README = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+NAMES = agent_names()
+
+
+def _row(case, policy):
+    return next(r for r in ROWS if r["case"] == case and r["policy"] == policy)
+
+
+@pytest.fixture(scope="module")
+def agents():
+    return load_agents()
+
+
+def test_every_agent_is_in_the_table_with_its_training_label(agents):
+    assert len(NAMES) >= 2
+    for name, agent in agents.items():
+        assert {r["case"] for r in ROWS if r["policy"] == name} == {1, 2, 3, "random"}
+        label = _row(1, name)["training"]
+        assert label == agent.training
+        assert label == ("from scratch" if agent.metadata["teacher"] is None
+                         else f"DAgger from {agent.metadata['teacher'].upper()} + RL")
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_metadata_records_how_it_was_made(agents, name):
+    meta = agents[name].metadata
+    assert meta["env"]["id"] == "ACLDBeam-v1"
+    assert meta["observation"]["env_id"] == "ACLDBeam-v1"
+    assert meta["observation"]["basis"] == "modal"
+    assert meta["command"].startswith("python -m train")
+    assert {"numpy", "gymnasium"} <= set(meta["versions"])
+
+
+@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("case", [1, 2, 3])
+def test_thesis_cases_reproduce_the_table(agents, name, case):
+    ep = rollout(agents[name], ACLDBeamEnv(load_case=case), seed=0)
+    row = metrics_row(case, name, ep)
+    ref = _row(case, name)
+    assert row.ise == pytest.approx(ref["ise"], rel=RTOL)
+    assert row.peak_mm == pytest.approx(ref["peak_mm"], rel=RTOL)
+    assert np.abs(ep.voltage).max() <= 120.0
+    assert f"{ref['ise']:.3e}" in README
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_heldout_random_set_reproduces_the_table(agents, name):
+    env = ACLDBeamEnv(load_case="random")
+    rows = [metrics_row("random", name, rollout(agents[name], env, seed=s))
+            for s in HELDOUT_SEEDS]
+    mean = mean_rows(rows, "random")[0]
+    assert mean.ise == pytest.approx(_row("random", name)["ise"], rel=RTOL)
+
+
+def test_table_is_complete():
+    policies = {"passive", "lqr", "smc", "mpc", "bound", *NAMES}
+    for case in (1, 2, 3, "random"):
+        assert {r["policy"] for r in ROWS if r["case"] == case} >= policies
+    for r in ROWS:
+        assert r["ise_rel_bound"] >= 1.0 - 1e-9 or r["policy"] == "bound"
+
+
+# --- the format: nothing executes, nothing silently misapplied ----------------------
+@pytest.fixture
+def agent_dir(tmp_path):
+    d = tmp_path / "agent"
+    shutil.copytree(AGENTS_DIR / NAMES[0], d)
+    return d
+
+
+class _Bomb:
+    """Unpickling this creates a marker file: proof that a pickle was read."""
+
+    marker: Path
+
+    def __reduce__(self):
+        return (Path.touch, (self.marker,))
+
+
+def test_load_never_unpickles(agent_dir, tmp_path):
+    marker = tmp_path / "unpickled"
+    bomb = _Bomb()
+    bomb.marker = marker
+    for name in ("vecnormalize.pkl", "model.zip"):
+        (agent_dir / name).write_bytes(pickle.dumps(bomb))
+    agent = TrainedAgent.load(agent_dir)
+    agent.predict(np.zeros(9, np.float32))
+    assert not marker.exists()
+
+
+def test_truncated_policy_file_is_named(agent_dir):
+    data = (agent_dir / POLICY_FILE).read_bytes()
+    (agent_dir / POLICY_FILE).write_bytes(data[: len(data) // 2])
+    with pytest.raises(AgentFileError, match=POLICY_FILE):
+        TrainedAgent.load(agent_dir)
+
+
+def test_bad_metadata_is_named(agent_dir):
+    (agent_dir / META_FILE).write_text("{not json")
+    with pytest.raises(AgentFileError, match=META_FILE):
+        TrainedAgent.load(agent_dir)
+    (agent_dir / META_FILE).write_text("[1, 2]")
+    with pytest.raises(AgentFileError, match=META_FILE):
+        TrainedAgent.load(agent_dir)
+
+
+def test_fingerprint_mismatch_is_refused_and_says_what_differs(agent_dir):
+    meta = json.loads((agent_dir / META_FILE).read_text())
+    meta["observation"]["xr_scale"] = [2 * x for x in meta["observation"]["xr_scale"]]
+    (agent_dir / META_FILE).write_text(json.dumps(meta))
+    with pytest.raises(AgentFileError, match="xr_scale"):
+        TrainedAgent.load(agent_dir)
+    meta["observation"]["basis"] = "schur"
+    (agent_dir / META_FILE).write_text(json.dumps(meta))
+    with pytest.raises(AgentFileError, match="basis"):
+        TrainedAgent.load(agent_dir)
+
+
+def test_agent_refuses_an_env_with_another_observation(agents):
+    agent = agents[NAMES[0]]
+    with pytest.raises(ValueError, match="mesh"):
+        rollout(agent, ACLDBeamEnv(mesh="thesis"))
+    with pytest.raises(ValueError, match="obs_mode"):
+        rollout(agent, ACLDBeamEnv(obs_mode="measurement"))

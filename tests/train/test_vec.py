@@ -1,0 +1,95 @@
+"""train.vec: the action map, the shaping potential and the wrapped training env."""
+
+import numpy as np
+import pytest
+import scipy.linalg as sla
+
+from acld_gym.envs.episode import nominal
+from baselines.policies import LQRPolicy
+from train.config import load_config
+from train.vec import VecAgentEnv, VoltageMap, lq_potential, make_vec_env
+
+
+def test_voltage_map_plain_and_residual():
+    obs = np.random.default_rng(0).normal(size=(5, 9))
+    a = np.array([[-1.0], [-0.5], [0.0], [0.5], [2.0]])
+    assert np.allclose(VoltageMap()(a, obs)[:, 0], [-120, -60, 0, 60, 120])  # 2.0 -> clipped
+    lqr = LQRPolicy()
+    u0 = lqr.voltage(lqr.reduced_state(obs))
+    res = VoltageMap("lqr")
+    # zero residual = the (saturated) LQR voltage
+    assert np.allclose(res(np.zeros((5, 1)), obs)[:, 0], np.clip(u0, -120, 120), atol=1e-3)
+    # a residual moves the unsaturated LQR voltage by at most 240 V
+    for r in (-1.0, -0.3, 0.4, 1.0):
+        expect = np.clip(u0 + 240.0 * r, -120, 120)
+        assert np.allclose(res(np.full((5, 1), r), obs)[:, 0], expect, atol=1e-3)
+    with pytest.raises(ValueError, match="residual"):
+        VoltageMap("pid")
+
+
+def test_lq_potential_solves_the_discounted_riccati_equation():
+    gamma, lam = 0.99, 0.01
+    P = lq_potential(gamma, lam)
+    assert np.allclose(P, P.T, rtol=1e-8, atol=1e-10 * np.abs(P).max())
+    assert np.linalg.eigvalsh(P).min() > 0  # positive definite (observable output)
+    nom = nominal()
+    S = np.diag(nom.xr_scale)
+    A = np.sqrt(gamma) * np.linalg.solve(S, nom.reduced.Ad @ S)
+    B = np.sqrt(gamma) * np.linalg.solve(S, nom.reduced.Bd)
+    Q = S @ nom.design.reduced.C.T @ nom.design.reduced.C @ S / 1e-6
+    R = lam / 120.0**2
+    # the DARE residual, relative to P's size
+    K = np.linalg.solve(R + B.T @ P @ B, B.T @ P @ A)
+    res = A.T @ P @ A - P + Q - A.T @ P @ B @ K
+    assert np.abs(res).max() < 1e-8 * np.abs(P).max()
+    # more expensive voltage -> larger cost-to-go
+    assert np.all(np.linalg.eigvalsh(lq_potential(gamma, 1.0) - P) > -1e-9 * np.abs(P).max())
+    assert sla.norm(lq_potential(0.9, lam)) < sla.norm(P)  # shorter horizon, smaller value
+
+
+def test_shaping_is_potential_based():
+    """Shaped minus raw reward is gamma Phi(s') - Phi(s) step by step (terminal obs at the end)."""
+    cfg = load_config("ppo").with_overrides(n_envs=2, load_case=1, shaping=0.01)
+    raw = VecAgentEnv(_base(cfg), None, cfg.gamma, None)
+    shaped = VecAgentEnv(_base(cfg), None, cfg.gamma, cfg.shaping)
+    o_raw, o_sh = raw.reset(), shaped.reset()
+    assert np.array_equal(o_raw, o_sh)
+    acts = np.random.default_rng(1).uniform(-1, 1, (1000, 2, 1)).astype(np.float32)
+    prev = o_sh
+    for k in range(1000):
+        for v in (raw, shaped):
+            v.step_async(acts[k])
+        o1, r1, d1, i1 = raw.step_wait()
+        o2, r2, d2, i2 = shaped.step_wait()
+        assert np.array_equal(o1, o2) and np.array_equal(d1, d2)
+        nxt = o2.copy()
+        for i in np.flatnonzero(d2):
+            nxt[i] = i2[i]["terminal_observation"]
+        expect = r1 + cfg.gamma * shaped.potential(nxt) - shaped.potential(prev)
+        assert np.allclose(r2, expect, rtol=1e-5, atol=1e-5)
+        prev = o2
+    assert d2.all()  # the episode ended (1000 steps) inside the loop
+
+
+def _base(cfg):
+    from acld_gym.envs.sb3 import SB3VecEnv
+
+    v = SB3VecEnv(num_envs=cfg.n_envs, load_case=cfg.load_case)
+    v.seed(3)
+    return v
+
+
+def test_make_vec_env_is_seeded_and_normalized():
+    cfg = load_config("ppo").with_overrides(n_envs=3)
+    a, b = make_vec_env(cfg, seed=5), make_vec_env(cfg, seed=5)
+    oa, ob = a.reset(), b.reset()
+    assert np.array_equal(oa, ob) and oa.shape == (3, 9)
+    assert a.action_space.low[0] == -1 and a.action_space.high[0] == 1
+    act = np.full((3, 1), 0.3, np.float32)
+    for _ in range(20):
+        a.step_async(act)
+        b.step_async(act)
+        ra, rb = a.step_wait(), b.step_wait()
+    assert np.array_equal(ra[0], rb[0]) and np.array_equal(ra[1], rb[1])
+    with pytest.raises(ValueError, match="backend"):
+        make_vec_env(cfg, 0, backend="ray")

@@ -98,7 +98,7 @@ def cmd_model(args: argparse.Namespace) -> int:
 
 
 def cmd_mesh(args: argparse.Namespace) -> int:
-    from acld_gym.physics.convergence import format_mesh_report, mesh_report
+    from acld_gym.thesis.mesh_study import format_mesh_report, mesh_report
 
     t0 = time.perf_counter()
     rep = mesh_report()

@@ -45,7 +45,14 @@ from numpy.lib.stride_tricks import as_strided, sliding_window_view
 from scipy.linalg.lapack import dtrtrs
 from scipy.optimize import lsq_linear
 
-from acld_gym.design.discrete import SampledSystem
+from acld_gym.design.discrete import (
+    SampledSystem,
+    _check_steps,
+    _output_rows,
+    _output_vector,
+    convolution_matrix,
+    impulse_response,
+)
 from acld_gym.physics.loads import TipLoad
 from acld_gym.thesis.table2 import V_LIMIT
 
@@ -79,83 +86,6 @@ class BoundSolution:
 
 
 # --- the linear model of an episode --------------------------------------------------------
-
-
-def _output_rows(Ad: np.ndarray, c: np.ndarray, n: int) -> np.ndarray:
-    """Rows :math:`c A_d^m`, m = 0..n-1, as an (n, nx) array.
-
-    By doubling: with rows 0..p-1 known, rows p..2p-1 are those times
-    :math:`A_d^p`; about log2(n) matrix products instead of n vector products.
-    """
-    rows = np.empty((n, Ad.shape[0]))
-    rows[0] = c
-    p, Ap = 1, Ad
-    while p < n:
-        m = min(p, n - p)
-        rows[p:p + m] = rows[:m] @ Ap
-        p += m
-        if p < n:
-            Ap = Ap @ Ap
-    return rows
-
-
-def _system_matrices(system) -> tuple[np.ndarray, np.ndarray]:
-    """(Ad, b): the state matrix and the voltage column of a plant or an (Ad, Bd) pair."""
-    if isinstance(system, SampledSystem):
-        return system.Ad, system.Bd[:, 0]
-    Ad, Bd = (np.asarray(a, dtype=float) for a in system)
-    return Ad, Bd.reshape(Ad.shape[0], -1)[:, 0]
-
-
-def _output_vector(output, nx: int) -> np.ndarray:
-    if isinstance(output, (int, np.integer)) and not isinstance(output, bool):
-        if not 0 <= output < nx:
-            raise ValueError(f"output must be a state index in [0, {nx}), got {output!r}")
-        c = np.zeros(nx)
-        c[output] = 1.0
-        return c
-    c = np.asarray(output, dtype=float).reshape(-1)
-    if c.size != nx:
-        raise ValueError(f"output must be a state index or a row of {nx} weights, "
-                         f"got shape {np.shape(output)}")
-    return c
-
-
-def _check_steps(n: int, name: str) -> None:
-    if not isinstance(n, (int, np.integer)) or isinstance(n, bool) or n < 1:
-        raise ValueError(f"{name} must be a positive integer, got {n!r}")
-
-
-def impulse_response(system, output: int | np.ndarray, n: int) -> np.ndarray:
-    r"""Voltage impulse response :math:`h_m = c\,A_d^m B_d`, m = 0..n-1.
-
-    Parameters
-    ----------
-    system : SampledSystem or (Ad, Bd)
-        The sampled plant (any state dimension; the first input column is used,
-        ``Bd`` may be a 1-D column).
-    output : int or array_like
-        A state index (the tip deflection of the full model) or an output row
-        :math:`c` (e.g. ``C[0]`` of a reduced model).
-    n : int
-        Number of samples, >= 1.
-
-    Returns
-    -------
-    h : ndarray, shape (n,)
-        ``h[m]`` is the output m steps after the period with a unit voltage,
-        i.e. the first column of :func:`convolution_matrix`'s ``G``.
-    """
-    _check_steps(n, "n")
-    Ad, b = _system_matrices(system)
-    return _output_rows(Ad, _output_vector(output, Ad.shape[0]), n) @ b
-
-
-def convolution_matrix(h: np.ndarray) -> np.ndarray:
-    """Lower-triangular Toeplitz matrix ``G[k, j] = h[k - j]`` (k >= j), so ``G @ v`` is the
-    response to the input sequence ``v`` (dense, n x n)."""
-    h = np.asarray(h, dtype=float)
-    return sla.toeplitz(h, np.zeros_like(h))
 
 
 def free_response(plant: SampledSystem, tip_index: int | np.ndarray, load: TipLoad,

@@ -14,10 +14,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from acld_gym.design.discrete import convolution_matrix, impulse_response
 from acld_gym.design.feedback import (
     THESIS_LQR_WEIGHT,
     THESIS_SMC_WEIGHT,
+    Feedback,
     discrete_lqr_gain,
+    passive,
 )
 from acld_gym.envs.episode import Nominal, nominal
 from acld_gym.envs.fingerprint import design_fingerprint
@@ -53,13 +56,18 @@ class _Policy:
                              f"({self.k + 1} values), got shape {obs.shape}")
         return obs[..., : self.k] * self.nom.xr_scale
 
-    def voltage(self, xr: np.ndarray) -> np.ndarray:  # pragma: no cover - abstract
-        raise NotImplementedError
+    #: The voltage law on the reduced state (:class:`acld_gym.design.feedback.Feedback`);
+    #: set by the subclass (MPC has none: it solves a QP).
+    law: Feedback
 
-    def small_signal_gain(self) -> np.ndarray:  # pragma: no cover - abstract
+    def voltage(self, xr: np.ndarray) -> np.ndarray:
+        """Requested voltage [V] for reduced states ``xr`` (n, k)."""
+        return self.law.voltage(xr)
+
+    def small_signal_gain(self) -> np.ndarray:
         """K with V = -K x_r where no limit or switching is active (the linearization
         about rest), for stability checks (:mod:`baselines.robustness`)."""
-        raise NotImplementedError
+        return self.law.small_signal_gain()
 
     def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
         """SB3 protocol: returns ``(actions, state)``; actions in volts, shape (n, 1) or (1,)."""
@@ -75,11 +83,9 @@ class PassivePolicy(_Policy):
 
     name = "passive"
 
-    def voltage(self, xr):
-        return np.zeros(xr.shape[0])
-
-    def small_signal_gain(self) -> np.ndarray:
-        return np.zeros(self.k)
+    def __init__(self, dt: float = 1e-3, nom=None, mesh: str = "converged"):
+        super().__init__(dt, nom, mesh)
+        self.law = passive(self.k)
 
 
 class LQRPolicy(_Policy):
@@ -94,12 +100,8 @@ class LQRPolicy(_Policy):
         sr = self.nom.reduced
         self.K, _ = discrete_lqr_gain(sr.Ad, sr.Bd, self.nom.design.state_weight(weight),
                                       np.eye(1))
-
-    def voltage(self, xr):
-        return -(xr @ self.K[0])
-
-    def small_signal_gain(self) -> np.ndarray:
-        return self.K[0].copy()
+        z = np.zeros_like(self.K[0])
+        self.law = Feedback(a=self.K[0], s=z, c=0.0, eps=1.0, name="lqr")
 
 
 class SMCPolicy(_Policy):
@@ -139,13 +141,8 @@ class SMCPolicy(_Policy):
         self.a = (self.s @ sr.Ad) / self.sb
         self.c = float(np.sign(self.sb)) * eta_factor * abs(float(self.s @ sr.Ed[:, 0]) / self.sb)
         self.eps = float(eps)
-
-    def voltage(self, xr):
-        return -(xr @ self.a) - self.c * np.clip((xr @ self.s) / self.eps, -1.0, 1.0)
-
-    def small_signal_gain(self) -> np.ndarray:
-        """Inside the boundary layer: :math:`V = -(a + c\\,s/\varepsilon)\\,x_r`."""
-        return self.a + (self.c / self.eps) * self.s
+        # the law itself is the continuous design's form (acld_gym.design.feedback)
+        self.law = Feedback(a=self.a, s=self.s, c=self.c, eps=self.eps, name="smc")
 
 
 #: MPC's fraction of the thesis LQR state weight (see :class:`MPCPolicy`): the smallest
@@ -195,8 +192,12 @@ class MPCPolicy(_Policy):
         sr, C = self.nom.reduced, self.nom.design.reduced.C
         A, B = sr.Ad, sr.Bd[:, 0]
         H, n = horizon, A.shape[0]
-        # u in units of 120 V, y in mm.
-        # Predictions: x_{k+j} = A^j x + sum_i A^{j-1-i} B u_i, j = 1..H.
+        # u in units of 120 V, y in mm. Output predictions y_{k+j} = C A^j x + (h * u)_j
+        # (the impulse response's Toeplitz matrix, acld_gym.design.discrete), and, for the
+        # state weight, state predictions x_{k+j} = A^j x + sum_i A^{j-1-i} B u_i.
+        s = V_LIMIT / 1e-3
+        h = impulse_response((A, sr.Bd), C[0], H)
+        self.Theta = convolution_matrix(h) * s
         Phi = np.empty((H, n, n))
         Gam = np.zeros((H, n, H))
         Aj = np.eye(n)
@@ -206,7 +207,6 @@ class MPCPolicy(_Policy):
             Gam[j, :, j] = B * V_LIMIT
             Aj = A @ Aj
             Phi[j] = Aj
-        self.Theta = np.einsum("k,jkh->jh", C[0], Gam) / 1e-3
         self.Psi = np.einsum("k,jkn->jn", C[0], Phi) / 1e-3
         # beta x^T Q x in these units: Q is in V^2 per state (R = 1 V^2), u is V / 120.
         Qx = state_weight * self.nom.design.state_weight(THESIS_LQR_WEIGHT) / V_LIMIT**2

@@ -136,7 +136,7 @@ def bench_breakdown(seconds: float) -> list[tuple[str, float]]:
     else:
         rows.append(("(acld_gym._stepcore not built: numpy steps only)", float("nan")))
     ref = ACLDBeamEnv(**KW)
-    ref._compiled = False
+    ref.compiled_step = False
     rows.append(("single env step, numpy reference path [us]",
                  _episode_step_us(ref, acts, max(1, episodes // 5))))
     rows.append(("no-op Gymnasium env in Python, same spaces and info [us]",

@@ -15,15 +15,17 @@ from stable_baselines3.common.monitor import Monitor
 from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
 
 from acld_gym.envs.beam_env import ACLDBeamEnv
+from acld_gym.physics.loads import THESIS_CASES
 from acld_gym.util.atomic import write_text
 
 from .vec import VecAgentEnv
 
-__all__ = ["THESIS_CASES", "EpisodeMetrics", "ThesisCaseMonitor", "SaveVecNormalize",
+__all__ = ["THESIS_CASES", "CURVE_FILE", "EpisodeMetrics", "ThesisCaseMonitor", "SaveVecNormalize",
            "PhysicsRolloutLogger", "EvalPhysicsLogger", "thesis_eval_env", "lqr_reference_ise",
            "make_eval_callback"]
 
-THESIS_CASES = (1, 2, 3)
+#: File name of a run's learning curve (the evaluations on the thesis cases).
+CURVE_FILE = "learning_curve.csv"
 CURVE_FIELDS = ("timesteps", "case", "ise", "ise_rel_lqr", "peak_mm", "tip_rms_mm",
                 "max_voltage_V")
 
@@ -192,4 +194,4 @@ def make_eval_callback(cfg, out: Path, n_envs: int) -> EvalCallback:
         eval_freq=max(cfg.eval_freq // n_envs, 1), deterministic=True,
         best_model_save_path=str(out / "best"), log_path=str(out / "eval"),
         callback_on_new_best=SaveVecNormalize(out / "best" / "vecnormalize.pkl"),
-        callback_after_eval=EvalPhysicsLogger(out / "learning_curve.csv"), verbose=0)
+        callback_after_eval=EvalPhysicsLogger(out / CURVE_FILE), verbose=0)

@@ -141,11 +141,11 @@ def plot_learning_curves(agents: dict, directory: Path) -> Path | None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from .callbacks import lqr_reference_ise
+    from .callbacks import CURVE_FILE, lqr_reference_ise
 
     curves = {}
     for name, agent in agents.items():
-        path = None if agent.directory is None else agent.directory / "learning_curve.csv"
+        path = None if agent.directory is None else agent.directory / CURVE_FILE
         if path is not None and path.is_file():
             with path.open() as fh:
                 curves[name] = list(csv.DictReader(fh))

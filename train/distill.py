@@ -28,6 +28,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from acld_gym.thesis.table2 import V_LIMIT
+
 __all__ = ["DistillConfig", "actor_mean", "distill", "fit_sign", "TEACHERS"]
 
 #: Reference policies that can serve as teacher (``baselines.policies``).
@@ -141,9 +143,9 @@ def distill(model, venv, cfg: DistillConfig, seed: int = 0, log=None) -> list[di
     """
     import torch
 
-    if venv.venv.map.residual is not None:
+    if venv.venv.residual is not None:
         raise ValueError("distill needs the plain voltage map (residual: null), got "
-                         f"residual {venv.venv.map.residual!r}")
+                         f"residual {venv.venv.residual!r}")
     from baselines.evaluate import default_policies
 
     teacher = default_policies()[cfg.teacher]
@@ -163,7 +165,7 @@ def distill(model, venv, cfg: DistillConfig, seed: int = 0, log=None) -> list[di
                 m = f(torch.as_tensor(obs, dtype=torch.float32)).numpy()
             student = np.tanh(m) if squash else np.clip(m, -1.0, 1.0)
             use = rng.random(len(raw)) < beta
-            action = np.where(use, volts[:, 0] / 120.0, student)
+            action = np.where(use, volts[:, 0] / V_LIMIT, student)
             raw_it.append(raw.copy())
             sign_it.append(np.where(volts[:, 0] >= 0.0, 1.0, -1.0))
             obs, _, _, _ = venv.step(action[:, None].astype(np.float32))

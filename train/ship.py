@@ -11,6 +11,7 @@ from pathlib import Path
 from acld_gym.util.atomic import write_text
 
 from .agent import META_FILE, MODEL_FILE, POLICY_FILE, STATS_FILE, TrainedAgent
+from .callbacks import CURVE_FILE
 from .compare import AGENTS_DIR
 
 __all__ = ["ship", "best_timesteps", "main"]
@@ -37,7 +38,7 @@ def ship(run: str | Path, name: str, agents_dir: str | Path = AGENTS_DIR) -> Pat
     ``policy.npz`` and ``metadata.json``, nothing pickled) and its learning curve to
     ``agents_dir/name``, atomically per file; returns that directory."""
     run = Path(run)
-    needed = [run / "best" / POLICY_FILE, run / "best" / META_FILE, run / "learning_curve.csv"]
+    needed = [run / "best" / POLICY_FILE, run / "best" / META_FILE, run / CURVE_FILE]
     for f in needed:
         if not f.is_file():
             raise FileNotFoundError(f"run directory {str(run)!r} lacks {f.relative_to(run)}")
@@ -46,7 +47,7 @@ def ship(run: str | Path, name: str, agents_dir: str | Path = AGENTS_DIR) -> Pat
     agent.metadata["best_timesteps"] = best_timesteps(needed[2])
     dst = Path(agents_dir) / name
     agent.save(dst)
-    write_text(dst / "learning_curve.csv", needed[2].read_text())
+    write_text(dst / CURVE_FILE, needed[2].read_text())
     for stale in (MODEL_FILE, STATS_FILE):  # pickled files of an older format
         (dst / stale).unlink(missing_ok=True)
     return dst

@@ -22,7 +22,9 @@ __all__ = ["trial", "score_run", "main"]
 
 def score_run(out: str | Path) -> float:
     """Mean ISE / ISE_LQR over the thesis cases at the run's last evaluation."""
-    path = Path(out) / "learning_curve.csv"
+    from .callbacks import CURVE_FILE
+
+    path = Path(out) / CURVE_FILE
     with path.open() as fh:
         rows = list(csv.DictReader(fh))
     if not rows:

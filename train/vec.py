@@ -94,6 +94,11 @@ class VecAgentEnv(VecEnvWrapper):
         self.P = None if shaping is None else lq_potential(self.gamma, shaping, mesh=mesh)
         self._obs: np.ndarray | None = None
 
+    @property
+    def residual(self) -> str | None:
+        """The action map's residual (None or ``"lqr"``)."""
+        return self.map.residual
+
     def potential(self, obs: np.ndarray) -> np.ndarray:
         z = np.asarray(obs, dtype=np.float64)[:, : self.P.shape[0]]
         return -np.einsum("ni,ij,nj->n", z, self.P, z)

@@ -32,12 +32,9 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
-__all__ = ["SampledSystem", "discretize"]
+from acld_gym.design.numerics import expm_balanced
 
-
-def _expm_balanced(F: np.ndarray) -> np.ndarray:
-    _, (d, _) = sla.matrix_balance(F, permute=False, separate=True)
-    return sla.expm(F * d[None, :] / d[:, None]) * d[:, None] / d[None, :]
+__all__ = ["SampledSystem", "discretize", "impulse_response", "convolution_matrix"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -102,7 +99,7 @@ def discretize(A: np.ndarray, B: np.ndarray, E: np.ndarray, dt: float,
     F = np.zeros((n + 1, n + 1))
     F[:n, :n] = A
     F[:n, n] = B[:, 0]
-    Phi = _expm_balanced(F * dt)
+    Phi = expm_balanced(F, dt)
     Ad, Bd = Phi[:n, :n], Phi[:n, n:n + 1]
     # One sub-step h with a constant input c and a ramp r(s) = s/h (r' = 1/h):
     # expm gives G = int e^{A(h-s)} E ds and Rm = int e^{A(h-s)} E s/h ds.
@@ -111,12 +108,12 @@ def discretize(A: np.ndarray, B: np.ndarray, E: np.ndarray, dt: float,
     Fh[:n, n] = E[:, 0]
     Fh[:n, n + 1] = E[:, 0]
     Fh[n + 1, n + 2] = 1.0 / h
-    P = _expm_balanced(Fh * h)
+    P = expm_balanced(Fh, h)
     G = P[:n, n]                # int_0^h e^{A(h-s)} E ds
     Rm = P[:n, n + 2]           # int_0^h e^{A(h-s)} E (s/h) ds
     # Linear interpolation f = f0 (1 - s/h) + f1 s/h on a sub-interval.
     w0, w1 = G - Rm, Rm
-    Ah = _expm_balanced(A * h)
+    Ah = expm_balanced(A, h)
     W0 = np.empty((n, substeps))
     W1 = np.empty((n, substeps))
     prop = np.eye(n)
@@ -125,3 +122,81 @@ def discretize(A: np.ndarray, B: np.ndarray, E: np.ndarray, dt: float,
         W1[:, i] = prop @ w1
         prop = Ah @ prop
     return SampledSystem(Ad=Ad, Bd=Bd, W0=W0, W1=W1, dt=float(dt))
+
+
+# --- responses of a sampled system ---------------------------------------------------
+def _output_rows(Ad: np.ndarray, c: np.ndarray, n: int) -> np.ndarray:
+    """Rows :math:`c A_d^m`, m = 0..n-1, as an (n, nx) array.
+
+    By doubling: with rows 0..p-1 known, rows p..2p-1 are those times
+    :math:`A_d^p`; about log2(n) matrix products instead of n vector products.
+    """
+    rows = np.empty((n, Ad.shape[0]))
+    rows[0] = c
+    p, Ap = 1, Ad
+    while p < n:
+        m = min(p, n - p)
+        rows[p:p + m] = rows[:m] @ Ap
+        p += m
+        if p < n:
+            Ap = Ap @ Ap
+    return rows
+
+
+def _system_matrices(system) -> tuple[np.ndarray, np.ndarray]:
+    """(Ad, b): the state matrix and the voltage column of a plant or an (Ad, Bd) pair."""
+    if isinstance(system, SampledSystem):
+        return system.Ad, system.Bd[:, 0]
+    Ad, Bd = (np.asarray(a, dtype=float) for a in system)
+    return Ad, Bd.reshape(Ad.shape[0], -1)[:, 0]
+
+
+def _output_vector(output, nx: int) -> np.ndarray:
+    if isinstance(output, (int, np.integer)) and not isinstance(output, bool):
+        if not 0 <= output < nx:
+            raise ValueError(f"output must be a state index in [0, {nx}), got {output!r}")
+        c = np.zeros(nx)
+        c[output] = 1.0
+        return c
+    c = np.asarray(output, dtype=float).reshape(-1)
+    if c.size != nx:
+        raise ValueError(f"output must be a state index or a row of {nx} weights, "
+                         f"got shape {np.shape(output)}")
+    return c
+
+
+def _check_steps(n: int, name: str) -> None:
+    if not isinstance(n, (int, np.integer)) or isinstance(n, bool) or n < 1:
+        raise ValueError(f"{name} must be a positive integer, got {n!r}")
+
+
+def impulse_response(system, output: int | np.ndarray, n: int) -> np.ndarray:
+    r"""Voltage impulse response :math:`h_m = c\,A_d^m B_d`, m = 0..n-1.
+
+    Parameters
+    ----------
+    system : SampledSystem or (Ad, Bd)
+        The sampled plant (any state dimension; the first input column is used,
+        ``Bd`` may be a 1-D column).
+    output : int or array_like
+        A state index (the tip deflection of the full model) or an output row
+        :math:`c` (e.g. ``C[0]`` of a reduced model).
+    n : int
+        Number of samples, >= 1.
+
+    Returns
+    -------
+    h : ndarray, shape (n,)
+        ``h[m]`` is the output m steps after the period with a unit voltage,
+        i.e. the first column of :func:`convolution_matrix`'s ``G``.
+    """
+    _check_steps(n, "n")
+    Ad, b = _system_matrices(system)
+    return _output_rows(Ad, _output_vector(output, Ad.shape[0]), n) @ b
+
+
+def convolution_matrix(h: np.ndarray) -> np.ndarray:
+    """Lower-triangular Toeplitz matrix ``G[k, j] = h[k - j]`` (k >= j), so ``G @ v`` is the
+    response to the input sequence ``v`` (dense, n x n)."""
+    h = np.asarray(h, dtype=float)
+    return sla.toeplitz(h, np.zeros_like(h))

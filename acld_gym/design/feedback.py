@@ -68,6 +68,11 @@ class Feedback:
             v = v - self.c * np.clip((xr @ self.s) / self.eps, -1.0, 1.0)
         return v if v_max is None else np.clip(v, -v_max, v_max)
 
+    def small_signal_gain(self) -> np.ndarray:
+        """K with V = -K x_r inside the boundary layer and below the limit:
+        :math:`a + (c/\varepsilon)\\,s`."""
+        return self.a + (self.c / self.eps) * self.s
+
 
 def passive(k: int) -> Feedback:
     """No control (V = 0): the passive (PCLD) beam."""

@@ -14,7 +14,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
-__all__ = ["DiagonalScaling", "balancing_scaling", "lyap_controllability", "lyap_observability",
+__all__ = ["DiagonalScaling", "balancing_scaling", "expm_balanced", "lyap_controllability",
+           "lyap_observability",
            "care_gain"]
 
 
@@ -34,6 +35,14 @@ def balancing_scaling(A: np.ndarray) -> DiagonalScaling:
     """Diagonal scaling that balances row and column norms of ``A`` (no permutation)."""
     _, (d, _) = sla.matrix_balance(A, permute=False, separate=True)
     return DiagonalScaling(np.asarray(d, dtype=float))
+
+
+def expm_balanced(F: np.ndarray, t: float = 1.0) -> np.ndarray:
+    r""":math:`e^{F t} = D\,e^{D^{-1} F D\,t}\,D^{-1}` with the balancing D of F: the
+    exponential of a badly scaled matrix (this model's span ~1e7 1/s) without losing
+    the small entries. The one matrix exponential of the package."""
+    _, (d, _) = sla.matrix_balance(F, permute=False, separate=True)
+    return sla.expm((F * d[None, :] / d[:, None]) * t) * d[:, None] / d[None, :]
 
 
 def _sym(X: np.ndarray) -> np.ndarray:

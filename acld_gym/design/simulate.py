@@ -25,9 +25,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg as sla
 
 from acld_gym.design.feedback import Feedback
+from acld_gym.design.numerics import expm_balanced
 from acld_gym.design.observer import Observer
 from acld_gym.physics.loads import TipLoad
 
@@ -140,11 +140,7 @@ class ClosedLoop:
         key = (reg, round(h, 15))
         P = self._cache.get(key)
         if P is None:
-            F = self.F0 + np.outer(self.bu, self.voltage_row(reg))
-            # Balance before the exponential: e^{Fh} = D e^{D^-1 F D h} D^-1.
-            _, (d, _) = sla.matrix_balance(F, permute=False, separate=True)
-            Fs = F * d[None, :] / d[:, None]
-            P = sla.expm(Fs * h) * d[:, None] / d[None, :]
+            P = expm_balanced(self.F0 + np.outer(self.bu, self.voltage_row(reg)), h)
             self._cache[key] = P
         return P
 

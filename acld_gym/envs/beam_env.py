@@ -197,7 +197,9 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
     # and gives the new measurement, the observation and the info's numbers. The step
     # runs in C (acld_gym._stepcore.StepCore) where it can, else in numpy (_step); the
     # core holds the step count, voltage, last measurement and last output for both.
-    _compiled = COMPILED_STEP  # False on an instance (before reset): numpy steps only
+    #: Step in C where it can (``COMPILED_STEP``); set False on an instance to force the
+    #: numpy reference step from the next reset on (benchmarks and tests compare the two).
+    compiled_step = COMPILED_STEP
 
     k = property(lambda self: self._core.k, lambda self, val: setattr(self._core, "k", val),
                  doc="Steps taken in the episode.")
@@ -249,7 +251,7 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
 
     def _make_core(self):
         """The step's core over this episode's arrays (state: at rest)."""
-        if not (self._compiled and COMPILED_STEP):
+        if not (self.compiled_step and COMPILED_STEP):
             return _NumpyCore(self._G.shape[0])
         core = StepCore(G=self._G, z=self._z, inputs=self._inputs, tipf=self._tipf,
                         y_hist=self.y_hist, nk=self._nk, n_x=self._n,

@@ -12,10 +12,9 @@ from acld_gym.design.pipeline import Design
 from acld_gym.design.simulate import SimulationResult, simulate
 from acld_gym.physics.loads import THESIS_CASES, thesis_load
 from acld_gym.thesis.metrics import max_abs, peak, settling_time
-from acld_gym.thesis.table2 import V_LIMIT, thesis_row
-from acld_gym.thesis.table2 import Table2Row as Row
+from acld_gym.thesis.table2 import PASSIVE_CASE1_PEAK_MM, V_LIMIT, Table2Row, thesis_row
 
-__all__ = ["Row", "run_cases", "format_table2", "T_END"]
+__all__ = ["Table2Row", "run_cases", "format_table2", "T_END"]
 
 #: Simulated window [s]; the thesis's settling times all lie below 1 s and
 #: do not change with a longer window.
@@ -24,7 +23,7 @@ CONTROLLERS = ("passive", "lqr", "smc")
 
 
 def run_cases(d: Design, cases: Iterable[int] = THESIS_CASES, observer: str = "thesis",
-              t_end: float = T_END, on_result: Callable | None = None) -> list[Row]:
+              t_end: float = T_END, on_result: Callable | None = None) -> list[Table2Row]:
     """Simulate every (case, controller, saturation) and return the rows.
 
     The passive beam does not depend on the limit: it is simulated once and
@@ -32,7 +31,7 @@ def run_cases(d: Design, cases: Iterable[int] = THESIS_CASES, observer: str = "t
     """
     A, B, E, Cy = d.plant
     obs = d.observer(observer)
-    rows: list[Row] = []
+    rows: list[Table2Row] = []
     for case in cases:
         load = thesis_load(case)
         for name in CONTROLLERS:
@@ -42,7 +41,7 @@ def run_cases(d: Design, cases: Iterable[int] = THESIS_CASES, observer: str = "t
                 if res is None or name != "passive":
                     res = simulate(A, B, E, Cy, obs, fb, load, t_end=t_end,
                                    v_max=V_LIMIT if sat else None)
-                row = Row(case, name, sat, peak(res.y) * 1e3, settling_time(res.t, res.y),
+                row = Table2Row(case, name, sat, peak(res.y) * 1e3, settling_time(res.t, res.y),
                           max_abs(res.voltage))
                 rows.append(row)
                 if on_result is not None:
@@ -54,7 +53,7 @@ def _pct(ours: float, ref: float) -> str:
     return f"{100.0 * (ours - ref) / ref:+6.1f}%"
 
 
-def format_table2(rows: list[Row], t_end: float = T_END) -> str:
+def format_table2(rows: list[Table2Row], t_end: float = T_END) -> str:
     """Table 2 with thesis value, ours and the difference per cell."""
     head = (f"{'case':>4} {'ctrl':>7} {'sat':>4} | {'peak [mm]':^25} | {'settling [s]':^27} | "
             f"{'max |V| [V]':^25}")
@@ -65,8 +64,9 @@ def format_table2(rows: list[Row], t_end: float = T_END) -> str:
         ref = thesis_row(r.case, r.controller, r.saturation)
         ts = f"{r.settling_s:8.4f}" if r.settling_s < t_end else f">{t_end:7.2f}"
         if ref is None:
-            ref_pk = "0.675" if (r.case == 1 and r.controller == "passive") else "-"
-            d_pk = _pct(r.peak_mm, 0.675) if ref_pk != "-" else ""
+            passive1 = r.case == 1 and r.controller == "passive"
+            ref_pk = f"{PASSIVE_CASE1_PEAK_MM:.3f}" if passive1 else "-"
+            d_pk = _pct(r.peak_mm, PASSIVE_CASE1_PEAK_MM) if passive1 else ""
             out.append(f"{r.case:>4} {r.controller:>7} {('on' if r.saturation else 'off'):>4} | "
                        f"{ref_pk:>7} {r.peak_mm:7.3f} {d_pk:>8} | {'-':>7} {ts} {'':>8} | "
                        f"{'-':>7} {r.max_voltage_V:7.0f} {'':>8}")

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass
 
-__all__ = ["Table2Row", "ThesisRow", "TABLE2", "PASSIVE_CASE1_PEAK_MM", "FIRST_RESONANCE_RAD_S",
+__all__ = ["Table2Row", "TABLE2", "PASSIVE_CASE1_PEAK_MM", "FIRST_RESONANCE_RAD_S",
            "V_LIMIT", "thesis_row"]
 
 #: Voltage limit of the saturated runs [V] (sec. 5.3).
@@ -35,27 +35,23 @@ class Table2Row:
         return asdict(self)
 
 
-#: The thesis's rows use the same record as ours.
-ThesisRow = Table2Row
-
-
-TABLE2: tuple[ThesisRow, ...] = (
-    ThesisRow(1, "lqr", True, 0.666, 0.3400, 120.0),
-    ThesisRow(1, "smc", True, 0.672, 0.3350, 120.0),
-    ThesisRow(1, "lqr", False, 0.594, 0.1125, 2380.0),
-    ThesisRow(1, "smc", False, 0.561, 0.0755, 2258.0),
-    ThesisRow(2, "lqr", True, 0.955, 0.4750, 120.0),
-    ThesisRow(2, "smc", True, 0.952, 0.4610, 120.0),
-    ThesisRow(2, "lqr", False, 0.624, 0.2250, 2445.0),
-    ThesisRow(2, "smc", False, 0.562, 0.1720, 2258.0),
-    ThesisRow(3, "lqr", True, 4.480, 0.9500, 120.0),
-    ThesisRow(3, "smc", True, 4.475, 0.9300, 120.0),
-    ThesisRow(3, "lqr", False, 1.145, 0.2980, 1622.0),
-    ThesisRow(3, "smc", False, 0.716, 0.2485, 1675.0),
+TABLE2: tuple[Table2Row, ...] = (
+    Table2Row(1, "lqr", True, 0.666, 0.3400, 120.0),
+    Table2Row(1, "smc", True, 0.672, 0.3350, 120.0),
+    Table2Row(1, "lqr", False, 0.594, 0.1125, 2380.0),
+    Table2Row(1, "smc", False, 0.561, 0.0755, 2258.0),
+    Table2Row(2, "lqr", True, 0.955, 0.4750, 120.0),
+    Table2Row(2, "smc", True, 0.952, 0.4610, 120.0),
+    Table2Row(2, "lqr", False, 0.624, 0.2250, 2445.0),
+    Table2Row(2, "smc", False, 0.562, 0.1720, 2258.0),
+    Table2Row(3, "lqr", True, 4.480, 0.9500, 120.0),
+    Table2Row(3, "smc", True, 4.475, 0.9300, 120.0),
+    Table2Row(3, "lqr", False, 1.145, 0.2980, 1622.0),
+    Table2Row(3, "smc", False, 0.716, 0.2485, 1675.0),
 )
 
 
-def thesis_row(case: int, controller: str, saturation: bool) -> ThesisRow | None:
+def thesis_row(case: int, controller: str, saturation: bool) -> Table2Row | None:
     """The Table 2 row for a configuration, or None (e.g. passive)."""
     for r in TABLE2:
         if (r.case, r.controller, r.saturation) == (case, controller, saturation):

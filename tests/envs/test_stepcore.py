@@ -31,7 +31,7 @@ def test_compiled_step_was_built():
 
 def _env(compiled: bool, **kw) -> ACLDBeamEnv:
     env = ACLDBeamEnv(**kw)
-    env._compiled = compiled  # takes effect at the next reset
+    env.compiled_step = compiled  # takes effect at the next reset
     return env
 
 

@@ -16,12 +16,13 @@ import pytest
 from acld_gym.design.pipeline import design
 from acld_gym.design.simulate import simulate
 from acld_gym.physics.loads import thesis_load
-from acld_gym.thesis.reproduce import Row, format_table2, run_cases
+from acld_gym.thesis.reproduce import format_table2, run_cases
 from acld_gym.thesis.table2 import (
     FIRST_RESONANCE_RAD_S,
     PASSIVE_CASE1_PEAK_MM,
     TABLE2,
     V_LIMIT,
+    Table2Row,
     thesis_row,
 )
 
@@ -38,7 +39,7 @@ def rows(d):
     return run_cases(d)  # ~5-8 s: the full 18-row study
 
 
-def _row(rows, case, ctrl, sat) -> Row:
+def _row(rows, case, ctrl, sat) -> Table2Row:
     (r,) = [r for r in rows if (r.case, r.controller, r.saturation) == (case, ctrl, sat)]
     return r
 
@@ -56,7 +57,8 @@ def test_passive_case1_peak(rows):
     r = _row(rows, 1, "passive", False)
     assert r.peak_mm == pytest.approx(PASSIVE_CASE1_PEAK_MM, rel=0.02)
     assert r.max_voltage_V == 0.0
-    assert _row(rows, 1, "passive", True) == Row(1, "passive", True, r.peak_mm, r.settling_s, 0.0)
+    assert _row(rows, 1, "passive", True) == Table2Row(1, "passive", True, r.peak_mm,
+                                                       r.settling_s, 0.0)
 
 
 def test_first_damped_frequency(d):

@@ -170,4 +170,7 @@ def main(argv=None) -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from acld_gym.util.blas import one_blas_thread
+
+    with one_blas_thread():  # as the package's entry points run (acld_gym.util.blas)
+        main()

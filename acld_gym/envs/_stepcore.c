@@ -3,7 +3,8 @@
  *
  * ``StepCore.step(action)`` is ACLDBeamEnv.step's common path in C: one
  * matrix-vector product ``out = G z`` (plant, observer, measurement,
- * observation and info in one, see acld_gym.env.output_matrix) plus the
+ * observation and info in one, see acld_gym.envs.step.output_matrix; the slots are
+ * acld_gym.envs.step.StepLayout's, passed in as integers) plus the
  * bookkeeping (clipping, reward, limits, the 5-tuple and the info dict). It
  * returns None where the Python reference path must take over (an action that
  * is not a finite 1-element float32/float64 array, a step past the tabulated
@@ -32,13 +33,16 @@ typedef struct {
     PyObject_HEAD
     PyArrayObject *G;      /* (m, nz) float64, C order: the step's fused matrix */
     PyArrayObject *z;      /* (nz,) float64: [x, xhat, y_meas, V, f0.., f1.., w'] */
-    PyArrayObject *inputs; /* (max_steps, nz - nk - 2) float64: per-step [f0.., f1.., w'] */
+    PyArrayObject *inputs; /* (max_steps, nz - i_in) float64: per-step [f0.., f1.., w'] */
     PyArrayObject *tipf;   /* (max_steps + 1,) float64: tip load at the period starts [N] */
     PyArrayObject *y_hist; /* (hist,) float64: last measurements [m] */
     PyArrayObject *last;   /* (m,) float64: G z of the last step (overwritten each step) */
     PyObject *info_template; /* the info dict's 7 keys, copied per step (no resizing) */
     double *Gt;            /* G transposed (nz, m), so the product runs down contiguous columns */
-    npy_intp m, nz, nk, n_x, n_xr, n_obs, n_in, hist;
+    npy_intp m, nz, n_x, n_xr, n_obs, n_in, hist;
+    /* the layout (acld_gym.envs.step.StepLayout): z's updated state and its voltage and
+       inputs slots; G z's measurement, deflection, x_r and estimate-observation slots */
+    npy_intp n_state, i_volt, i_in, o_ymeas, o_y, o_xr, o_obs;
     long k, max_steps;
     int obs_mode, active;
     double v, y_meas, dt, y_ref, lam, v_max, limit, y_scale;
@@ -110,24 +114,29 @@ core_dealloc(StepCore *self)
 static int
 core_init(StepCore *self, PyObject *args, PyObject *kwds)
 {
-    static char *kwlist[] = {"G", "z", "inputs", "tipf", "y_hist", "nk", "n_x", "n_xr",
+    static char *kwlist[] = {"G", "z", "inputs", "tipf", "y_hist", "n_state", "i_voltage",
+                             "i_inputs", "o_ymeas", "o_y", "o_xr", "o_obs", "n_x", "n_xr",
                              "obs_mode", "n_obs", "dt", "y_ref", "lam", "v_max", "limit",
                              "y_scale", NULL};
     PyObject *G, *z, *inputs, *tipf, *y_hist;
-    Py_ssize_t nk, n_x, n_xr, n_obs;
+    Py_ssize_t n_state, i_volt, i_in, o_ymeas, o_y, o_xr, o_obs, n_x, n_xr, n_obs;
     int obs_mode;
     double dt, y_ref, lam, v_max, limit, y_scale;
-    if (!PyArg_ParseTupleAndKeywords(args, kwds, "$OOOOOnnnindddddd", kwlist, &G, &z, &inputs,
-                                     &tipf, &y_hist, &nk, &n_x, &n_xr, &obs_mode, &n_obs, &dt,
-                                     &y_ref, &lam, &v_max, &limit, &y_scale))
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "$OOOOOnnnnnnnnnindddddd", kwlist, &G, &z,
+                                     &inputs, &tipf, &y_hist, &n_state, &i_volt, &i_in,
+                                     &o_ymeas, &o_y, &o_xr, &o_obs, &n_x, &n_xr, &obs_mode,
+                                     &n_obs, &dt, &y_ref, &lam, &v_max, &limit, &y_scale))
         return -1;
     if (check_array(G, "G", 2, -1) || check_array(z, "z", 1, -1))
         return -1;
     npy_intp m = PyArray_DIM((PyArrayObject *)G, 0), nz = PyArray_DIM((PyArrayObject *)G, 1);
-    npy_intp n_in = nz - nk - 2;
-    if (PyArray_DIM((PyArrayObject *)z, 0) != nz || nk < 1 || n_in < 1 || n_xr < 0
-        || m < nk + 2 + n_xr || n_x < 1 || n_x > nk) {
-        PyErr_SetString(PyExc_ValueError, "StepCore: inconsistent sizes of G, z, nk, n_x, n_xr");
+    npy_intp n_in = nz - i_in;
+    /* every slot inside its vector, the updated state before the voltage and inputs */
+    if (PyArray_DIM((PyArrayObject *)z, 0) != nz || n_state < 1 || n_x < 1 || n_x > n_state
+        || i_volt < n_state || i_volt >= nz || i_in <= i_volt || n_in < 1 || n_xr < 0
+        || n_state > m || o_ymeas < 0 || o_ymeas >= m || o_y < 0 || o_y >= m
+        || o_xr < 0 || o_xr + n_xr > m || o_obs < 0 || o_obs > m) {
+        PyErr_SetString(PyExc_ValueError, "StepCore: inconsistent sizes of G, z and the layout");
         return -1;
     }
     if (check_array(inputs, "inputs", 2, n_in) || check_array(tipf, "tipf", 1, -1)
@@ -140,7 +149,7 @@ core_init(StepCore *self, PyObject *args, PyObject *kwds)
     }
     npy_intp hist = PyArray_DIM((PyArrayObject *)y_hist, 0);
     /* estimate: the last n_obs outputs, after [x', xhat', y_meas', y', x_r'] */
-    int ok = (obs_mode == OBS_ESTIMATE && n_obs <= m - (nk + 2 + n_xr))
+    int ok = (obs_mode == OBS_ESTIMATE && o_obs + n_obs <= m)
              || (obs_mode == OBS_MEASUREMENT && n_obs == hist + 1)
              || (obs_mode == OBS_FULL && n_obs == n_x);
     if (!ok || n_obs < 1 || hist < 1) {
@@ -177,7 +186,9 @@ core_init(StepCore *self, PyObject *args, PyObject *kwds)
     self->last = (PyArrayObject *)last;
     self->info_template = tmpl;
     self->Gt = Gt;
-    self->m = m; self->nz = nz; self->nk = nk; self->n_x = n_x; self->n_xr = n_xr;
+    self->m = m; self->nz = nz; self->n_x = n_x; self->n_xr = n_xr;
+    self->n_state = n_state; self->i_volt = i_volt; self->i_in = i_in;
+    self->o_ymeas = o_ymeas; self->o_y = o_y; self->o_xr = o_xr; self->o_obs = o_obs;
     self->n_obs = n_obs;
     self->n_in = n_in; self->hist = hist; self->max_steps = (long)max_steps;
     self->obs_mode = obs_mode; self->k = 0; self->v = 0.0; self->y_meas = 0.0;
@@ -216,22 +227,22 @@ core_step(StepCore *self, PyObject *action)
 
     const double v = requested < -self->v_max ? -self->v_max
                      : (requested > self->v_max ? self->v_max : requested);
-    const npy_intp nk = self->nk, m = self->m;
+    const npy_intp m = self->m;
     double *z = PyArray_DATA(self->z);
     double *o = PyArray_DATA(self->last);
     PyObject *xr = PyArray_SimpleNew(1, &self->n_xr, NPY_DOUBLE);  /* info's own copy */
     if (xr == NULL) return NULL;
 
     /* 1.-3. plant (ZOH), observer and the new measurement: one product */
-    z[nk + 1] = v;
-    memcpy(z + nk + 2, (double *)PyArray_DATA(self->inputs) + self->k * self->n_in,
+    z[self->i_volt] = v;
+    memcpy(z + self->i_in, (double *)PyArray_DATA(self->inputs) + self->k * self->n_in,
            (size_t)self->n_in * sizeof(double));
     product(self->Gt, z, o, m, self->nz);
-    memcpy(z, o, (size_t)(nk + 1) * sizeof(double));
+    memcpy(z, o, (size_t)self->n_state * sizeof(double));
     const long k = ++self->k;
     self->v = v;
-    self->y_meas = o[nk];
-    const double y = o[nk + 1];
+    self->y_meas = o[self->o_ymeas];
+    const double y = o[self->o_y];
 
     /* 4. reward on the true deflection, 5. limits: beyond the deflection limit, or any
        non-finite number in the new state (never passed off as a normal step) */
@@ -244,7 +255,7 @@ core_step(StepCore *self, PyObject *action)
 
     PyObject *obs;
     if (self->obs_mode == OBS_ESTIMATE) {
-        obs = float32_copy(o + m - self->n_obs, self->n_obs, 1.0);
+        obs = float32_copy(o + self->o_obs, self->n_obs, 1.0);
     } else if (self->obs_mode == OBS_FULL) {
         obs = float32_copy(z, self->n_x, 1.0);
     } else {
@@ -262,7 +273,7 @@ core_step(StepCore *self, PyObject *action)
         Py_DECREF(xr);
         return NULL;
     }
-    memcpy(PyArray_DATA((PyArrayObject *)xr), o + nk + 2, (size_t)self->n_xr * sizeof(double));
+    memcpy(PyArray_DATA((PyArrayObject *)xr), o + self->o_xr, (size_t)self->n_xr * sizeof(double));
     const double tip_load = ((double *)PyArray_DATA(self->tipf))[k];
     PyObject *info = PyDict_Copy(self->info_template);
     PyObject *why = !finite ? s_nonfinite : (over ? s_limit : Py_None);

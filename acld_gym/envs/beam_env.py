@@ -23,6 +23,7 @@ from acld_gym.envs.fingerprint import observation_fingerprint
 from acld_gym.envs.render import FigureOwner
 from acld_gym.envs.step import (
     Y_SCALE,
+    StepLayout,
     estimate_map,
     load_schedule,
     observation_size,
@@ -210,7 +211,9 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
                       doc="Last tip measurement [m].")
     _last = property(lambda self: self._core.last,
                      doc="G z of the last step (:func:`output_matrix`; one buffer).")
-    x = property(lambda self: self._z[:self._n], doc="True plant state [q; dq/dt] (a view).")
+    x = property(lambda self: self._z[self._layout.x],
+                 doc="True plant state [q; dq/dt] (a view).")
+    xhat = property(lambda self: self._z[self._layout.xhat], doc="Observer state (a view).")
     @property
     def spec(self):
         """The registration spec (set by ``gym.make``), with ``max_episode_steps`` the
@@ -231,21 +234,20 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
     def observation_fingerprint(self) -> dict:
         """What the observation depends on (:mod:`acld_gym.envs.fingerprint`)."""
         return observation_fingerprint(self)
-    xhat = property(lambda self: self._z[self._n:self._nk], doc="Observer state (a view).")
 
     def _reset_state(self, load: TipLoad) -> None:
         self.load = load
-        n, k = self._plant.Ad.shape[0], self._obs.n
-        self._n = n
-        self._nk = nk = n + k
-        self._z = np.zeros(nk + 3 + 2 * self._plant.substeps)
+        self._layout = lay = StepLayout(n=self._plant.Ad.shape[0], k=self._obs.n,
+                                        r=self.nom.design.reduced.order,
+                                        substeps=self._plant.substeps)
+        self._z = np.zeros(lay.z_size)
         self.y_hist = np.zeros(self.obs_hist)
         self.history: list[tuple[float, float, float]] = []
         F, tipf = load_schedule(self.nom.plant, load, 0, self.max_steps)
         self._tipf = np.ascontiguousarray(tipf, dtype=np.float64)
         self._noise = np.zeros(self.max_steps + 1)
         self._inputs = np.hstack([F, self._noise[1:, None]])  # per step: [f0, f1, w']
-        self._G = output_matrix(step_matrix(self._plant, self.nom.plant, self._obs), n, k,
+        self._G = output_matrix(step_matrix(self._plant, self.nom.plant, self._obs), lay,
                                 self.nom.output, self.nom.design.reduced.SL, self._est)
         self._core = self._make_core()
 
@@ -254,8 +256,7 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
         if not (self.compiled_step and COMPILED_STEP):
             return _NumpyCore(self._G.shape[0])
         core = StepCore(G=self._G, z=self._z, inputs=self._inputs, tipf=self._tipf,
-                        y_hist=self.y_hist, nk=self._nk, n_x=self._n,
-                        n_xr=self.nom.design.reduced.order,
+                        y_hist=self.y_hist, **self._layout.core_kwargs(),
                         obs_mode=OBS_MODES.index(self.obs_mode),
                         n_obs=self.observation_space.shape[0], dt=self.dt, y_ref=self.y_ref,
                         lam=self.lam, v_max=self.v_max, limit=self.deflection_limit,
@@ -302,17 +303,17 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
 
     def _observation(self) -> np.ndarray:
         if self.obs_mode == "estimate":
-            return self._last[-(self._est.shape[1] + 1):].astype(np.float32)
+            return self._last[self._layout.out_estimate].astype(np.float32)
         if self.obs_mode == "measurement":
             return np.append(self.y_hist / Y_SCALE, self.v / self.v_max).astype(np.float32)
         return self.x.astype(np.float32)
 
     def _info(self, requested: float | None = None) -> dict[str, Any]:
-        k, nk = self.k, self._nk
+        k, lay = self.k, self._layout
         tip_load = float(self._tipf[k]) if k <= self.max_steps else float(self.load(k * self.dt))
-        return {"tip_deflection": float(self._last[nk + 1]), "voltage": self.v,
+        return {"tip_deflection": float(self._last[lay.out_y]), "voltage": self.v,
                 "tip_load": tip_load, "time": k * self.dt,
-                "xr_true": self._last[nk + 2:nk + 2 + self.nom.design.reduced.order].copy(),
+                "xr_true": self._last[lay.out_xr].copy(),
                 "clipped": requested is not None and requested != self.v,
                 "requested_voltage": self.v if requested is None else requested,
                 "terminated_by": None}
@@ -326,10 +327,11 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
         self._reset_state(load)
         self._draw_noise()
         w = float(self._noise[0])  # the beam starts at rest: the first measurement is noise
-        self.y_meas = self._z[self._nk] = w
+        lay = self._layout
+        self.y_meas = self._z[lay.y_meas] = w
         self.y_hist[-1] = w
-        self._last[self._nk] = w
-        self._last[-(self._est.shape[1] + 1):] = w * np.append(self._est[-1], 1.0 / Y_SCALE)
+        self._last[lay.y_meas] = w
+        self._last[lay.out_estimate] = w * np.append(self._est[-1], 1.0 / Y_SCALE)
         return self._observation(), self._info()
 
     def step(self, action):
@@ -343,17 +345,17 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
         if isinstance(self._core, _NotReset):
             raise RuntimeError("ACLDBeamEnv: call reset() before step()")
         v, requested = self._voltage(action)
-        c, z, nk = self._core, self._z, self._nk
+        c, z, lay = self._core, self._z, self._layout
         k = c.k
-        z[nk + 1] = v
-        z[nk + 2:] = self._step_inputs(k)
+        z[lay.voltage] = v
+        z[lay.inputs] = self._step_inputs(k)
         # 1. plant (ZOH) and 2. observer over one period, 3. the new measurement
         out = np.dot(self._G, z, out=c.last)
-        z[:nk + 1] = out[:nk + 1]
+        z[lay.state] = out[lay.state]
         c.k = k = k + 1
         c.v = v
-        c.y_meas = float(out[nk])
-        y = float(out[nk + 1])
+        c.y_meas = float(out[lay.y_meas])
+        y = float(out[lay.out_y])
         if self.obs_mode == "measurement":
             self.y_hist[:-1] = self.y_hist[1:]
             self.y_hist[-1] = c.y_meas

@@ -4,6 +4,7 @@ matrix of the whole step, the load schedule, the reward and the end of an episod
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -15,12 +16,97 @@ from acld_gym.physics.loads import TipLoad
 if TYPE_CHECKING:
     from acld_gym.envs.episode import Nominal
 
-__all__ = ["Y_SCALE", "observation_size", "estimate_map", "step_matrix", "output_matrix",
+__all__ = ["StepLayout", "Y_SCALE", "observation_size", "estimate_map", "step_matrix",
+           "output_matrix",
            "load_schedule", "reward_of", "termination"]
 
 
 #: Deflection scale of the observations [m].
 Y_SCALE = 1e-3
+
+
+@dataclass(frozen=True)
+class StepLayout:
+    """Which slot of the step's vectors holds what: the one owner of the layout, read by
+    the single env, the vector env and the compiled step (as integers,
+    :meth:`core_kwargs`).
+
+    Input ``z = [x, xhat, y_meas, V, f0 (s), f1 (s), w']``: plant state (n), observer
+    state (k), last measurement, voltage, the period's load samples at the s sub-steps'
+    starts and ends, and the new measurement's noise (the vector env's Z is z without
+    w'). Output ``G z = [x', xhat', y_meas', y', x_r', e', y_meas' / Y_SCALE]``: the next
+    state (its first :attr:`state` entries replace z's), the true tip deflection, the
+    true reduced state (r), and the ``"estimate"`` observation (r + 1).
+    """
+
+    n: int
+    k: int
+    r: int
+    substeps: int
+
+    # --- input z -------------------------------------------------------------------
+    @property
+    def x(self) -> slice:
+        return slice(0, self.n)
+
+    @property
+    def xhat(self) -> slice:
+        return slice(self.n, self.n + self.k)
+
+    @property
+    def state(self) -> slice:
+        """x, xhat and y_meas: what one step advances."""
+        return slice(0, self.n + self.k + 1)
+
+    @property
+    def y_meas(self) -> int:
+        return self.n + self.k
+
+    @property
+    def voltage(self) -> int:
+        return self.n + self.k + 1
+
+    @property
+    def loads(self) -> slice:
+        return slice(self.n + self.k + 2, self.n + self.k + 2 + 2 * self.substeps)
+
+    @property
+    def noise(self) -> int:
+        return self.loads.stop
+
+    @property
+    def inputs(self) -> slice:
+        """The per-step inputs ``[f0, f1, w']`` (tabulated for an episode)."""
+        return slice(self.loads.start, self.z_size)
+
+    @property
+    def z_size(self) -> int:
+        return self.noise + 1
+
+    # --- output G z ----------------------------------------------------------------
+    @property
+    def out_y(self) -> int:
+        return self.n + self.k + 1
+
+    @property
+    def out_xr(self) -> slice:
+        return slice(self.out_y + 1, self.out_y + 1 + self.r)
+
+    @property
+    def out_estimate(self) -> slice:
+        """The ``"estimate"`` observation: the scaled x_r estimate and the tip."""
+        return slice(self.out_xr.stop, self.out_xr.stop + self.r + 1)
+
+    @property
+    def out_size(self) -> int:
+        return self.out_estimate.stop
+
+    def core_kwargs(self) -> dict[str, int]:
+        """The layout as the compiled step takes it (``acld_gym.envs._stepcore``)."""
+        return {"n_state": self.state.stop, "i_voltage": self.voltage,
+                "i_inputs": self.inputs.start, "o_ymeas": self.y_meas, "o_y": self.out_y,
+                "o_xr": self.out_xr.start, "o_obs": self.out_estimate.start, "n_x": self.n,
+                "n_xr": self.r}
 
 
 def observation_size(nom: Nominal, obs_mode: str, hist: int) -> int:
@@ -56,23 +142,22 @@ def step_matrix(plant: SampledSystem, nom_plant: SampledSystem,
     return S
 
 
-def output_matrix(S: np.ndarray, n: int, k: int, output: np.ndarray, SL: np.ndarray,
+def output_matrix(S: np.ndarray, layout: StepLayout, output: np.ndarray, SL: np.ndarray,
                   est: np.ndarray) -> np.ndarray:
-    """The single env's whole step as one matrix G, from :func:`step_matrix` S.
-
-    Input ``z = [x, xhat, y_meas, V, f0, f1, w']`` (S's input and the noise w' of the
-    new measurement); output ``G z = [x', xhat', y_meas', y', x_r', e', y_meas' / Y_SCALE]``
-    with ``y' = output @ x'`` the true tip deflection, ``y_meas' = y' + w'``,
-    ``x_r' = S_L^T x'`` the true reduced state and ``e' = [xhat', y_meas'] M`` the
-    scaled estimate (:func:`estimate_map` M). So ``(G z)[:n+k+1]`` is the next state
-    and ``(G z)[-7:]`` the ``"estimate"`` observation.
+    """The single env's whole step as one matrix G, from :func:`step_matrix` S, in the
+    slots of ``layout`` (:class:`StepLayout`): ``y' = output @ x'`` the true tip
+    deflection, ``y_meas' = y' + w'``, ``x_r' = S_L^T x'`` the true reduced state and
+    ``e' = [xhat', y_meas'] M`` the scaled estimate (:func:`estimate_map` M).
     """
-    X = np.hstack([S[:n + k], np.zeros((n + k, 1))])
-    y = output @ X[:n]
+    n, k = layout.n, layout.k
+    X = np.hstack([S[:n + k], np.zeros((n + k, 1))])  # S's input and the noise w'
+    y = output @ X[layout.x]
     y_meas = y.copy()
-    y_meas[-1] = 1.0
-    e = est[:k].T @ X[n:] + np.outer(est[k], y_meas)
-    return np.vstack([X, y_meas, y, SL.T @ X[:n], e, y_meas / Y_SCALE])
+    y_meas[layout.noise] = 1.0
+    e = est[:k].T @ X[layout.xhat] + np.outer(est[k], y_meas)
+    G = np.vstack([X, y_meas, y, SL.T @ X[layout.x], e, y_meas / Y_SCALE])
+    assert G.shape == (layout.out_size, layout.z_size)
+    return G
 
 
 def load_schedule(plant: SampledSystem, load: TipLoad, start: int,

@@ -36,6 +36,7 @@ from acld_gym.envs.episode import SENSOR_NOISE_M, draw_episode, reset_options
 from acld_gym.envs.render import FigureOwner
 from acld_gym.envs.step import (
     Y_SCALE,
+    StepLayout,
     estimate_map,
     load_schedule,
     observation_size,
@@ -98,15 +99,17 @@ class ACLDBeamVectorEnv(FigureOwner, VectorEnv):
         self.single_observation_space = spaces.Box(-np.inf, np.inf, (n_obs,), np.float32)
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
 
-        N, n, k = self.num_envs, self.nom.plant.Ad.shape[0], self._obs.n
-        self._n, self._k = n, k
+        N = self.num_envs
+        self._layout = lay = StepLayout(n=self.nom.plant.Ad.shape[0], k=self._obs.n,
+                                        r=self.nom.design.reduced.order,
+                                        substeps=self.nom.plant.substeps)
         self._S_nom = step_matrix(self.nom.plant, self.nom.plant, self._obs)
         self._ST = np.ascontiguousarray(self._S_nom.T)
         # Per-env step matrices only with parameter noise (batched einsum).
         self._S = (np.repeat(self._S_nom[None], N, axis=0) if self.param_noise > 0 else None)
-        # Z = [x, xhat, y_meas, V, f0, f1]: the step is new[:, :n+k] = Z @ S.T.
-        self._Z = np.zeros((N, self._S_nom.shape[1]))
-        self._ycol, self._vcol, self._fcol = n + k, n + k + 1, n + k + 2
+        # Z: the layout's z without the noise slot; the step is Z[:, x + xhat] = Z @ S.T.
+        self._Z = np.zeros((N, lay.noise))
+        self._adv = slice(0, lay.k + lay.n)  # what S advances (y_meas is set separately)
         # Load tables: rows 0..2 thesis cases 1..3, rows 3.. one per sub-env (random loads).
         self._pool_F = np.zeros((3, steps, 2 * self.nom.plant.substeps))
         self._pool_tip = np.zeros((3, steps + 1))
@@ -168,32 +171,32 @@ class ACLDBeamVectorEnv(FigureOwner, VectorEnv):
             self._noise[i] = rng.normal(0.0, self.sensor_noise, self.horizon + 1)
         self._Z[i] = 0.0
         y = self._noise[i, 0]
-        self._Z[i, self._ycol] = y
+        self._Z[i, self._layout.y_meas] = y
         self._y_hist[i] = 0.0
         self._y_hist[i, -1] = y
         self._clipped[i] = False
         self._why[i] = None
 
     def _observations(self) -> np.ndarray:
-        Z, n, k = self._Z, self._n, self._k
-        y = Z[:, self._ycol]
+        Z, lay = self._Z, self._layout
+        y = Z[:, lay.y_meas]
         if self.obs_mode == "estimate":
             out = np.empty((self.num_envs, self._est.shape[1] + 1))
-            np.matmul(Z[:, n:n + k + 1], self._est, out=out[:, :-1])
+            np.matmul(Z[:, lay.xhat.start:lay.y_meas + 1], self._est, out=out[:, :-1])
             out[:, -1] = y / Y_SCALE
         elif self.obs_mode == "measurement":
             out = np.empty((self.num_envs, self.obs_hist + 1))
             out[:, :-1] = self._y_hist / Y_SCALE
-            out[:, -1] = Z[:, self._vcol] / self.v_max
+            out[:, -1] = Z[:, lay.voltage] / self.v_max
         else:
-            out = Z[:, :n]
+            out = Z[:, lay.x]
         return out.astype(np.float32)
 
     def _infos(self) -> dict[str, Any]:
         N = self.num_envs
         ones = np.ones(N, dtype=bool)
-        vals = {"tip_deflection": self._Z[:, :self._n] @ self._out,
-                "voltage": self._Z[:, self._vcol].copy(),
+        vals = {"tip_deflection": self._Z[:, self._layout.x] @ self._out,
+                "voltage": self._Z[:, self._layout.voltage].copy(),
                 "tip_load": self._pool_tip[self._slot, self._steps],
                 "time": self._steps * self.dt,
                 "clipped": self._clipped.copy(),
@@ -230,18 +233,18 @@ class ACLDBeamVectorEnv(FigureOwner, VectorEnv):
         if self._needs_reset:
             raise RuntimeError("ACLDBeamVectorEnv: call reset() before step()")
         requested, v = check_actions(actions, self.num_envs, self.v_max, vector=True)
-        Z, n, k, idx = self._Z, self._n, self._k, self._idx
+        Z, lay, idx = self._Z, self._layout, self._idx
         reset = self._prev_done
-        Z[:, self._vcol] = v
-        Z[:, self._fcol:] = self._pool_F[self._slot, np.minimum(self._steps, self.horizon - 1)]
+        Z[:, lay.voltage] = v
+        Z[:, lay.loads] = self._pool_F[self._slot, np.minimum(self._steps, self.horizon - 1)]
         if self._S is None:
-            Z[:, :n + k] = Z @ self._ST
+            Z[:, self._adv] = Z @ self._ST
         else:
-            Z[:, :n + k] = np.einsum("nij,nj->ni", self._S, Z)
+            Z[:, self._adv] = np.einsum("nij,nj->ni", self._S, Z)
         self._steps += 1
-        y_true = Z[:, :n] @ self._out
+        y_true = Z[:, lay.x] @ self._out
         y = y_true + self._noise[idx, np.minimum(self._steps, self.horizon)]
-        Z[:, self._ycol] = y
+        Z[:, lay.y_meas] = y
         self._y_hist[:, :-1] = self._y_hist[:, 1:]
         self._y_hist[:, -1] = y
         self._clipped = requested != v
@@ -296,8 +299,8 @@ class _EnvView:
     def __init__(self, venv: ACLDBeamVectorEnv, i: int):
         self.nom = venv.nom
         self.render_mode = venv.render_mode
-        self.x = venv._Z[i, :venv._n]
-        self.v = float(venv._Z[i, venv._vcol])
+        self.x = venv._Z[i, venv._layout.x]
+        self.v = float(venv._Z[i, venv._layout.voltage])
         self.k = int(venv._steps[i])
         self.dt = venv.dt
         self.load = venv._loads[i]

@@ -161,6 +161,9 @@ def test_rendering_steps_in_numpy_and_records_history():
     (dict(obs_mode=3), "obs_mode"),
     (dict(n_obs=8), "obs_mode"),
     (dict(n_x=100), "inconsistent sizes"),
+    (dict(o_obs=55), "obs_mode"),
+    (dict(i_inputs=10), "inconsistent sizes"),
+    (dict(o_xr=58), "inconsistent sizes"),
     (dict(z=np.zeros(134)[::2]), "z must be"),
     (dict(tipf=np.zeros(1001, ">f8")), "tipf must be"),
 ])
@@ -170,7 +173,7 @@ def test_core_constructor_rejects_inconsistent_arrays(change, match):
     env = ACLDBeamEnv(mesh="thesis")  # the sizes below are the thesis mesh's
     env.reset(seed=0)
     args = dict(G=env._G, z=env._z, inputs=env._inputs, tipf=env._tipf, y_hist=env.y_hist,
-                nk=env._nk, n_x=env._n, n_xr=6, obs_mode=0, n_obs=7, dt=1e-3, y_ref=1e-3,
+                **env._layout.core_kwargs(), obs_mode=0, n_obs=7, dt=1e-3, y_ref=1e-3,
                 lam=0.01, v_max=120.0, limit=0.02, y_scale=1e-3)
     StepCore(**args)  # the env's own arguments are accepted
     with pytest.raises(ValueError, match=match):
@@ -242,3 +245,21 @@ def test_bad_actions_are_rejected_and_leave_the_state_intact(compiled, action):
         env.step(action)
     assert np.array_equal(env._z, before[0]) and (env.k, env.v) == before[1:3]
     assert env.np_random.bit_generator.state == before[3]
+
+
+def test_layout_owns_every_slot():
+    # The fused step's layout (acld_gym.envs.step.StepLayout): its slots tile z and G z
+    # exactly, and the env's matrix G has its shape.
+    from acld_gym.envs.step import StepLayout
+
+    for mesh in ("thesis", "converged"):
+        env = ACLDBeamEnv(mesh=mesh)
+        lay = env._layout
+        assert isinstance(lay, StepLayout) and env._G.shape == (lay.out_size, lay.z_size)
+        z_slots = [lay.x, lay.xhat, slice(lay.y_meas, lay.y_meas + 1),
+                   slice(lay.voltage, lay.voltage + 1), lay.loads,
+                   slice(lay.noise, lay.noise + 1)]
+        assert [s.start for s in z_slots[1:]] == [s.stop for s in z_slots[:-1]]
+        assert z_slots[-1].stop == lay.z_size
+        assert lay.out_estimate.stop == lay.out_size
+        assert lay.out_estimate.stop - lay.out_estimate.start == env.observation_space.shape[0]

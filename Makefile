@@ -4,7 +4,7 @@ VENV    := .venv
 BIN     := $(VENV)/bin
 STAMP   := $(VENV)/.installed-stamp
 
-.PHONY: install run test test-slow lint format bench agents clean
+.PHONY: install run studies test test-slow lint format bench agents clean
 
 $(STAMP): pyproject.toml constraints.txt setup.py acld_gym/envs/_stepcore.c
 	$(PY) -m venv $(VENV)
@@ -18,21 +18,28 @@ $(STAMP): pyproject.toml constraints.txt setup.py acld_gym/envs/_stepcore.c
 
 install: $(STAMP)
 
-## Reproduce the thesis (Table 2, figures), evaluate the reference policies in the env,
-## then compare the shipped PPO/SAC agents with them (thesis cases + held-out random loads).
+## Reproduce the thesis (Table 2, figures, on its own mesh), then on ACLDBeam-v1 (the
+## mesh-converged beam): evaluate the reference policies and the bound, and compare the
+## shipped agents with them (thesis cases + held-out random loads). A progress line
+## shows on a terminal.
 run: $(STAMP)
 	$(BIN)/acld-gym reproduce --json results/table2.json --plots results/figures
 	$(BIN)/python -m baselines.evaluate --json results/baselines.json --plots results/figures
 	$(BIN)/python -m train.compare --json results/compare.json --plots results/figures
 
-## Retrain the shipped agents (the commands in train/agents/*/metadata.json; about a
-## minute each on 2 cores). The shipped files are each run's best/ checkpoint.
+## The README's slower studies: mesh convergence and the thesis mesh against the converged
+## plant, and the baselines' stability at every corner of the parameter box.
+studies: $(STAMP)
+	$(BIN)/acld-gym mesh --json results/mesh.json
+	$(BIN)/python -m baselines.robustness
+
+## Retrain the shipped DAgger agents (the commands in train/agents/*/metadata.json) and
+## ship each run's best checkpoint. The teacher-free agents come from the benchmark
+## (python -m train.benchmark; README, "Reinforcement learning without a teacher").
 agents: $(STAMP)
-	$(BIN)/python -m train ppo --seed 0 --out runs/ppo --no-progress
-	$(BIN)/python -m train sac --seed 0 --out runs/sac --no-progress
-	$(BIN)/python -m train ppo --seed 0 --param-noise 0.1 --out runs/ppo_robust --no-progress
-	$(BIN)/python -m train sac --seed 0 --param-noise 0.1 --out runs/sac_robust --no-progress
-	for a in ppo sac ppo_robust sac_robust; do $(BIN)/python -m train.ship runs/$$a $$a; done
+	$(BIN)/python -m train ppo --config train/ppo_dagger.yaml --seed 0 --out runs/ppo_dagger --no-progress
+	$(BIN)/python -m train sac --config train/sac_dagger.yaml --seed 0 --out runs/sac_dagger --no-progress
+	for a in ppo_dagger sac_dagger; do $(BIN)/python -m train.ship runs/$$a $$a; done
 
 ## Lint + the test suite (slow tests excluded; see test-slow).
 test: $(STAMP)
@@ -49,6 +56,7 @@ format: $(STAMP)
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_reproduce.py
 	$(BIN)/python benchmarks/bench_env.py
+	$(BIN)/python benchmarks/bench_bound.py
 	$(BIN)/python benchmarks/bench_train.py --timesteps 32768 --n-envs 8
 
 clean:

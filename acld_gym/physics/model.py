@@ -26,8 +26,16 @@ import scipy.linalg as sla
 from acld_gym.physics.assembly import AssembledTerms, DofMap, assemble_terms, number_dofs
 from acld_gym.physics.params import PRESETS, BeamParameters, Mesh, split_overrides
 
-__all__ = ["BeamModel", "ParametricModel", "first_order", "build_model", "parametric_model",
-           "resolve"]
+__all__ = ["BeamModel", "ParametricModel", "first_order", "oscillatory_modes", "build_model",
+           "parametric_model", "resolve"]
+
+
+def oscillatory_modes(A: np.ndarray) -> np.ndarray:
+    """The eigenvalues :math:`\\sigma + j\\omega` of ``A`` with :math:`\\omega > 0`, by
+    frequency [1/s]: one per oscillatory mode (real, overdamped poles are no modes)."""
+    lam = np.linalg.eigvals(A)
+    lam = lam[lam.imag > 1e-9 * np.abs(lam)]
+    return lam[np.argsort(lam.imag)]
 
 
 def first_order(M: np.ndarray, C: np.ndarray, K: np.ndarray, Pc: np.ndarray, Fd: np.ndarray,
@@ -113,9 +121,7 @@ class BeamModel:
         These are the imaginary parts of the complex pole pairs of A (one value
         per pair); overdamped (real) poles are not modes and are left out.
         """
-        p = self.poles
-        im = p.imag[p.imag > 1e-9 * np.abs(p)]
-        return np.sort(im)
+        return oscillatory_modes(self.state_space()[0]).imag
 
     def undamped_frequencies(self) -> np.ndarray:
         """sqrt(eig(K, M)) [rad/s], ascending: the undamped second-order system

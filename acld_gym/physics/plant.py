@@ -53,7 +53,12 @@ import numpy as np
 import scipy.linalg as sla
 
 from acld_gym.physics.elements import PIEZO_COEFFICIENT, TERM_COEFFICIENTS
-from acld_gym.physics.model import ParametricModel, first_order, parametric_model
+from acld_gym.physics.model import (
+    ParametricModel,
+    first_order,
+    oscillatory_modes,
+    parametric_model,
+)
 from acld_gym.physics.params import BeamParameters, Mesh
 
 __all__ = ["Plant", "fe_plant", "thesis_plant", "band_of"]
@@ -147,15 +152,12 @@ class Plant:
 
     def natural_frequencies(self) -> np.ndarray:
         """Damped natural frequencies [rad/s] of the oscillatory modes, ascending."""
-        lam = np.linalg.eigvals(self.state_space()[0])
-        return np.sort(lam.imag[lam.imag > 1e-9 * np.abs(lam)])
+        return self.modes().imag
 
     def modes(self) -> np.ndarray:
         """Oscillatory eigenvalues :math:`\\sigma + j\\omega` (:math:`\\omega > 0`) by
         frequency [1/s]."""
-        lam = np.linalg.eigvals(self.state_space()[0])
-        lam = lam[lam.imag > 1e-9 * np.abs(lam)]
-        return lam[np.argsort(lam.imag)]
+        return oscillatory_modes(self.state_space()[0])
 
 
 # --- the two presets -----------------------------------------------------------------

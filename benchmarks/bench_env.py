@@ -1,4 +1,4 @@
-"""Env-steps per second of ACLDBeam-v0: single env, native vector env, SB3 adapter.
+"""Env-steps per second of ACLDBeam-v1: single env, native vector env, SB3 adapter.
 
 Then the single env's step taken apart (resets excluded): the compiled step, its
 matrix-vector product alone (timed in C, mean over the states of an episode), the
@@ -16,12 +16,14 @@ from __future__ import annotations
 
 import argparse
 import os
+import subprocess
+import sys
 import time
 
 import gymnasium as gym
 import numpy as np
 
-import acld_gym  # noqa: F401  (registers ACLDBeam-v0)
+import acld_gym  # noqa: F401  (registers ACLDBeam-v1)
 from acld_gym.envs.beam_env import COMPILED_STEP, ACLDBeamEnv
 from acld_gym.envs.sb3 import SB3VecEnv
 from acld_gym.envs.vector_env import ACLDBeamVectorEnv
@@ -87,8 +89,15 @@ class _NoOpEnv(gym.Env):
     def step(self, action):
         v = float(action[0])
         self.k += 1
-        info = {"tip_deflection": 0.0, "voltage": v, "tip_load": 0.0, "time": self.k * 1e-3,
-                "xr_true": np.zeros(6), "clipped": False, "requested_voltage": v}
+        info = {
+            "tip_deflection": 0.0,
+            "voltage": v,
+            "tip_load": 0.0,
+            "time": self.k * 1e-3,
+            "xr_true": np.zeros(6),
+            "clipped": False,
+            "requested_voltage": v,
+        }
         return np.zeros(7, np.float32), -v * v, False, self.k >= 1000, info
 
 
@@ -129,19 +138,37 @@ def bench_breakdown(seconds: float) -> list[tuple[str, float]]:
     if COMPILED_STEP:
         t_step = _episode_step_us(env, acts, episodes)
         t_prod = _product_us(env, acts)
-        rows += [("single env step, compiled (acld_gym._stepcore) [us]", t_step),
-                 (f"  of which the fused {G.shape[0]} x {G.shape[1]} product [us]", t_prod),
-                 ("  the rest: call, action check, reward, obs, info [us]", t_step - t_prod),
-                 ("  product's share of the step [%]", 100 * t_prod / t_step)]
+        rows += [
+            ("single env step, compiled (acld_gym.envs._stepcore) [us]", t_step),
+            (f"  of which the fused {G.shape[0]} x {G.shape[1]} product [us]", t_prod),
+            ("  the rest: call, action check, reward, obs, info [us]", t_step - t_prod),
+            ("  product's share of the step [%]", 100 * t_prod / t_step),
+        ]
     else:
-        rows.append(("(acld_gym._stepcore not built: numpy steps only)", float("nan")))
+        rows.append(("(acld_gym.envs._stepcore not built: numpy steps only)", float("nan")))
     ref = ACLDBeamEnv(**KW)
     ref.compiled_step = False
-    rows.append(("single env step, numpy reference path [us]",
-                 _episode_step_us(ref, acts, max(1, episodes // 5))))
-    rows.append(("no-op Gymnasium env in Python, same spaces and info [us]",
-                 1e6 / bench_single(_NoOpEnv(), seconds)))
+    rows.append(
+        (
+            "single env step, numpy reference path [us]",
+            _episode_step_us(ref, acts, max(1, episodes // 5)),
+        )
+    )
+    rows.append(
+        (
+            "no-op Gymnasium env in Python, same spaces and info [us]",
+            1e6 / bench_single(_NoOpEnv(), seconds),
+        )
+    )
     return rows
+
+
+def _first_make_seconds() -> float:
+    """Wall time of ``import acld_gym; gym.make("ACLDBeam-v1")`` in a new interpreter."""
+    code = "import gymnasium as gym, acld_gym; gym.make('ACLDBeam-v1')"
+    t0 = time.perf_counter()
+    subprocess.run([sys.executable, "-c", code], check=True)
+    return time.perf_counter() - t0
 
 
 def main(argv=None) -> None:
@@ -149,17 +176,27 @@ def main(argv=None) -> None:
     ap.add_argument("--seconds", type=float, default=2.0, help="time per measurement [s]")
     args = ap.parse_args(argv)
     s = args.seconds
-    print(f"ACLDBeam-v0 env-steps/s (load_case='random', obs 'estimate'; {os.cpu_count()} CPUs, "
-          f"numpy {np.__version__}, {s:g} s each; compiled step: {COMPILED_STEP})")
+    print(
+        f"ACLDBeam-v1 env-steps/s (load_case='random', obs 'estimate'; {os.cpu_count()} CPUs, "
+        f"numpy {np.__version__}, {s:g} s each; compiled step: {COMPILED_STEP})"
+    )
+    startup = [_first_make_seconds() for _ in range(3)]
+    print(
+        "first gym.make('ACLDBeam-v1') in a fresh process (import included), 3 runs [s]: "
+        + ", ".join(f"{t:.2f}" for t in startup)
+    )
     rows = [
         ("single ACLDBeamEnv (raw class)", bench_single(ACLDBeamEnv(**KW), s)),
-        ("single gym.make (TimeLimit, OrderEnforcing, PassiveEnvChecker)",
-         bench_single(gym.make("ACLDBeam-v0", **KW), s)),
+        (
+            "single gym.make (OrderEnforcing, PassiveEnvChecker)",
+            bench_single(gym.make("ACLDBeam-v1", **KW), s),
+        ),
     ]
     for n in (1, 64, 1024):
         rows.append((f"ACLDBeamVectorEnv N={n}", bench_vector(n, s)))
-    rows.append(("ACLDBeamVectorEnv N=1024, load_case=1 (cheap resets)",
-                 bench_vector(1024, s, load_case=1)))
+    rows.append(
+        ("ACLDBeamVectorEnv N=1024, load_case=1 (cheap resets)", bench_vector(1024, s, load_case=1))
+    )
     rows.append(("SB3VecEnv N=64 (infos as list of dicts)", bench_sb3(64, s)))
     width = max(len(name) for name, _ in rows)
     for name, rate in rows:

@@ -47,8 +47,12 @@ def _blas_threads() -> str:
             libs = sorted(set(re.findall(r"(/\S*openblas\S*\.so\S*)", f.read())))
         for lib in libs:
             dll = ctypes.CDLL(lib)
-            for name in ("scipy_openblas_get_num_threads64_", "scipy_openblas_get_num_threads",
-                         "openblas_get_num_threads64_", "openblas_get_num_threads"):
+            for name in (
+                "scipy_openblas_get_num_threads64_",
+                "scipy_openblas_get_num_threads",
+                "openblas_get_num_threads64_",
+                "openblas_get_num_threads",
+            ):
                 if hasattr(dll, name):
                     return str(getattr(dll, name)())
     except OSError:
@@ -68,15 +72,23 @@ def _worker(args) -> None:
     tip = nom.design.model.tip_index if tip is None else tip
     plant, n = nom.plant, args.steps
     episodes = [(f"thesis {c}", thesis_load(c)) for c in args.thesis]
-    episodes += [(f"random {s}", random_load(np.random.default_rng(s), n * plant.dt,
-                                             plant.dt / plant.substeps))
-                 for s in range(args.random)]
+    episodes += [
+        (
+            f"random {s}",
+            random_load(np.random.default_rng(s), n * plant.dt, plant.dt / plant.substeps),
+        )
+        for s in range(args.random)
+    ]
     clairvoyant_bound(plant, tip, thesis_load(3), n)  # warm-up (imports, first allocations)
-    print(f"OpenBLAS threads: {_blas_threads()} | busy neighbour: "
-          f"{'yes' if args.busy_label else 'no'} | load average {os.getloadavg()[0]:.2f} | "
-          f"{plant.Ad.shape[0]} states, {n} steps")
-    print(f"{'episode':<10} {'PDAS [ms]':>9} {'BVLS [s]':>9} {'speed-up':>9} "
-          f"{'ISE PDAS [m^2 s]':>17} {'rel. diff':>10}")
+    print(
+        f"OpenBLAS threads: {_blas_threads()} | busy neighbour: "
+        f"{'yes' if args.busy_label else 'no'} | load average {os.getloadavg()[0]:.2f} | "
+        f"{plant.Ad.shape[0]} states, {n} steps"
+    )
+    print(
+        f"{'episode':<10} {'PDAS [ms]':>9} {'BVLS [s]':>9} {'speed-up':>9} "
+        f"{'ISE PDAS [m^2 s]':>17} {'rel. diff':>10}"
+    )
     for name, load in episodes:
         times = []
         for _ in range(args.repeat):
@@ -87,19 +99,31 @@ def _worker(args) -> None:
         t0 = time.perf_counter()
         ref = clairvoyant_bound(plant, tip, load, n, method="bvls")
         t_ref = time.perf_counter() - t0
-        print(f"{name:<10} {1e3 * t_new:9.1f} {t_ref:9.2f} {t_ref / t_new:8.0f}x "
-              f"{new.ise:17.6e} {(new.ise - ref.ise) / ref.ise:10.1e}", flush=True)
+        print(
+            f"{name:<10} {1e3 * t_new:9.1f} {t_ref:9.2f} {t_ref / t_new:8.0f}x "
+            f"{new.ise:17.6e} {(new.ise - ref.ise) / ref.ise:10.1e}",
+            flush=True,
+        )
 
 
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--thesis", type=int, nargs="*", default=[1, 2, 3], choices=[1, 2, 3],
-                   help="thesis load cases")
+    p.add_argument(
+        "--thesis",
+        type=int,
+        nargs="*",
+        default=[1, 2, 3],
+        choices=[1, 2, 3],
+        help="thesis load cases",
+    )
     p.add_argument("--random", type=int, default=3, help="random-load episodes (seeds 0..)")
     p.add_argument("--steps", type=int, default=1000, help="episode length")
     p.add_argument("--repeat", type=int, default=3, help="PDAS runs per episode (median)")
-    p.add_argument("--busy", action="store_true",
-                   help="also time beside a CPU-bound process, with 1 and 2 BLAS threads")
+    p.add_argument(
+        "--busy",
+        action="store_true",
+        help="also time beside a CPU-bound process, with 1 and 2 BLAS threads",
+    )
     p.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     p.add_argument("--busy-label", action="store_true", help=argparse.SUPPRESS)
     args = p.parse_args()
@@ -111,11 +135,25 @@ def main() -> None:
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(1))
     runs = [(1, False)] + ([(1, True), (2, True)] if args.busy else [])
     for threads, busy in runs:
-        env = dict(os.environ, OPENBLAS_NUM_THREADS=str(threads), OMP_NUM_THREADS=str(threads),
-                   MKL_NUM_THREADS=str(threads))
-        cmd = [sys.executable, os.path.abspath(__file__), "--worker", "--random",
-               str(args.random), "--steps", str(args.steps), "--repeat", str(args.repeat),
-               "--thesis", *map(str, args.thesis)]
+        env = dict(
+            os.environ,
+            OPENBLAS_NUM_THREADS=str(threads),
+            OMP_NUM_THREADS=str(threads),
+            MKL_NUM_THREADS=str(threads),
+        )
+        cmd = [
+            sys.executable,
+            os.path.abspath(__file__),
+            "--worker",
+            "--random",
+            str(args.random),
+            "--steps",
+            str(args.steps),
+            "--repeat",
+            str(args.repeat),
+            "--thesis",
+            *map(str, args.thesis),
+        ]
         neighbour = None
         if busy:
             cmd.append("--busy-label")

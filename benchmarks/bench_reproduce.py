@@ -82,8 +82,10 @@ def main() -> None:
         t_rk = time.perf_counter() - t0
         err = np.abs(y - yref).max() / peak(yref)
         full = t_rk * (1.0 / WINDOW) * 15  # 15 distinct runs of 1 s
-        print(f"  RK4 h = {h:.0e} s: rel. error {err:.1e}, {t_rk:.1f} s "
-              f"(extrapolated to the full reproduction: {full / 60:.0f} min)")
+        print(
+            f"  RK4 h = {h:.0e} s: rel. error {err:.1e}, {t_rk:.1f} s "
+            f"(extrapolated to the full reproduction: {full / 60:.0f} min)"
+        )
     y = rk4(loop, load, WINDOW, 1e-5, grid)
     print(f"  RK4 h = 1e-05 s: {'diverges' if not np.all(np.isfinite(y)) else 'finite'}")
 

@@ -40,8 +40,9 @@ def train_rate(backend: str, n_envs: int, steps: int) -> float:
     depend on the backend's speed as much as on the MPC's QPs."""
     from train.cli import train
 
-    cfg = load_config("ppo").with_overrides(n_envs=n_envs, n_timesteps=steps,
-                                            eval_freq=10**9, checkpoint_freq=10**9)
+    cfg = load_config("ppo").with_overrides(
+        n_envs=n_envs, n_timesteps=steps, eval_freq=10**9, checkpoint_freq=10**9
+    )
     cfg = replace(cfg, distill=None)
     with tempfile.TemporaryDirectory() as d:
         t0 = time.perf_counter()

@@ -1,0 +1,147 @@
+"""Evaluation for the teacher-free benchmark (``python -m train.benchmark``).
+
+The agents are scored by ISE / ISE_LQR through the env (+/-120 V, 1 ms, default Kalman
+observer, deterministic policy): thesis cases 1, 2, 3 with seed 0 and the held-out
+random set (:data:`train.compare.HELDOUT_SEEDS`; ``ISE / LQR`` there is the mean ISE
+over the set divided by LQR's mean, as in ``python -m train.compare``). LQR, SMC,
+MPC and the clairvoyant bound are computed here ONLY to normalise and report the
+final numbers; no training loop ever sees them.
+
+Two evaluators:
+
+* :func:`rollout_ise`: one single-env episode per (case, seed) with
+  :func:`baselines.evaluate.rollout` (the final numbers and the references);
+* :func:`batched_ise`: every episode of a case in one native vector env, the policy
+  called once per step on the batch (the learning curves; equal to the former up
+  to floating-point rounding).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+import acld_gym  # registers the env ids
+from acld_gym.util.atomic import write_text
+
+__all__ = ["CASES", "DEFAULT_ENV_ID", "eval_episodes", "rollout_ise",
+           "batched_ise", "relative_ise", "reference_policies", "references"]
+
+DEFAULT_ENV_ID = acld_gym.ENV_ID
+#: Evaluation cases, in table order.
+CASES: tuple = (1, 2, 3, "random")
+
+
+def eval_episodes(random_episodes: int | None = None) -> dict:
+    """``{case: seeds}``: seed 0 for the thesis cases, the held-out seeds (all 20, or the
+    first ``random_episodes``) for ``"random"``."""
+    from .compare import HELDOUT_SEEDS
+
+    n = len(HELDOUT_SEEDS) if random_episodes is None else int(random_episodes)
+    return {1: (0,), 2: (0,), 3: (0,), "random": tuple(HELDOUT_SEEDS[:n])}
+
+
+def _make_env(env_id: str, case):
+    """The env of ``env_id`` without wrappers (it truncates by itself)."""
+    return gym.make(env_id, load_case=case).unwrapped
+
+
+def rollout_ise(policy, env_id: str = DEFAULT_ENV_ID, episodes: dict | None = None) -> dict:
+    """Mean ISE [m^2 s] per case of ``policy`` (SB3 ``predict`` in volts), one single-env
+    episode per seed (:func:`baselines.evaluate.rollout`)."""
+    from baselines.evaluate import metrics_row, rollout
+
+    episodes = eval_episodes() if episodes is None else episodes
+    out = {}
+    for case, seeds in episodes.items():
+        env = _make_env(env_id, case)
+        out[case] = float(np.mean([metrics_row(case, "agent", rollout(policy, env, seed=s)).ise
+                                   for s in seeds]))
+    return out
+
+
+def batched_ise(policy, env_id: str = DEFAULT_ENV_ID, episodes: dict | None = None) -> dict:
+    """Mean ISE [m^2 s] per case, all episodes side by side (one native vector env per
+    case, stepped together; ``policy.predict`` once per step on the whole batch)."""
+    episodes = eval_episodes() if episodes is None else episodes
+    venvs, obs = [], []
+    for case, seeds in episodes.items():
+        venv = gym.make_vec(env_id, num_envs=len(seeds), load_case=case)
+        obs.append(venv.reset(seed=[int(s) for s in seeds])[0])
+        venvs.append(venv)
+    sizes = np.cumsum([len(s) for s in episodes.values()])[:-1]
+    dt = venvs[0].unwrapped.dt
+    n = sum(len(s) for s in episodes.values())
+    ise = np.zeros(n)
+    alive = np.ones(n, dtype=bool)
+    while alive.any():
+        act, _ = policy.predict(np.concatenate(obs), deterministic=True)
+        act = np.asarray(act, dtype=np.float64).reshape(-1, 1)
+        obs, y, done = [], [], []
+        for venv, a in zip(venvs, np.split(act, sizes), strict=True):
+            o, _, term, trunc, info = venv.step(a)
+            obs.append(o)
+            y.append(info["tip_deflection"])
+            done.append(term | trunc)
+        ise += np.where(alive, np.concatenate(y) ** 2 * dt, 0.0)
+        alive &= ~np.concatenate(done)
+    for venv in venvs:
+        venv.close()
+    return {case: float(part.mean()) for case, part in zip(episodes, np.split(ise, sizes),
+                                                           strict=True)}
+
+
+def relative_ise(ise: dict, refs: dict, to: str = "lqr") -> dict:
+    """``{case: ise[case] / refs[to][case]}`` (keys of ``refs`` may be strings, as in JSON)."""
+    ref = refs[to]
+    return {c: ise[c] / ref[str(c)] if str(c) in ref else ise[c] / ref[c] for c in ise}
+
+
+def reference_policies(env_id: str = DEFAULT_ENV_ID) -> dict:
+    """Passive, LQR, SMC and MPC designed on ``env_id``'s own nominal model (used only to
+    report the evaluation, never in training)."""
+    from baselines.policies import LQRPolicy, MPCPolicy, PassivePolicy, SMCPolicy
+
+    env = _make_env(env_id, 1)
+    nom = env.nom
+    return {"passive": PassivePolicy(nom=nom), "lqr": LQRPolicy(nom=nom),
+            "smc": SMCPolicy(nom=nom), "mpc": MPCPolicy(nom=nom)}
+
+
+def references(env_id: str = DEFAULT_ENV_ID, cache: str | Path | None = None,
+               random_episodes: int | None = None, bound: bool = True) -> dict[str, Any]:
+    """Mean ISE per case of passive, LQR, SMC, MPC and the clairvoyant bound,
+    ``{"env_id": ..., "episodes": ..., "passive": {case: ise}, ...}`` (cases as strings).
+
+    Read from ``cache`` (JSON) when it holds the same env id and episodes, else computed
+    (the bound takes about 30 s) and written there atomically.
+    """
+    from baselines.evaluate import bound_episode, metrics_row
+
+    episodes = eval_episodes(random_episodes)
+    key = {str(c): list(s) for c, s in episodes.items()}
+    if cache is not None and Path(cache).is_file():
+        data = json.loads(Path(cache).read_text())
+        if data.get("env_id") == env_id and data.get("episodes") == key \
+                and (not bound or "bound" in data):
+            return data
+    pols = reference_policies(env_id)
+    data: dict[str, Any] = {"env_id": env_id, "episodes": key}
+    for name, pol in pols.items():
+        data[name] = {str(c): v for c, v in rollout_ise(pol, env_id, episodes).items()}
+    if bound:
+        data["bound"] = {}
+        for case, seeds in episodes.items():
+            env = _make_env(env_id, case)
+            vals = []
+            for s in seeds:
+                env.reset(seed=s)
+                vals.append(metrics_row(case, "bound", bound_episode(env)).ise)
+            data["bound"][str(case)] = float(np.mean(vals))
+    if cache is not None:
+        write_text(cache, json.dumps(data, indent=2) + "\n")
+    return data

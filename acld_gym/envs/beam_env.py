@@ -64,9 +64,10 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
     the thesis's own 1 + 1 + 3-element model (38 states) instead. It is sampled
     exactly with a zero-order hold on the voltage; the tip load is integrated
     within each period (sub-steps with first-order hold, exact for pulses). The
-    observer runs on the nominal 6-state reduced model (the design model), never on
+    observer runs on the nominal reduced model (the design model: 8 states on the
+    converged plant, 6 on the thesis mesh), never on
     the (possibly randomized) plant. A step is one fused matrix-vector product
-    (:func:`output_matrix`); it runs in C (``acld_gym._stepcore``) when that module
+    (:func:`output_matrix`); it runs in C (``acld_gym.envs._stepcore``) when that module
     was built (``COMPILED_STEP``), else in numpy, with the same results.
 
     ## Action Space
@@ -86,7 +87,7 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
     | ``"measurement"`` | 9 | last 8 tip measurements, last voltage | y / 1 mm; V / 120 V |
     | ``"full"`` | 36 (38) | true plant state [q; dq/dt] (privileged) | see below |
 
-    x_r is the state of the 6-state reduced model in its canonical real modal
+    x_r is the state of the reduced design model in its canonical real modal
     form (:func:`acld_gym.design.reduction.modal_form`): one (cosine, sine)-like pair per
     mode (modes 1-4 in order; 1-3 on the thesis mesh), the same on every machine. Each component is
     divided by its peak magnitude in the passive response to thesis load case 1
@@ -116,6 +117,12 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
       steps (1 s = 1000 steps by default). ``gym.make`` adds no other limit, and
       ``env.spec.max_episode_steps`` is that step count; ``max_episode_steps=n`` can
       only shorten the episode (a ``TimeLimit`` of n steps).
+    * Limits: at most 1,000,000 steps per episode (``checks.MAX_EPISODE_STEPS``) and
+      4,000,000 tabulated steps over a vector env's sub-envs (``MAX_TABLE_STEPS``): the
+      load and noise of an episode are tabulated at reset (about 350 bytes per step of
+      a single env, 350 MB at the limit; 170 bytes per vector sub-env step), so a
+      longer episode is refused at construction with a ``ValueError`` instead of
+      exhausting memory.
 
     ## Arguments
 
@@ -196,7 +203,7 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
     # The state lives in one buffer z = [x, xhat, y_meas, V, f0, f1, w'] (x and xhat
     # are views into it). One product G z (output_matrix) advances plant and observer
     # and gives the new measurement, the observation and the info's numbers. The step
-    # runs in C (acld_gym._stepcore.StepCore) where it can, else in numpy (_step); the
+    # runs in C (acld_gym.envs._stepcore.StepCore) where it can, else in numpy (_step); the
     # core holds the step count, voltage, last measurement and last output for both.
     #: Step in C where it can (``COMPILED_STEP``); set False on an instance to force the
     #: numpy reference step from the next reset on (benchmarks and tests compare the two).
@@ -339,7 +346,7 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
         return result if result is not None else self._step(action)
 
     def _step(self, action):
-        """The step in numpy: the reference for :class:`acld_gym._stepcore.StepCore`, and
+        """The step in numpy: the reference for :class:`acld_gym.envs._stepcore.StepCore`, and
         the path for actions of other types, bad actions, rendering and steps past the
         tabulated episode."""
         if isinstance(self._core, _NotReset):
@@ -403,7 +410,7 @@ class _NotReset:
 
 
 class _NumpyCore:
-    """The state :class:`acld_gym._stepcore.StepCore` keeps, without a compiled step
+    """The state :class:`acld_gym.envs._stepcore.StepCore` keeps, without a compiled step
     (every step goes to ``ACLDBeamEnv._step``)."""
 
     __slots__ = ("k", "v", "y_meas", "last")

@@ -3,7 +3,8 @@
 ``python -m baselines.evaluate [--mesh converged|thesis] [--json PATH] [--plots DIR]``
 prints a table per case (peak [mm], 5 % settling [s], ISE [m^2 s], max |V| [V],
 return) for passive, LQR, SMC, MPC and the clairvoyant bound, all with the +/-120 V
-limit, 1 ms control and the default Kalman observer. Any object with SB3's
+limit, 1 ms control and the default Kalman observer; on the thesis mesh it also prints
+the saturated LQR/SMC rows against thesis Table 2. Any object with SB3's
 ``predict`` can be evaluated with :func:`rollout`, so trained agents use the same
 code; a policy that records an ``observation_fingerprint`` is checked against the
 env's before it acts.
@@ -25,6 +26,7 @@ from acld_gym.envs.fingerprint import fingerprint_differences, observation_finge
 from acld_gym.envs.step import reward_of
 from acld_gym.physics.truth import MESHES
 from acld_gym.thesis.metrics import max_abs, peak, settling_time
+from acld_gym.thesis.table2 import thesis_row
 from acld_gym.util.atomic import check_directory, check_writable, save_figure, write_json
 from acld_gym.util.blas import one_blas_thread
 from acld_gym.util.progress import Progress
@@ -32,7 +34,7 @@ from acld_gym.util.validate import arg_type
 
 __all__ = ["EvalRow", "Episode", "rollout", "check_compatible", "bound_episode", "episode_rows",
            "evaluate", "default_policies",
-           "mean_rows", "format_tables", "plot_episodes"]
+           "mean_rows", "format_tables", "format_thesis_comparison", "plot_episodes"]
 
 
 @dataclass(frozen=True)
@@ -194,6 +196,21 @@ def format_tables(rows: list[EvalRow]) -> str:
     return "\n".join(out)
 
 
+def format_thesis_comparison(rows: list[EvalRow]) -> str:
+    """The env's saturated LQR and SMC rows against thesis Table 2 (peak, settling): the
+    acceptance check of the reference policies on the thesis mesh (7 % peak, 10 %
+    settling; tests/baselines/test_policies.py)."""
+    out = ["\nagainst thesis Table 2 (saturated rows; acceptance: peak 7 %, settling 10 %)",
+           f"{'row':>12} {'peak':>8} {'settling':>9}"]
+    for r in rows:
+        ref = thesis_row(r.case, r.policy, True) if r.case in (1, 2, 3) else None
+        if ref is not None:
+            out.append(f"{r.policy.upper() + ' case ' + str(r.case):>12} "
+                       f"{100 * (r.peak_mm / ref.peak_mm - 1):+7.1f}% "
+                       f"{100 * (r.settling_s / ref.settling_s - 1):+8.1f}%")
+    return "\n".join(out)
+
+
 def plot_episodes(episodes: dict, directory: Path) -> None:
     import matplotlib
 
@@ -243,6 +260,8 @@ def main(argv: list[str] | None = None) -> int:
     rows = evaluate(default_policies(args.mesh), seed=args.seed,
                     env_kwargs={"mesh": args.mesh}, episodes=episodes, quiet=args.quiet)
     print(format_tables(rows))
+    if args.mesh == "thesis":
+        print(format_thesis_comparison(rows))
     if args.json:
         write_json(args.json, [r.as_dict() for r in rows])
         print(f"\nwrote {args.json}")

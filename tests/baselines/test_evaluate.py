@@ -41,3 +41,15 @@ def test_cli_bad_argument_exits_2(capsys):
         main(["--seed", "abc"])
     assert e.value.code == 2
     assert "--seed" in capsys.readouterr().err
+
+
+def test_thesis_comparison_lists_saturated_lqr_smc_rows_only():
+    from baselines.evaluate import EvalRow, format_thesis_comparison
+
+    rows = [EvalRow(1, "lqr", 0.666 * 1.05, 0.34 * 0.9, 1e-8, 120.0, -1.0, 0.01),
+            EvalRow(2, "smc", 0.952, 0.461, 1e-8, 120.0, -1.0, 0.01),
+            EvalRow(1, "mpc", 0.6, 0.3, 1e-8, 120.0, -1.0, 0.1),
+            EvalRow("random", "lqr", 0.6, 0.3, 1e-8, 120.0, -1.0, 0.1)]
+    lines = format_thesis_comparison(rows).strip().splitlines()[2:]
+    assert [ln.split() for ln in lines] == [["LQR", "case", "1", "+5.0%", "-10.0%"],
+                                            ["SMC", "case", "2", "+0.0%", "+0.0%"]]

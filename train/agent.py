@@ -33,7 +33,8 @@ from acld_gym.util.atomic import write_atomic, write_json
 from .features import direction_features
 from .vec import VoltageMap
 
-__all__ = ["TrainedAgent", "ActorProgram", "AgentFileError", "export_sb3", "POLICY_FILE",
+__all__ = ["TrainedAgent", "ActorProgram", "AgentFileError", "export_sb3", "linear_program",
+           "POLICY_FILE",
            "META_FILE", "MODEL_FILE", "STATS_FILE"]
 
 POLICY_FILE = "policy.npz"
@@ -100,7 +101,7 @@ class ActorProgram:
 
 
 def export_sb3(model, obs_norm=None) -> ActorProgram:
-    """The deterministic actor of an SB3 ``MlpPolicy`` (PPO, SAC, TD3, TQC, ...) and its
+    """The deterministic actor of an SB3 ``MlpPolicy`` (PPO, SAC, TD3, TQC, ARS, ...) and its
     ``VecNormalize`` observation statistics as an :class:`ActorProgram` (equal to SB3's
     ``predict`` to float32 round-off; tests/test_train_agents.py)."""
     import torch.nn as nn
@@ -125,6 +126,10 @@ def export_sb3(model, obs_norm=None) -> ActorProgram:
     elif actor is not None and hasattr(actor, "mu"):  # TD3: mu is the whole net, Tanh last
         extractor = actor.features_extractor
         layers = list(actor.mu)
+        squash = False
+    elif not hasattr(pol, "mlp_extractor"):  # ARS (sb3-contrib): action_net is the actor
+        extractor = pol.features_extractor
+        layers = list(pol.action_net)
         squash = False
     else:  # PPO / A2C: Gaussian mean, clipped to the box
         extractor = pol.pi_features_extractor
@@ -152,6 +157,34 @@ def export_sb3(model, obs_norm=None) -> ActorProgram:
             raise TypeError(f"export_sb3: unsupported layer {m!r}")
     if squash:
         ops.append({"op": "tanh"})
+    return ActorProgram(ops, arrays)
+
+
+def linear_program(theta: np.ndarray, transform: np.ndarray | None = None,
+                   features: str | None = None) -> ActorProgram:
+    r"""The saturated linear actor :math:`a = \mathrm{clip}(w \cdot f + b, -1, 1)` as an
+    :class:`ActorProgram`, with ``theta = [w, b]`` and f the features of
+    :math:`u = T^T z` (``transform`` T, identity if None): u itself (``features=None``) or
+    ``"direction"``, :math:`[u/|u|, \log|u|]`. The teacher-free random search's actor
+    (:class:`train.bench_algos.LinearDirectionActor`)."""
+    theta = np.asarray(theta, dtype=np.float64)
+    w, b = theta[:-1, None], theta[-1:]
+    if features not in (None, "direction"):
+        raise ValueError(f"features must be None or 'direction', got {features!r}")
+    if features is None:  # one layer: (z T) w + b = z (T w) + b
+        W = w if transform is None else np.asarray(transform, np.float64) @ w
+        return ActorProgram([{"op": "linear", "layer": 0}, {"op": "clip", "low": -1.0,
+                                                              "high": 1.0}], {"W0": W, "b0": b})
+    ops: list[dict] = []
+    arrays: dict[str, np.ndarray] = {}
+    if transform is not None:
+        T = np.asarray(transform, np.float64)
+        ops.append({"op": "linear", "layer": 0})
+        arrays.update(W0=T, b0=np.zeros(T.shape[1]))
+    layer = len(ops)
+    ops += [{"op": "direction"}, {"op": "linear", "layer": layer},
+            {"op": "clip", "low": -1.0, "high": 1.0}]
+    arrays.update({f"W{layer}": w, f"b{layer}": b})
     return ActorProgram(ops, arrays)
 
 

@@ -69,10 +69,11 @@ def load_algo_config(spec: str | Path) -> tuple[str, dict]:
 
 
 def run_trial(name: str, config: dict, seed: int, env_id: str = DEFAULT_ENV_ID,
-              random_episodes: int = 20) -> dict:
+              random_episodes: int = 20, out: str | Path | None = None) -> dict:
     """Train one (config, seed) and evaluate it; returns the trial's record (JSON-able):
     the learning curve (mean ISE per case at each evaluation, batched), the final ISE
-    per case (single-env rollouts) and the training wall time (evaluations excluded)."""
+    per case (single-env rollouts) and the training wall time (evaluations excluded).
+    With ``out``, the final policy is saved as an agent in :func:`agent_dir`."""
     import torch
 
     from .bench_algos import AlgoConfig, train_algo
@@ -91,7 +92,7 @@ def run_trial(name: str, config: dict, seed: int, env_id: str = DEFAULT_ENV_ID,
     policy, record = train_algo(cfg, seed, env_id, on_eval)
     wall = time.perf_counter() - t0
     final = rollout_ise(policy, env_id, episodes)
-    return {"name": name, "algo": cfg.algo, "seed": int(seed), "env_id": env_id,
+    rec = {"name": name, "algo": cfg.algo, "seed": int(seed), "env_id": env_id,
             "config": config, "random_episodes": int(random_episodes),
             "budget": cfg.timesteps, "steps": int(record.get("steps", 0)),
             "train_seconds": float(record["train_seconds"]),
@@ -100,17 +101,74 @@ def run_trial(name: str, config: dict, seed: int, env_id: str = DEFAULT_ENV_ID,
             "final_ise": {str(c): v for c, v in final.items()}, "curve": curve,
             "record": {k: v for k, v in record.items()
                        if k not in ("train_seconds", "train_cpu_seconds")}}
+    if out is not None:
+        save_agent(policy, rec, Path(out))
+    return rec
 
 
 def _trial_path(out: Path, name: str, seed: int) -> Path:
     return out / "trials" / f"{name}-s{seed}.json"
 
 
+def agent_dir(out: Path, name: str, seed: int) -> Path:
+    """Where a trial's final policy is saved as an agent (:class:`train.agent.TrainedAgent`)."""
+    return Path(out) / "agents" / f"{name}-s{seed}"
+
+
+def policy_program(policy):
+    """A trained benchmark policy as a :class:`train.agent.ActorProgram` (numpy arrays and
+    a JSON list of operations: loading it never runs code)."""
+    from .agent import ActorProgram, export_sb3, linear_program
+    from .bench_algos import LinearDirectionActor, SB3Policy
+
+    if isinstance(policy, LinearDirectionActor):
+        return linear_program(policy.theta, policy.transform, policy.features)
+    if isinstance(policy, SB3Policy):  # direction features (an env wrapper), then VecNormalize
+        prog = export_sb3(policy.model, policy.obs_norm)
+        if policy.features == "direction":
+            prog = ActorProgram([{"op": "direction"}, *prog.ops], prog.arrays)
+        return prog
+    raise TypeError(f"cannot export a {type(policy).__name__}")
+
+
+def save_agent(policy, rec: dict, out: Path) -> Path:
+    """Save a trial's final policy as an agent directory (``policy.npz``,
+    ``metadata.json`` with ``training: "from scratch"``, no teacher, the command, config,
+    budget, times and the observation fingerprint of the env it was trained on)."""
+    import gymnasium as gym
+
+    from acld_gym.envs.fingerprint import observation_fingerprint
+
+    from .agent import TrainedAgent
+    from .callbacks import CURVE_FILE
+    from .cli import versions
+
+    probe = gym.make(rec["env_id"])
+    meta = {"algo": rec["algo"], "seed": rec["seed"], "benchmark": rec["name"],
+            "command": f"python -m train.benchmark --config {rec['name']} "
+                       f"--seeds {rec['seed']} --env-id {rec['env_id']}",
+            "config": rec["config"], "training": "from scratch", "teacher": None,
+            "residual": None, "timesteps": rec["steps"], "budget": rec["budget"],
+            "train_seconds": round(rec["train_seconds"], 1),
+            "train_cpu_seconds": round(rec["train_cpu_seconds"], 1),
+            "final_ise": rec["final_ise"], "versions": versions(),
+            "env": {"id": rec["env_id"], "kwargs": {}},
+            "observation": observation_fingerprint(probe)}
+    probe.close()
+    d = TrainedAgent(policy_program(policy), meta, rec["algo"]).save(
+        agent_dir(out, rec["name"], rec["seed"]))
+    # its learning curve on the thesis cases and the random set, batched evaluations
+    lines = ["timesteps,case,ise"] + [f"{p['steps']},{c},{ise!r}" for p in rec["curve"]
+                                      for c, ise in p["ise"].items()]
+    write_text(d / CURVE_FILE, "\n".join(lines) + "\n")
+    return d
+
+
 def _tune_trainable(config: dict) -> None:  # pragma: no cover - runs inside Ray workers
     from ray import tune
 
     kwargs = json.loads(config["trial"])
-    out = Path(kwargs.pop("out"))
+    out = Path(kwargs["out"])
     rec = run_trial(**kwargs)
     # written here too, so that --resume finds the finished runs after an interruption (on a
     # cluster the driver writes them again from the reported results)
@@ -125,7 +183,7 @@ def run_trials(trials: list[dict], out: Path, backend: str = "local", num_cpus: 
     records = []
     if backend == "local":
         for t in trials:
-            rec = run_trial(**t)
+            rec = run_trial(**t, out=out)
             write_text(_trial_path(out, rec["name"], rec["seed"]), json.dumps(rec) + "\n")
             print(f"  {rec['name']} seed {rec['seed']}: trained in {rec['train_seconds']:.0f} s",
                   flush=True)

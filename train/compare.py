@@ -2,8 +2,9 @@
 
 For each thesis load case (1, 2, 3) and a fixed held-out set of random loads
 (``case "random"``: the mean over the set; seeds disjoint from anything used in
-training), runs passive / LQR / SMC / MPC / PPO / SAC and the clairvoyant bound
-through ``ACLDBeam-v0`` (+/-120 V, 1 ms, default Kalman observer) and prints
+training), runs passive / LQR / SMC / MPC, every shipped agent (``train/agents/``,
+labelled by how it was trained: "from scratch" or "DAgger from MPC + RL") and the
+clairvoyant bound through ``ACLDBeam-v1`` (+/-120 V, 1 ms, default Kalman observer) and prints
 peak [mm], 5 % settling [s], ISE [m^2 s], ISE relative to LQR and to the bound,
 max |V| [V], return, and compute time per step [ms].
 
@@ -60,7 +61,9 @@ def agent_names(directory: str | Path = AGENTS_DIR, mesh: str = "converged") -> 
                 rec = json.loads(meta.read_text())
             except json.JSONDecodeError:
                 continue  # TrainedAgent.load reports it when asked for it by name
-            if rec.get("env", {}).get("kwargs", {}).get("mesh") == mesh:
+            env = rec.get("env", {})
+            default = "thesis" if env.get("id") == "ACLDBeam-v0" else "converged"
+            if env.get("kwargs", {}).get("mesh", default) == mesh:
                 out.append(d.name)
     return out
 

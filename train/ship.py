@@ -36,8 +36,19 @@ def best_timesteps(curve: str | Path) -> int:
 def ship(run: str | Path, name: str, agents_dir: str | Path = AGENTS_DIR) -> Path:
     """Copy ``run``'s ``best/`` agent (the ``EvalCallback`` best on the thesis cases:
     ``policy.npz`` and ``metadata.json``, nothing pickled) and its learning curve to
-    ``agents_dir/name``, atomically per file; returns that directory."""
+    ``agents_dir/name``, atomically per file; returns that directory. ``run`` may also be
+    an agent directory itself (``python -m train.benchmark`` saves one per trial, its
+    final policy, in ``<out>/agents/<config>-s<seed>``): it is copied as it is."""
     run = Path(run)
+    if (run / POLICY_FILE).is_file() and (run / META_FILE).is_file() and not (
+            run / "best").is_dir():
+        agent = TrainedAgent.load(run, check=False)
+        agent.metadata["checkpoint"] = "final policy"
+        dst = Path(agents_dir) / name
+        agent.save(dst)
+        if (run / CURVE_FILE).is_file():
+            write_text(dst / CURVE_FILE, (run / CURVE_FILE).read_text())
+        return dst
     needed = [run / "best" / POLICY_FILE, run / "best" / META_FILE, run / CURVE_FILE]
     for f in needed:
         if not f.is_file():
@@ -55,7 +66,8 @@ def ship(run: str | Path, name: str, agents_dir: str | Path = AGENTS_DIR) -> Pat
 
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="python -m train.ship", description=__doc__)
-    p.add_argument("run", help="a run directory written by python -m train")
+    p.add_argument("run", help="a run directory written by python -m train, or an agent "
+                              "directory written by python -m train.benchmark")
     p.add_argument("name", help="agent name, e.g. ppo, sac, ppo_robust")
     p.add_argument("--agents", default=str(AGENTS_DIR), help="destination (default: shipped)")
     args = p.parse_args(argv)

@@ -219,7 +219,7 @@ class ReducedModel:
 
     def to_statespace(self):
         """The reduced model as a ``control.StateSpace`` (inputs voltage [V] and, when
-        the reduction kept it, tip load [N]; :mod:`acld_gym.design.interop`)."""
+        the reduction kept it, tip load [N]; :mod:`acld_gym.physics.interop`)."""
         from acld_gym.physics.interop import statespace
 
         return statespace(self.A, self.B, self.E, self.C, f"reduced-{self.order}")

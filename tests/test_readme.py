@@ -62,6 +62,10 @@ def run_block(block: str, namespace: dict, where: str = "README block") -> list[
             exec(compile(ast.Module([node], []), where, "exec"), namespace)
             continue
         value = eval(compile(ast.Expression(node.value), where, "eval"), namespace)
+        if claim[1].strip().startswith(("'", '"')):  # a string claim: equal as written
+            if value != ast.literal_eval(claim[1].strip()):
+                failures.append(f"{source!r}: got {value!r}, README says {claim[1].strip()}")
+            continue
         printed = NUMBER.findall(claim[1])
         got = numbers(value)
         if len(got) != len(printed):
@@ -78,6 +82,8 @@ def test_claim_parser_on_examples():
     assert claims(block)[0] == (1, "(x * 0.3333, 1e-8)", " (0.667, 1.0e-08)")
     assert claims(block)[1] == (2, "[x]", " [2.0]")
     assert run_block(block, {}) == []
+    assert run_block("s = 'ab'\ns  # -> 'ab'  [text]\n", {}) == []
+    assert len(run_block("s = 'ab'\ns  # -> 'abc'\n", {})) == 1
     bad = "x = 2\nx * 0.3334  # -> 0.666\n"
     assert run_block(bad, {}) and half_unit("2.5e-08") == pytest.approx(0.05e-08)
 

@@ -20,7 +20,12 @@ reports learning-curve points through a callback, and returns a policy with SB3'
   through :func:`make_sb3_env`: the native batched env (``SB3VecEnv``), actions in
   [-1, 1] (``train.vec.VecAgentEnv``, no residual, no shaping), optionally the
   direction features as the observation (:class:`VecDirectionFeatures`), and
-  ``VecNormalize``.
+  ``VecNormalize``. Options for them (fields of :class:`AlgoConfig`): ``whiten_steps``,
+  a ZCA whitening of the observation estimated from the agent's own first rollouts
+  (:class:`VecWhiten`, the steps counted in the budget); for PPO the policy
+  ``SplitCriticPolicy`` (the critic on its own features, e.g. quadratic ones,
+  :class:`SplitCriticPolicy`) and ``episode_scale``, advantages normalised per episode
+  (:class:`EpisodeScaledRolloutBuffer`).
 """
 
 from __future__ import annotations
@@ -32,15 +37,25 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
+import torch
+import torch.nn as nn
 from gymnasium import spaces
+from stable_baselines3.common.buffers import RolloutBuffer
+from stable_baselines3.common.policies import ActorCriticPolicy
+from stable_baselines3.common.torch_layers import (
+    BaseFeaturesExtractor,
+    FlattenExtractor,
+    MlpExtractor,
+)
 from stable_baselines3.common.vec_env import VecEnv, VecEnvWrapper, VecNormalize
 
 import acld_gym  # noqa: F401  (registers the env ids)
 
-from .features import direction_features
+from .features import DirectionFeatures, direction_features
 
 __all__ = ["ALGOS", "SB3_ALGOS", "AlgoConfig", "LinearDirectionActor", "whitening",
-           "VecDirectionFeatures",
+           "VecDirectionFeatures", "VecWhiten", "QuadraticFeatures", "SplitCriticPolicy",
+           "EpisodeScaledRolloutBuffer",
            "ConcatVecEnv", "make_sb3_env", "SB3Policy", "RandomSearch", "train_algo"]
 
 #: Algorithms from stable-baselines3 / sb3-contrib (module, class).
@@ -88,6 +103,18 @@ class AlgoConfig:
     eval_points : int
         Learning-curve points (evaluations) over the budget, besides the one at step 0
         (log-spaced, :class:`eval_schedule`).
+    whiten_steps : int
+        SB3 algorithms: 0 (default) for none; else the agent first acts with its own
+        initial (stochastic) policy for about this many env steps (whole vector steps,
+        counted in the budget), and :func:`whitening` of the observation directions it
+        saw becomes a fixed linear map of the observation, ``u = T^T z``
+        (:class:`VecWhiten`), the network's input. Needs ``features: null`` and
+        ``norm_obs: false``; the final actor takes T into its first layer.
+    episode_scale : bool
+        PPO only: the advantages of each episode in a rollout are divided by their
+        root mean square (:class:`EpisodeScaledRolloutBuffer`; the critic's targets
+        are unchanged): episodes whose returns differ by decades weigh alike in the
+        policy gradient (normalisation per load). Use ``n_steps`` = the episode length.
     """
 
     algo: str
@@ -98,6 +125,8 @@ class AlgoConfig:
     normalize: dict = field(default_factory=lambda: {"norm_obs": False, "norm_reward": True})
     model: dict = field(default_factory=dict)
     eval_points: int = 10
+    whiten_steps: int = 0
+    episode_scale: bool = False
 
     def __post_init__(self):
         if self.algo not in ALGOS:
@@ -115,6 +144,16 @@ class AlgoConfig:
             raise ValueError(f"features must be 'direction' or null, got {self.features!r}")
         if self.algo != "vrs" and "policy" not in self.model:
             raise ValueError(f"{self.algo}: model must name the SB3 policy")
+        if isinstance(self.whiten_steps, bool) or not isinstance(self.whiten_steps, int) \
+                or self.whiten_steps < 0 or (self.whiten_steps and self.algo in ("vrs", "ars")):
+            raise ValueError(f"whiten_steps must be a non-negative integer (SB3 algorithms "
+                             f"other than ars; vrs: model.whiten), got {self.whiten_steps!r}")
+        if self.whiten_steps and (self.features is not None
+                                  or self.normalize.get("norm_obs", False)):
+            raise ValueError("whiten_steps needs features: null and norm_obs: false (the "
+                             "trained actor takes the whitening into its first layer)")
+        if self.episode_scale and self.algo != "ppo":
+            raise ValueError("episode_scale is for ppo only")
 
     @property
     def load_weights(self) -> dict:
@@ -399,6 +438,128 @@ class VecDirectionFeatures(VecEnvWrapper):
         return self._f(obs), rewards, dones, infos
 
 
+class VecWhiten(VecEnvWrapper):
+    r"""Observation ``z`` -> ``u = T^T z`` with a fixed matrix T (identity until
+    :meth:`set_transform`). While ``collect`` is a list, the raw observation directions
+    ``z/|z|`` seen (every sub-env, every step) are appended to it, from which
+    :func:`whitening` estimates T (:func:`train_sb3` with ``whiten_steps``)."""
+
+    def __init__(self, venv: VecEnv):
+        super().__init__(venv)
+        self.transform = np.eye(venv.observation_space.shape[0])
+        self.collect: list | None = None
+
+    def set_transform(self, transform: np.ndarray) -> None:
+        self.transform = np.asarray(transform, dtype=np.float64)
+
+    def _u(self, obs: np.ndarray) -> np.ndarray:
+        z = np.asarray(obs, dtype=np.float64)
+        if self.collect is not None:
+            r = np.linalg.norm(z, axis=-1, keepdims=True)
+            self.collect.append((z / np.maximum(r, 1e-12))[r[:, 0] > 0])
+        return (z @ self.transform).astype(np.float32)
+
+    def reset(self) -> np.ndarray:
+        return self._u(self.venv.reset())
+
+    def step_wait(self):
+        obs, rewards, dones, infos = self.venv.step_wait()
+        for i in np.flatnonzero(dones):
+            z = np.asarray(infos[i]["terminal_observation"], dtype=np.float64)
+            infos[i]["terminal_observation"] = (z @ self.transform).astype(np.float32)
+        return self._u(obs), rewards, dones, infos
+
+
+class QuadraticFeatures(BaseFeaturesExtractor):
+    r"""Features :math:`[u,\ u_i u_j\ (i \le j)]` of the observation u (d + d(d+1)/2
+    values): a linear value on them is a quadratic form plus a linear term, the
+    shape of a linear-quadratic problem's value function."""
+
+    def __init__(self, observation_space: spaces.Box):
+        d = int(observation_space.shape[0])
+        super().__init__(observation_space, features_dim=d + d * (d + 1) // 2)
+        i, j = np.triu_indices(d)
+        self.register_buffer("_i", torch.as_tensor(i), persistent=False)
+        self.register_buffer("_j", torch.as_tensor(j), persistent=False)
+
+    def forward(self, observations: torch.Tensor) -> torch.Tensor:
+        return torch.cat([observations, observations[:, self._i] * observations[:, self._j]],
+                         dim=-1)
+
+
+#: ``critic_features`` of :class:`SplitCriticPolicy` and their extractor classes.
+CRITIC_FEATURES = {"quadratic": QuadraticFeatures, "direction": DirectionFeatures,
+                   "flatten": FlattenExtractor}
+
+
+class _SplitMlp(nn.Module):
+    """``MlpExtractor``'s interface with actor and critic on inputs of their own size."""
+
+    def __init__(self, pi_dim, vf_dim, net_arch, activation_fn, device):
+        super().__init__()
+        arch = net_arch if isinstance(net_arch, dict) else {"pi": net_arch, "vf": net_arch}
+        pi = MlpExtractor(pi_dim, {"pi": list(arch.get("pi", [])), "vf": []},
+                          activation_fn, device)
+        vf = MlpExtractor(vf_dim, {"pi": [], "vf": list(arch.get("vf", []))},
+                          activation_fn, device)
+        self.policy_net, self.value_net = pi.policy_net, vf.value_net
+        self.latent_dim_pi, self.latent_dim_vf = pi.latent_dim_pi, vf.latent_dim_vf
+
+    def forward(self, features):
+        return self.forward_actor(features), self.forward_critic(features)
+
+    def forward_actor(self, features):
+        return self.policy_net(features)
+
+    def forward_critic(self, features):
+        return self.value_net(features)
+
+
+class SplitCriticPolicy(ActorCriticPolicy):
+    """PPO's ``ActorCriticPolicy`` whose critic has features of its own,
+    ``critic_features`` (a ``policy_kwargs`` key): ``"quadratic"``
+    (:class:`QuadraticFeatures`; with ``net_arch: {vf: []}`` the value is a quadratic
+    form of the observation, suited to a linear-quadratic problem), ``"direction"``
+    (:class:`train.features.DirectionFeatures`) or ``"flatten"``. The actor sees the
+    (flattened) observation, e.g. linear with ``net_arch: {pi: []}``."""
+
+    def __init__(self, *args, critic_features: str = "quadratic", **kwargs):
+        if critic_features not in CRITIC_FEATURES:
+            raise ValueError(f"critic_features must be one of {list(CRITIC_FEATURES)}")
+        self.critic_features = critic_features
+        kwargs["share_features_extractor"] = False
+        super().__init__(*args, **kwargs)
+
+    def _build_mlp_extractor(self) -> None:
+        self.vf_features_extractor = CRITIC_FEATURES[self.critic_features](
+            self.observation_space)
+        self.mlp_extractor = _SplitMlp(self.features_dim,
+                                       self.vf_features_extractor.features_dim,
+                                       self.net_arch, self.activation_fn, self.device)
+
+    def _get_constructor_parameters(self) -> dict:
+        data = super()._get_constructor_parameters()
+        data["critic_features"] = self.critic_features
+        return data
+
+
+class EpisodeScaledRolloutBuffer(RolloutBuffer):
+    """A ``RolloutBuffer`` that divides the GAE advantages of each episode segment (per
+    sub-env, split at episode starts) by their root mean square, after the returns
+    (the critic's targets, unchanged) are computed: advantage normalisation per
+    episode (per load). Episodes whose returns differ by decades then weigh alike in
+    the policy gradient, as in the random search's -log(-R) score."""
+
+    def compute_returns_and_advantage(self, last_values, dones) -> None:
+        super().compute_returns_and_advantage(last_values, dones)
+        n = self.buffer_size
+        for e in range(self.n_envs):
+            starts = [0, *[int(t) for t in np.flatnonzero(self.episode_starts[1:, e]) + 1], n]
+            for a, b in zip(starts[:-1], starts[1:], strict=True):
+                rms = float(np.sqrt(np.mean(self.advantages[a:b, e] ** 2)))
+                self.advantages[a:b, e] /= max(rms, 1e-12)
+
+
 class ConcatVecEnv(VecEnv):
     """Several SB3 ``VecEnv`` with the same spaces side by side as one (sub-envs in order)."""
 
@@ -474,7 +635,9 @@ def _split_envs(weights: dict, n_envs: int) -> dict:
 def make_sb3_env(cfg: AlgoConfig, seed: int, env_id: str, gamma: float = 0.99) -> VecNormalize:
     """The SB3 training env: per training load case a native batched env
     (``SB3VecEnv`` over ``gym.make_vec(env_id)``) side by side, actions in [-1, 1]
-    (``VecAgentEnv``: no residual, no shaping), optional direction features, and
+    (``VecAgentEnv``: no residual, no shaping), :class:`VecWhiten` if
+    ``cfg.whiten_steps`` (identity until :func:`train_sb3` sets it), optional direction
+    features, and
     ``VecNormalize`` with ``cfg.normalize`` (seeded: sub-env i gets ``seed + i``)."""
     from acld_gym.envs.sb3 import SB3VecEnv
 
@@ -486,6 +649,8 @@ def make_sb3_env(cfg: AlgoConfig, seed: int, env_id: str, gamma: float = 0.99) -
     venv: VecEnv = parts[0] if len(parts) == 1 else ConcatVecEnv(parts)
     venv.seed(seed)
     venv = VecAgentEnv(venv, residual=None, gamma=gamma, shaping=None)
+    if cfg.whiten_steps:
+        venv = VecWhiten(venv)
     if cfg.features == "direction":
         venv = VecDirectionFeatures(venv)
     return VecNormalize(venv, gamma=gamma, **cfg.normalize)
@@ -493,19 +658,23 @@ def make_sb3_env(cfg: AlgoConfig, seed: int, env_id: str, gamma: float = 0.99) -
 
 class SB3Policy:
     """A trained SB3 model with its frozen ``VecNormalize`` statistics as a policy on the
-    env's raw observation, ``predict`` in volts (``V = v_max * clip(a, -1, 1)``)."""
+    env's raw observation, ``predict`` in volts (``V = v_max * clip(a, -1, 1)``);
+    ``transform``: the agent's whitening matrix (:class:`VecWhiten`), or None."""
 
     def __init__(self, model, obs_norm: VecNormalize | None, features: str | None,
-                 v_max: float = 120.0):
+                 v_max: float = 120.0, transform: np.ndarray | None = None):
         self.model = model
         self.obs_norm = obs_norm
         self.features = features
         self.v_max = float(v_max)
+        self.transform = None if transform is None else np.asarray(transform, np.float64)
 
     def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
         obs = np.asarray(observation, dtype=np.float32)
         batched = obs.ndim == 2
         x = np.atleast_2d(obs)
+        if self.transform is not None:
+            x = (x.astype(np.float64) @ self.transform).astype(np.float32)
         if self.features == "direction":
             x = direction_features(x).astype(np.float32)
         if self.obs_norm is not None:
@@ -526,10 +695,28 @@ def _sb3_class(algo: str):
     return getattr(importlib.import_module(module), name)
 
 
-def _resolve_policy_kwargs(kwargs: dict) -> dict:
-    """YAML-friendly ``policy_kwargs``: ``activation_fn`` given by name (``"tanh"``)."""
-    import torch.nn as nn
+class _linear_schedule:  # noqa: N801  (an SB3 schedule: progress remaining 1 -> 0)
+    def __init__(self, start: float, end: float):
+        self.start, self.end = start, end
 
+    def __call__(self, progress_remaining: float) -> float:
+        return self.end + (self.start - self.end) * progress_remaining
+
+
+def _resolve_policy_kwargs(kwargs: dict) -> dict:
+    """YAML-friendly keyword arguments: ``policy_kwargs.activation_fn`` given by name
+    (``"tanh"``); ``policy: SplitCriticPolicy`` names :class:`SplitCriticPolicy`;
+    ``learning_rate`` / ``clip_range`` as ``{linear: [start, end]}``, a schedule linear in
+    the progress from ``start`` to ``end``."""
+    for key in ("learning_rate", "clip_range"):
+        value = kwargs.get(key)
+        if isinstance(value, dict):
+            if set(value) != {"linear"} or len(value["linear"]) != 2:
+                raise ValueError(f"{key}: a number or {{linear: [start, end]}}, got {value!r}")
+            kwargs = {**kwargs, key: _linear_schedule(*map(float, value["linear"]))}
+
+    if kwargs.get("policy") == "SplitCriticPolicy":
+        kwargs = {**kwargs, "policy": SplitCriticPolicy}
     pk = dict(kwargs.get("policy_kwargs") or {})
     if isinstance(pk.get("activation_fn"), str):
         pk["activation_fn"] = {"tanh": nn.Tanh, "relu": nn.ReLU}[pk["activation_fn"].lower()]
@@ -538,20 +725,52 @@ def _resolve_policy_kwargs(kwargs: dict) -> dict:
     return kwargs
 
 
+def _first_actor_layer(model) -> nn.Linear:
+    """The first linear layer of an SB3 model's deterministic actor (as ``export_sb3``
+    walks it)."""
+    pol = model.policy
+    actor = getattr(pol, "actor", None)
+    if actor is not None and hasattr(actor, "latent_pi"):  # SAC, TQC
+        layers = [*actor.latent_pi, *(actor.mu if isinstance(actor.mu, nn.Sequential)
+                                      else [actor.mu])]
+    elif actor is not None and hasattr(actor, "mu"):  # TD3
+        layers = list(actor.mu)
+    else:  # PPO
+        layers = [*pol.mlp_extractor.policy_net, pol.action_net]
+    return next(m for m in layers if isinstance(m, nn.Linear))
+
+
+def _fold_transform(model, transform: np.ndarray) -> None:
+    """Fold the whitening ``u = T^T z`` into the actor's first layer (``W u = (W T^T) z``),
+    so that the trained actor takes the raw observation (and exports as a plain SB3
+    actor). Only the deterministic actor stays meaningful afterwards (critic and gSDE
+    noise still expect u): call it when training is over."""
+    layer = _first_actor_layer(model)
+    with torch.no_grad():
+        t = torch.as_tensor(np.asarray(transform).T, dtype=layer.weight.dtype)
+        layer.weight.copy_(layer.weight @ t)
+
+
 def train_sb3(cfg: AlgoConfig, seed: int, env_id: str, callback: CurveCallback | None = None,
               ) -> tuple[SB3Policy, dict]:
-    """Train an SB3 / sb3-contrib algorithm for ``cfg.timesteps`` env steps."""
-    import torch
+    """Train an SB3 / sb3-contrib algorithm for ``cfg.timesteps`` env steps (with
+    ``cfg.whiten_steps``: first that many steps of the initial policy, from which the
+    whitening is estimated, then the rest of the budget of training)."""
     from stable_baselines3.common.callbacks import BaseCallback
 
     torch.set_num_threads(1)
     kwargs = _resolve_policy_kwargs(dict(cfg.model))
     policy = kwargs.pop("policy")
     gamma = float(kwargs.get("gamma", 0.99))
+    if cfg.episode_scale:
+        kwargs["rollout_buffer_class"] = EpisodeScaledRolloutBuffer
     venv = make_sb3_env(cfg, seed, env_id, gamma)
     v_max = 120.0
     model = _sb3_class(cfg.algo)(policy, venv, seed=seed, device="cpu", verbose=0, **kwargs)
     schedule = eval_schedule(cfg.timesteps, cfg.eval_points)
+    white = venv.venv  # under VecNormalize (whiten_steps: no direction features)
+    transform = None
+    offset = 0
 
     def snapshot() -> SB3Policy:
         norm = None
@@ -561,21 +780,43 @@ def train_sb3(cfg: AlgoConfig, seed: int, env_id: str, callback: CurveCallback |
             norm = copy.deepcopy(venv)
             norm.venv = None
             norm.training = False
-        return SB3Policy(model, norm, cfg.features, v_max)
+        return SB3Policy(model, norm, cfg.features, v_max, transform)
+
+    if cfg.whiten_steps:
+        assert isinstance(white, VecWhiten)
+        if callback is not None and schedule.due(0):
+            callback(0, snapshot())
+        white.collect = []
+        obs = venv.reset()
+        if getattr(model, "use_sde", False):
+            model.policy.reset_noise(venv.num_envs)
+        while offset < cfg.whiten_steps:
+            action, _ = model.predict(obs, deterministic=False)
+            obs, _, _, _ = venv.step(action)
+            offset += venv.num_envs
+        transform = whitening(np.concatenate(white.collect))
+        white.collect = None
+        white.set_transform(transform)
 
     class Curve(BaseCallback):
         def _on_step(self) -> bool:
-            if callback is not None and schedule.due(self.num_timesteps):
-                callback(int(self.num_timesteps), snapshot())
+            steps = offset + int(self.num_timesteps)
+            if callback is not None and schedule.due(steps):
+                callback(steps, snapshot())
             return True
 
         def _on_training_start(self) -> None:
             self._on_step()
 
-    model.learn(cfg.timesteps, callback=Curve())
+    model.learn(max(cfg.timesteps - offset, 1), callback=Curve())
+    record = {"steps": offset + int(model.num_timesteps), "whiten_steps": offset,
+              "transform": None if transform is None else transform.tolist()}
+    if transform is not None:  # u = T' z into the actor's first layer: a plain SB3 actor on z
+        _fold_transform(model, transform)
+        transform = None
     pol = snapshot()
     venv.close()
-    return pol, {"steps": int(model.num_timesteps)}
+    return pol, record
 
 
 def train_algo(cfg: AlgoConfig, seed: int, env_id: str, callback: CurveCallback | None = None,

@@ -111,6 +111,76 @@ def test_sb3_algorithms_train_and_act_in_volts(name, changes, model):
     assert v.shape == (3, 1)
 
 
+def test_ppo_with_whitening_quadratic_critic_and_episode_scale():
+    """The linear-quadratic PPO recipe's options on a tiny budget: the whitening is
+    estimated from the agent's own first steps (counted in the budget) and folded into
+    the final actor, which then takes the raw observation and exports as a plain actor."""
+    from train.bench_algos import AlgoConfig, SplitCriticPolicy, train_algo
+    from train.benchmark import policy_program
+
+    data = yaml.safe_load(open("train/benchmark/ppo_lq.yaml"))
+    data.update(timesteps=4000, n_envs=2, whiten_steps=1000, episode_scale=True,
+                eval_points=1)
+    data["model"] = {**data["model"], "n_steps": 500, "batch_size": 500, "n_epochs": 1}
+    seen = []
+    policy, record = train_algo(AlgoConfig.from_dict(data), 0, "ACLDBeam-v1",
+                                lambda steps, pol: seen.append((steps, pol.transform)))
+    assert seen[0] == (0, None) and record["whiten_steps"] == 1000
+    assert record["steps"] >= 4000 and np.asarray(record["transform"]).shape == (9, 9)
+    assert any(t is not None for _, t in seen[1:])  # whitened while training
+    assert isinstance(policy.model.policy, SplitCriticPolicy) and policy.transform is None
+    z = np.random.default_rng(1).normal(size=(4, 9)).astype(np.float32)
+    v, _ = policy.predict(z)
+    prog = policy_program(policy)
+    assert v.shape == (4, 1) and np.all(np.abs(v) <= 120.0)
+    assert np.allclose(120 * np.clip(prog(z.astype(np.float64)), -1, 1).reshape(-1, 1), v,
+                       atol=1e-3)
+
+
+def test_fold_transform_and_quadratic_features():
+    import torch
+    from stable_baselines3 import PPO, SAC
+
+    from train.bench_algos import QuadraticFeatures, SB3Policy, _fold_transform
+
+    feats = QuadraticFeatures(gym.spaces.Box(-1, 1, (3,)))
+    x = torch.tensor([[1.0, 2.0, 3.0]])
+    assert feats.features_dim == 9
+    assert feats(x).tolist() == [[1, 2, 3, 1, 2, 3, 4, 6, 9]]
+    env = gym.make("Pendulum-v1")
+    T = np.random.default_rng(0).normal(size=(3, 3))
+    z = np.random.default_rng(1).normal(size=(5, 3)).astype(np.float32)
+    for model in (PPO("MlpPolicy", env, policy_kwargs={"net_arch": {"pi": [], "vf": [8]}}),
+                  SAC("MlpPolicy", env, policy_kwargs={"net_arch": [8]})):
+        before, _ = SB3Policy(model, None, None, transform=T).predict(z)
+        _fold_transform(model, T)
+        after, _ = SB3Policy(model, None, None).predict(z)
+        assert np.allclose(before, after, atol=1e-3)
+
+
+def test_episode_scaled_advantages():
+    from train.bench_algos import EpisodeScaledRolloutBuffer
+
+    box = gym.spaces.Box(-1, 1, (2,))
+    buf = EpisodeScaledRolloutBuffer(6, box, box, n_envs=2, gamma=1.0, gae_lambda=1.0)
+    for t in range(6):
+        scale = np.array([1.0, 1000.0]) if t < 3 else np.array([1.0, 0.001])
+        starts = np.array([t == 0, t in (0, 3)])
+        buf.add(np.zeros((2, 2)), np.zeros((2, 2)), -scale * (t + 1), starts,
+                torch_zeros(2), torch_zeros(2))
+    buf.compute_returns_and_advantage(torch_zeros(2), np.zeros(2, dtype=bool))
+    rms = [np.sqrt(np.mean(buf.advantages[a:b, e] ** 2)) for e, a, b in
+           [(0, 0, 6), (1, 0, 3), (1, 3, 6)]]
+    assert np.allclose(rms, 1.0)
+    assert buf.returns[0, 1] == pytest.approx(-6000.0)  # the critic's targets unscaled
+
+
+def torch_zeros(n):
+    import torch
+
+    return torch.zeros(n)
+
+
 def test_whitening_and_actor():
     from train.bench_algos import LinearDirectionActor, whitening
 

@@ -43,7 +43,7 @@ import yaml
 
 from acld_gym.util.atomic import save_figure, write_text
 
-from .bench_eval import CASES, DEFAULT_ENV_ID
+from .bench.evaluate import CASES, DEFAULT_ENV_ID
 
 __all__ = ["CONFIG_DIR", "DEFAULT_ALGOS", "load_algo_config", "run_trial", "run_trials",
            "summarize", "markdown", "plot_curves", "main"]
@@ -62,7 +62,7 @@ def load_algo_config(spec: str | Path) -> tuple[str, dict]:
     if not path.is_file():
         raise FileNotFoundError(f"config {str(spec)!r}: no file {str(path)!r}")
     data = yaml.safe_load(path.read_text()) or {}
-    from .bench_algos import AlgoConfig
+    from .bench.config import AlgoConfig
 
     AlgoConfig.from_dict(data)  # validate early
     return path.stem, data
@@ -76,8 +76,9 @@ def run_trial(name: str, config: dict, seed: int, env_id: str = DEFAULT_ENV_ID,
     With ``out``, the final policy is saved as an agent in :func:`agent_dir`."""
     import torch
 
-    from .bench_algos import AlgoConfig, train_algo
-    from .bench_eval import batched_ise, eval_episodes, rollout_ise
+    from .bench.algos import train_algo
+    from .bench.config import AlgoConfig
+    from .bench.evaluate import batched_ise, eval_episodes, rollout_ise
 
     torch.set_num_threads(1)
     cfg = AlgoConfig.from_dict(config)
@@ -119,7 +120,8 @@ def policy_program(policy):
     """A trained benchmark policy as a :class:`train.agent.ActorProgram` (numpy arrays and
     a JSON list of operations: loading it never runs code)."""
     from .agent import ActorProgram, export_sb3, linear_program
-    from .bench_algos import LinearDirectionActor, SB3Policy
+    from .bench.sb3_policies import SB3Policy
+    from .bench.search import LinearDirectionActor
 
     if isinstance(policy, LinearDirectionActor):
         return linear_program(policy.theta, policy.transform, policy.features)
@@ -216,7 +218,7 @@ def run_trials(trials: list[dict], out: Path, backend: str = "local", num_cpus: 
 def summarize(records: list[dict], refs: dict) -> dict:
     """Per config: IQM and 95 % stratified-bootstrap CI of ISE / LQR per case over the
     seeds, the per-seed values, wall time, and the goals of issue 10."""
-    from .bench_stats import iqm, iqm_with_ci
+    from .bench.stats import iqm, iqm_with_ci
 
     lqr = refs["lqr"]
     out: dict = {"env_id": refs["env_id"], "episodes": refs["episodes"], "algorithms": {},
@@ -418,7 +420,7 @@ def main(argv: list[str] | None = None) -> int:
                     continue
             trials.append({"name": name, "config": data, "seed": seed, "env_id": args.env_id,
                            "random_episodes": args.random_episodes})
-    from .bench_eval import references
+    from .bench.evaluate import references
 
     t0 = time.perf_counter()
     refs = references(args.env_id, out / f"references-{args.env_id}.json",

@@ -25,7 +25,7 @@ from acld_gym.envs.episode import PARAM_NOISE_MAX
 from acld_gym.util.atomic import check_writable
 from acld_gym.util.validate import arg_type
 
-from .config import ALGOS, TrainConfig, algo_class, load_config
+from .config import ALGOS, TrainConfig, algo_class, load_config, parse_load_case
 
 __all__ = ["main", "train", "make_model", "versions", "parse_load_case"]
 
@@ -141,13 +141,12 @@ def export_run(out: Path, cfg: TrainConfig, meta: dict, model=None, venv=None) -
                      cfg.algo).save(best)
 
 
-def parse_load_case(text: str):
-    """``--load-case`` value: 1, 2, 3 or ``random``."""
-    if text == "random":
-        return text
-    if text in ("1", "2", "3"):
-        return int(text)
-    raise argparse.ArgumentTypeError(f"expected 1, 2, 3 or random, got {text!r}")
+def _load_case_arg(text: str):
+    """``--load-case`` value: 1, 2, 3 or ``random`` (:func:`train.config.parse_load_case`)."""
+    try:
+        return parse_load_case(text)
+    except ValueError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
 
 
 #: Seeds: numpy's legacy seeding (used by SB3) takes integers below 2**32.
@@ -161,7 +160,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="python -m train", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("algo", choices=ALGOS, help="the algorithm")
-    p.add_argument("--load-case", type=parse_load_case, default=None,
+    p.add_argument("--load-case", type=_load_case_arg, default=None,
                    help="training loads: 1, 2, 3 or random (default: the config's)")
     p.add_argument("--timesteps", type=_positive_int, default=None,
                    help="env steps in total (default: the config's n_timesteps)")

@@ -13,12 +13,22 @@ from acld_gym.envs.episode import LOAD_CASES, PARAM_NOISE_MAX
 from acld_gym.physics.truth import MESHES
 from acld_gym.util.validate import check_int, check_real
 
-__all__ = ["ALGOS", "TrainConfig", "load_config", "config_path", "algo_class"]
+__all__ = ["ALGOS", "TrainConfig", "load_config", "config_path", "algo_class", "parse_load_case"]
 
 ALGOS = ("ppo", "sac")
 RESIDUALS = (None, "lqr")
 FEATURE_NAMES = ("direction",)
 _HERE = Path(__file__).resolve().parent
+
+
+def parse_load_case(value) -> int | str:
+    """A load case from YAML or command-line text: 1, 2, 3 (int or digit string) or
+    ``"random"``; anything else raises a ``ValueError`` naming the choices."""
+    if isinstance(value, str) and value in ("1", "2", "3"):
+        return int(value)
+    if type(value) in (int, str) and value in LOAD_CASES:  # not bool, not 1.0
+        return value
+    raise ValueError(f"load case must be 1, 2, 3 or 'random', got {value!r}")
 
 
 @dataclass(frozen=True)

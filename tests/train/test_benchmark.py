@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import yaml
 
-from train.bench_stats import iqm, iqm_with_ci, stratified_bootstrap_ci
+from train.bench.stats import iqm, iqm_with_ci, stratified_bootstrap_ci
 
 
 def test_iqm_drops_a_quarter_from_each_end():
@@ -95,7 +95,8 @@ def test_benchmark_runs_end_to_end(tmp_path, capsys):
     ("tqc", {"timesteps": 300, "n_envs": 2}, {"learning_starts": 100, "buffer_size": 1000}),
 ])
 def test_sb3_algorithms_train_and_act_in_volts(name, changes, model):
-    from train.bench_algos import AlgoConfig, train_algo
+    from train.bench.algos import train_algo
+    from train.bench.config import AlgoConfig
 
     data = yaml.safe_load(open(f"train/benchmark/{name}.yaml"))
     data.update(changes, eval_points=1)
@@ -115,7 +116,9 @@ def test_ppo_with_whitening_quadratic_critic_and_episode_scale():
     """The linear-quadratic PPO recipe's options on a tiny budget: the whitening is
     estimated from the agent's own first steps (counted in the budget) and folded into
     the final actor, which then takes the raw observation and exports as a plain actor."""
-    from train.bench_algos import AlgoConfig, SplitCriticPolicy, train_algo
+    from train.bench.algos import train_algo
+    from train.bench.config import AlgoConfig
+    from train.bench.sb3_policies import SplitCriticPolicy
     from train.benchmark import policy_program
 
     data = yaml.safe_load(open("train/benchmark/ppo_lq.yaml"))
@@ -137,11 +140,12 @@ def test_ppo_with_whitening_quadratic_critic_and_episode_scale():
                        atol=1e-3)
 
 
-def test_fold_transform_and_quadratic_features():
+def test_fold_whitening_and_quadratic_features():
     import torch
     from stable_baselines3 import PPO, SAC
 
-    from train.bench_algos import QuadraticFeatures, SB3Policy, _fold_transform
+    from train.bench.sb3_policies import QuadraticFeatures, SB3Policy
+    from train.bench.sb3_train import fold_whitening
 
     feats = QuadraticFeatures(gym.spaces.Box(-1, 1, (3,)))
     x = torch.tensor([[1.0, 2.0, 3.0]])
@@ -153,13 +157,13 @@ def test_fold_transform_and_quadratic_features():
     for model in (PPO("MlpPolicy", env, policy_kwargs={"net_arch": {"pi": [], "vf": [8]}}),
                   SAC("MlpPolicy", env, policy_kwargs={"net_arch": [8]})):
         before, _ = SB3Policy(model, None, None, transform=T).predict(z)
-        _fold_transform(model, T)
+        fold_whitening(model, T)
         after, _ = SB3Policy(model, None, None).predict(z)
         assert np.allclose(before, after, atol=1e-3)
 
 
 def test_episode_scaled_advantages():
-    from train.bench_algos import EpisodeScaledRolloutBuffer
+    from train.bench.sb3_policies import EpisodeScaledRolloutBuffer
 
     box = gym.spaces.Box(-1, 1, (2,))
     buf = EpisodeScaledRolloutBuffer(6, box, box, n_envs=2, gamma=1.0, gae_lambda=1.0)
@@ -182,7 +186,7 @@ def torch_zeros(n):
 
 
 def test_whitening_and_actor():
-    from train.bench_algos import LinearDirectionActor, whitening
+    from train.bench.search import LinearDirectionActor, whitening
 
     rng = np.random.default_rng(0)
     u = rng.normal(size=(5000, 3)) @ np.array([[1.0, 0.99, 0.0], [0.0, 0.1, 0.0], [0, 0, 2.0]])
@@ -222,8 +226,9 @@ def test_benchmark_through_ray_tune(tmp_path):
 @pytest.mark.slow
 def test_recipe_seed_beats_lqr_on_case1():
     """One seed of the teacher-free recipe (train/benchmark/vrs.yaml, full budget)."""
-    from train.bench_algos import AlgoConfig, train_algo
-    from train.bench_eval import reference_policies, rollout_ise
+    from train.bench.algos import train_algo
+    from train.bench.config import AlgoConfig
+    from train.bench.evaluate import reference_policies, rollout_ise
 
     env_id = "ACLDBeam-v1"
     cfg = AlgoConfig.from_dict(yaml.safe_load(open("train/benchmark/vrs.yaml")))

@@ -11,7 +11,7 @@ import yaml
 
 import acld_gym  # noqa: F401  (registers the env ids)
 from train.agent import TrainedAgent, linear_program
-from train.bench_algos import LinearDirectionActor, whitening
+from train.bench.search import LinearDirectionActor, whitening
 
 
 def _observations(n=64, seed=0):

@@ -2,7 +2,7 @@
 
 import pytest
 
-from train.config import ALGOS, TrainConfig, config_path, load_config
+from train.config import ALGOS, TrainConfig, config_path, load_config, parse_load_case
 
 
 @pytest.mark.parametrize("algo", ALGOS)
@@ -43,3 +43,14 @@ def test_bad_files(tmp_path):
         load_config("ppo", bad)
     with pytest.raises(ValueError, match="algo"):
         config_path("a2c")
+
+
+@pytest.mark.parametrize("value, expected", [(1, 1), ("2", 2), (3, 3), ("random", "random")])
+def test_parse_load_case_accepts_the_cases(value, expected):
+    assert parse_load_case(value) == expected
+
+
+@pytest.mark.parametrize("value", [0, 4, "4", True, "Random", None, 1.5, 1.0])
+def test_parse_load_case_names_the_choices(value):
+    with pytest.raises(ValueError, match="1, 2, 3 or 'random'"):
+        parse_load_case(value)

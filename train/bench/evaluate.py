@@ -28,8 +28,16 @@ import numpy as np
 import acld_gym  # registers the env ids
 from acld_gym.util.atomic import write_text
 
-__all__ = ["CASES", "DEFAULT_ENV_ID", "eval_episodes", "rollout_ise",
-           "batched_ise", "relative_ise", "reference_policies", "references"]
+__all__ = [
+    "CASES",
+    "DEFAULT_ENV_ID",
+    "eval_episodes",
+    "rollout_ise",
+    "batched_ise",
+    "relative_ise",
+    "reference_policies",
+    "references",
+]
 
 DEFAULT_ENV_ID = acld_gym.ENV_ID
 #: Evaluation cases, in table order.
@@ -39,7 +47,7 @@ CASES: tuple = (1, 2, 3, "random")
 def eval_episodes(random_episodes: int | None = None) -> dict:
     """``{case: seeds}``: seed 0 for the thesis cases, the held-out seeds (all 20, or the
     first ``random_episodes``) for ``"random"``."""
-    from .compare import HELDOUT_SEEDS
+    from ..compare import HELDOUT_SEEDS
 
     n = len(HELDOUT_SEEDS) if random_episodes is None else int(random_episodes)
     return {1: (0,), 2: (0,), 3: (0,), "random": tuple(HELDOUT_SEEDS[:n])}
@@ -59,8 +67,9 @@ def rollout_ise(policy, env_id: str = DEFAULT_ENV_ID, episodes: dict | None = No
     out = {}
     for case, seeds in episodes.items():
         env = _make_env(env_id, case)
-        out[case] = float(np.mean([metrics_row(case, "agent", rollout(policy, env, seed=s)).ise
-                                   for s in seeds]))
+        out[case] = float(
+            np.mean([metrics_row(case, "agent", rollout(policy, env, seed=s)).ise for s in seeds])
+        )
     return out
 
 
@@ -91,8 +100,9 @@ def batched_ise(policy, env_id: str = DEFAULT_ENV_ID, episodes: dict | None = No
         alive &= ~np.concatenate(done)
     for venv in venvs:
         venv.close()
-    return {case: float(part.mean()) for case, part in zip(episodes, np.split(ise, sizes),
-                                                           strict=True)}
+    return {
+        case: float(part.mean()) for case, part in zip(episodes, np.split(ise, sizes), strict=True)
+    }
 
 
 def relative_ise(ise: dict, refs: dict, to: str = "lqr") -> dict:
@@ -108,12 +118,20 @@ def reference_policies(env_id: str = DEFAULT_ENV_ID) -> dict:
 
     env = _make_env(env_id, 1)
     nom = env.nom
-    return {"passive": PassivePolicy(nom=nom), "lqr": LQRPolicy(nom=nom),
-            "smc": SMCPolicy(nom=nom), "mpc": MPCPolicy(nom=nom)}
+    return {
+        "passive": PassivePolicy(nom=nom),
+        "lqr": LQRPolicy(nom=nom),
+        "smc": SMCPolicy(nom=nom),
+        "mpc": MPCPolicy(nom=nom),
+    }
 
 
-def references(env_id: str = DEFAULT_ENV_ID, cache: str | Path | None = None,
-               random_episodes: int | None = None, bound: bool = True) -> dict[str, Any]:
+def references(
+    env_id: str = DEFAULT_ENV_ID,
+    cache: str | Path | None = None,
+    random_episodes: int | None = None,
+    bound: bool = True,
+) -> dict[str, Any]:
     """Mean ISE per case of passive, LQR, SMC, MPC and the clairvoyant bound,
     ``{"env_id": ..., "episodes": ..., "passive": {case: ise}, ...}`` (cases as strings).
 
@@ -126,8 +144,11 @@ def references(env_id: str = DEFAULT_ENV_ID, cache: str | Path | None = None,
     key = {str(c): list(s) for c, s in episodes.items()}
     if cache is not None and Path(cache).is_file():
         data = json.loads(Path(cache).read_text())
-        if data.get("env_id") == env_id and data.get("episodes") == key \
-                and (not bound or "bound" in data):
+        if (
+            data.get("env_id") == env_id
+            and data.get("episodes") == key
+            and (not bound or "bound" in data)
+        ):
             return data
     pols = reference_policies(env_id)
     data: dict[str, Any] = {"env_id": env_id, "episodes": key}

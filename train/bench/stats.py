@@ -18,11 +18,12 @@ def iqm(scores) -> float:
     if x.size == 0:
         raise ValueError("iqm of no scores")
     k = int(0.25 * x.size)
-    return float(x[k:x.size - k].mean())
+    return float(x[k : x.size - k].mean())
 
 
-def stratified_bootstrap_ci(scores, statistic=iqm, reps: int = 2000, confidence: float = 0.95,
-                            seed: int = 0) -> tuple[float, float]:
+def stratified_bootstrap_ci(
+    scores, statistic=iqm, reps: int = 2000, confidence: float = 0.95, seed: int = 0
+) -> tuple[float, float]:
     """Percentile confidence interval of ``statistic`` over a (runs, tasks) score
     matrix (a 1-D array is one task): each replicate draws, for every task
     independently, as many runs as there are with replacement.

@@ -1,0 +1,29 @@
+r"""The teacher-free benchmark (``python -m train.benchmark``).
+
+Every algorithm learns from the env's observation and reward only: no controller,
+demonstration or controller-derived reward anywhere in training, and nothing read
+from the env's internals. :func:`train_algo` trains one for a fixed env-step budget,
+reports learning-curve points through a callback, and returns a policy with SB3's
+``predict`` in volts.
+
+* ``vrs`` (the recipe): vectorised random search (ARS, Mania et al. 2018, "V1-t") on
+  the linear direction actor :class:`LinearDirectionActor`,
+  :math:`V = 120\,\mathrm{clip}(w \cdot [u/|u|, \log|u|] + b, -1, 1)` (9 parameters
+  for the 7-value observation z), :math:`u = T^T z` with T a whitening matrix the
+  agent estimates from its own first round of episodes (:func:`whitening`). All
+  2 x ``n_directions`` perturbed actors run side by side in the native batched env
+  on the same episodes (common random numbers), and each episode's return R is
+  scored as :math:`-\log(-R)` (``objective: log``), which makes loads whose returns
+  differ by three decades weigh alike (reward normalisation per load).
+* ``ars``: sb3-contrib's ``ARS`` (linear policy, clipped) on the direction features.
+* ``ppo``, ``sac``, ``td3``, ``tqc``, ``crossq``: stable-baselines3 / sb3-contrib
+  through :func:`make_sb3_env`: the native batched env (``SB3VecEnv``), actions in
+  [-1, 1] (``train.vec.VecAgentEnv``, no residual, no shaping), optionally the
+  direction features as the observation (:class:`VecDirectionFeatures`), and
+  ``VecNormalize``. Options for them (fields of :class:`AlgoConfig`): ``whiten_steps``,
+  a ZCA whitening of the observation estimated from the agent's own first rollouts
+  (:class:`VecWhiten`, the steps counted in the budget); for PPO the policy
+  ``SplitCriticPolicy`` (the critic on its own features, e.g. quadratic ones,
+  :class:`SplitCriticPolicy`) and ``episode_scale``, advantages normalised per episode
+  (:class:`EpisodeScaledRolloutBuffer`).
+"""

@@ -1,0 +1,164 @@
+"""Policy pieces for the SB3 algorithms: a critic on its own (e.g. quadratic) features
+(:class:`SplitCriticPolicy`), advantages normalised per episode
+(:class:`EpisodeScaledRolloutBuffer`), and a trained model as a ``predict`` policy in
+volts (:class:`SB3Policy`)."""
+
+from __future__ import annotations
+
+import numpy as np
+import torch
+import torch.nn as nn
+from gymnasium import spaces
+from stable_baselines3.common.buffers import RolloutBuffer
+from stable_baselines3.common.policies import ActorCriticPolicy
+from stable_baselines3.common.torch_layers import (
+    BaseFeaturesExtractor,
+    FlattenExtractor,
+    MlpExtractor,
+)
+from stable_baselines3.common.vec_env import VecNormalize
+
+import acld_gym  # noqa: F401  (registers the env ids)
+
+from ..features import DirectionFeatures, direction_features
+
+__all__ = [
+    "QuadraticFeatures",
+    "CRITIC_FEATURES",
+    "SplitCriticPolicy",
+    "EpisodeScaledRolloutBuffer",
+    "SB3Policy",
+]
+
+
+class QuadraticFeatures(BaseFeaturesExtractor):
+    r"""Features :math:`[u,\ u_i u_j\ (i \le j)]` of the observation u (d + d(d+1)/2
+    values): a linear value on them is a quadratic form plus a linear term, the
+    shape of a linear-quadratic problem's value function."""
+
+    def __init__(self, observation_space: spaces.Box):
+        d = int(observation_space.shape[0])
+        super().__init__(observation_space, features_dim=d + d * (d + 1) // 2)
+        i, j = np.triu_indices(d)
+        self.register_buffer("_i", torch.as_tensor(i), persistent=False)
+        self.register_buffer("_j", torch.as_tensor(j), persistent=False)
+
+    def forward(self, observations: torch.Tensor) -> torch.Tensor:
+        return torch.cat(
+            [observations, observations[:, self._i] * observations[:, self._j]], dim=-1
+        )
+
+
+#: ``critic_features`` of :class:`SplitCriticPolicy` and their extractor classes.
+CRITIC_FEATURES = {
+    "quadratic": QuadraticFeatures,
+    "direction": DirectionFeatures,
+    "flatten": FlattenExtractor,
+}
+
+
+class _SplitMlp(nn.Module):
+    """``MlpExtractor``'s interface with actor and critic on inputs of their own size."""
+
+    def __init__(self, pi_dim, vf_dim, net_arch, activation_fn, device):
+        super().__init__()
+        arch = net_arch if isinstance(net_arch, dict) else {"pi": net_arch, "vf": net_arch}
+        pi = MlpExtractor(pi_dim, {"pi": list(arch.get("pi", [])), "vf": []}, activation_fn, device)
+        vf = MlpExtractor(vf_dim, {"pi": [], "vf": list(arch.get("vf", []))}, activation_fn, device)
+        self.policy_net, self.value_net = pi.policy_net, vf.value_net
+        self.latent_dim_pi, self.latent_dim_vf = pi.latent_dim_pi, vf.latent_dim_vf
+
+    def forward(self, features):
+        return self.forward_actor(features), self.forward_critic(features)
+
+    def forward_actor(self, features):
+        return self.policy_net(features)
+
+    def forward_critic(self, features):
+        return self.value_net(features)
+
+
+class SplitCriticPolicy(ActorCriticPolicy):
+    """PPO's ``ActorCriticPolicy`` whose critic has features of its own,
+    ``critic_features`` (a ``policy_kwargs`` key): ``"quadratic"``
+    (:class:`QuadraticFeatures`; with ``net_arch: {vf: []}`` the value is a quadratic
+    form of the observation, suited to a linear-quadratic problem), ``"direction"``
+    (:class:`train.features.DirectionFeatures`) or ``"flatten"``. The actor sees the
+    (flattened) observation, e.g. linear with ``net_arch: {pi: []}``."""
+
+    def __init__(self, *args, critic_features: str = "quadratic", **kwargs):
+        if critic_features not in CRITIC_FEATURES:
+            raise ValueError(f"critic_features must be one of {list(CRITIC_FEATURES)}")
+        self.critic_features = critic_features
+        kwargs["share_features_extractor"] = False
+        super().__init__(*args, **kwargs)
+
+    def _build_mlp_extractor(self) -> None:
+        self.vf_features_extractor = CRITIC_FEATURES[self.critic_features](self.observation_space)
+        self.mlp_extractor = _SplitMlp(
+            self.features_dim,
+            self.vf_features_extractor.features_dim,
+            self.net_arch,
+            self.activation_fn,
+            self.device,
+        )
+
+    def _get_constructor_parameters(self) -> dict:
+        data = super()._get_constructor_parameters()
+        data["critic_features"] = self.critic_features
+        return data
+
+
+class EpisodeScaledRolloutBuffer(RolloutBuffer):
+    """A ``RolloutBuffer`` that divides the GAE advantages of each episode segment (per
+    sub-env, split at episode starts) by their root mean square, after the returns
+    (the critic's targets, unchanged) are computed: advantage normalisation per
+    episode (per load). Episodes whose returns differ by decades then weigh alike in
+    the policy gradient, as in the random search's -log(-R) score."""
+
+    def compute_returns_and_advantage(self, last_values, dones) -> None:
+        super().compute_returns_and_advantage(last_values, dones)
+        n = self.buffer_size
+        for e in range(self.n_envs):
+            starts = [0, *[int(t) for t in np.flatnonzero(self.episode_starts[1:, e]) + 1], n]
+            for a, b in zip(starts[:-1], starts[1:], strict=True):
+                rms = float(np.sqrt(np.mean(self.advantages[a:b, e] ** 2)))
+                self.advantages[a:b, e] /= max(rms, 1e-12)
+
+
+class SB3Policy:
+    """A trained SB3 model with its frozen ``VecNormalize`` statistics as a policy on the
+    env's raw observation, ``predict`` in volts (``V = v_max * clip(a, -1, 1)``);
+    ``transform``: the agent's whitening matrix (:class:`VecWhiten`), or None."""
+
+    def __init__(
+        self,
+        model,
+        obs_norm: VecNormalize | None,
+        features: str | None,
+        v_max: float = 120.0,
+        transform: np.ndarray | None = None,
+    ):
+        self.model = model
+        self.obs_norm = obs_norm
+        self.features = features
+        self.v_max = float(v_max)
+        self.transform = None if transform is None else np.asarray(transform, np.float64)
+
+    def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
+        obs = np.asarray(observation, dtype=np.float32)
+        batched = obs.ndim == 2
+        x = np.atleast_2d(obs)
+        if self.transform is not None:
+            x = (x.astype(np.float64) @ self.transform).astype(np.float32)
+        if self.features == "direction":
+            x = direction_features(x).astype(np.float32)
+        if self.obs_norm is not None:
+            x = self.obs_norm.normalize_obs(x)
+        import torch
+
+        with torch.no_grad():  # the deterministic action of model.predict, without its checks
+            a = self.model.policy._predict(torch.as_tensor(x), deterministic=True).numpy()
+        v = self.v_max * np.clip(np.asarray(a, dtype=np.float64).reshape(-1, 1), -1, 1)
+        v = v.astype(np.float32)
+        return (v if batched else v[0]), state

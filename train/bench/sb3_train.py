@@ -1,0 +1,157 @@
+"""Training of the stable-baselines3 / sb3-contrib algorithms (PPO, SAC, TD3, TQC,
+CrossQ, ARS) for the benchmark, from scratch on the env's observation and reward."""
+
+from __future__ import annotations
+
+import numpy as np
+import torch
+import torch.nn as nn
+
+import acld_gym  # noqa: F401  (registers the env ids)
+
+from .config import SB3_ALGOS, AlgoConfig, CurveCallback, eval_schedule
+from .sb3_envs import VecWhiten, make_sb3_env
+from .sb3_policies import EpisodeScaledRolloutBuffer, SB3Policy, SplitCriticPolicy
+from .search import whitening
+
+__all__ = ["fold_whitening", "train_sb3"]
+
+
+def _sb3_class(algo: str):
+    import importlib
+
+    module, name = SB3_ALGOS[algo]
+    return getattr(importlib.import_module(module), name)
+
+
+class _linear_schedule:  # noqa: N801  (an SB3 schedule: progress remaining 1 -> 0)
+    def __init__(self, start: float, end: float):
+        self.start, self.end = start, end
+
+    def __call__(self, progress_remaining: float) -> float:
+        return self.end + (self.start - self.end) * progress_remaining
+
+
+def _resolve_policy_kwargs(kwargs: dict) -> dict:
+    """YAML-friendly keyword arguments: ``policy_kwargs.activation_fn`` given by name
+    (``"tanh"``); ``policy: SplitCriticPolicy`` names :class:`SplitCriticPolicy`;
+    ``learning_rate`` / ``clip_range`` as ``{linear: [start, end]}``, a schedule linear in
+    the progress from ``start`` to ``end``."""
+    for key in ("learning_rate", "clip_range"):
+        value = kwargs.get(key)
+        if isinstance(value, dict):
+            if set(value) != {"linear"} or len(value["linear"]) != 2:
+                raise ValueError(f"{key}: a number or {{linear: [start, end]}}, got {value!r}")
+            kwargs = {**kwargs, key: _linear_schedule(*map(float, value["linear"]))}
+
+    if kwargs.get("policy") == "SplitCriticPolicy":
+        kwargs = {**kwargs, "policy": SplitCriticPolicy}
+    pk = dict(kwargs.get("policy_kwargs") or {})
+    if isinstance(pk.get("activation_fn"), str):
+        pk["activation_fn"] = {"tanh": nn.Tanh, "relu": nn.ReLU}[pk["activation_fn"].lower()]
+    if pk:
+        kwargs = {**kwargs, "policy_kwargs": pk}
+    return kwargs
+
+
+def _first_actor_layer(model) -> nn.Linear:
+    """The first linear layer of an SB3 model's deterministic actor (as ``export_sb3``
+    walks it)."""
+    pol = model.policy
+    actor = getattr(pol, "actor", None)
+    if actor is not None and hasattr(actor, "latent_pi"):  # SAC, TQC
+        layers = [
+            *actor.latent_pi,
+            *(actor.mu if isinstance(actor.mu, nn.Sequential) else [actor.mu]),
+        ]
+    elif actor is not None and hasattr(actor, "mu"):  # TD3
+        layers = list(actor.mu)
+    else:  # PPO
+        layers = [*pol.mlp_extractor.policy_net, pol.action_net]
+    return next(m for m in layers if isinstance(m, nn.Linear))
+
+
+def fold_whitening(model, transform: np.ndarray) -> None:
+    """Fold the whitening ``u = T^T z`` into the actor's first layer (``W u = (W T^T) z``),
+    so that the trained actor takes the raw observation (and exports as a plain SB3
+    actor). Only the deterministic actor stays meaningful afterwards (critic and gSDE
+    noise still expect u): call it when training is over."""
+    layer = _first_actor_layer(model)
+    with torch.no_grad():
+        t = torch.as_tensor(np.asarray(transform).T, dtype=layer.weight.dtype)
+        layer.weight.copy_(layer.weight @ t)
+
+
+def train_sb3(
+    cfg: AlgoConfig,
+    seed: int,
+    env_id: str,
+    callback: CurveCallback | None = None,
+) -> tuple[SB3Policy, dict]:
+    """Train an SB3 / sb3-contrib algorithm for ``cfg.timesteps`` env steps (with
+    ``cfg.whiten_steps``: first that many steps of the initial policy, from which the
+    whitening is estimated, then the rest of the budget of training)."""
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    torch.set_num_threads(1)
+    kwargs = _resolve_policy_kwargs(dict(cfg.model))
+    policy = kwargs.pop("policy")
+    gamma = float(kwargs.get("gamma", 0.99))
+    if cfg.episode_scale:
+        kwargs["rollout_buffer_class"] = EpisodeScaledRolloutBuffer
+    venv = make_sb3_env(cfg, seed, env_id, gamma)
+    v_max = 120.0
+    model = _sb3_class(cfg.algo)(policy, venv, seed=seed, device="cpu", verbose=0, **kwargs)
+    schedule = eval_schedule(cfg.timesteps, cfg.eval_points)
+    white = venv.venv  # under VecNormalize (whiten_steps: no direction features)
+    transform = None
+    offset = 0
+
+    def snapshot() -> SB3Policy:
+        norm = None
+        if cfg.normalize.get("norm_obs", False):
+            import copy
+
+            norm = copy.deepcopy(venv)
+            norm.venv = None
+            norm.training = False
+        return SB3Policy(model, norm, cfg.features, v_max, transform)
+
+    if cfg.whiten_steps:
+        assert isinstance(white, VecWhiten)
+        if callback is not None and schedule.due(0):
+            callback(0, snapshot())
+        white.collect = []
+        obs = venv.reset()
+        if getattr(model, "use_sde", False):
+            model.policy.reset_noise(venv.num_envs)
+        while offset < cfg.whiten_steps:
+            action, _ = model.predict(obs, deterministic=False)
+            obs, _, _, _ = venv.step(action)
+            offset += venv.num_envs
+        transform = whitening(np.concatenate(white.collect))
+        white.collect = None
+        white.set_transform(transform)
+
+    class Curve(BaseCallback):
+        def _on_step(self) -> bool:
+            steps = offset + int(self.num_timesteps)
+            if callback is not None and schedule.due(steps):
+                callback(steps, snapshot())
+            return True
+
+        def _on_training_start(self) -> None:
+            self._on_step()
+
+    model.learn(max(cfg.timesteps - offset, 1), callback=Curve())
+    record = {
+        "steps": offset + int(model.num_timesteps),
+        "whiten_steps": offset,
+        "transform": None if transform is None else transform.tolist(),
+    }
+    if transform is not None:  # u = T' z into the actor's first layer: a plain SB3 actor on z
+        fold_whitening(model, transform)
+        transform = None
+    pol = snapshot()
+    venv.close()
+    return pol, record

@@ -1,0 +1,278 @@
+"""``vrs``, the benchmark's recipe: vectorised random search (ARS, Mania et al. 2018,
+"V1-t") on the linear direction actor, every perturbed actor side by side in the
+native batched env on common episodes. Learns from the env's reward only."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import gymnasium as gym
+import numpy as np
+
+import acld_gym  # noqa: F401  (registers the env ids)
+
+from ..features import direction_features
+from .config import AlgoConfig, CurveCallback, eval_schedule
+
+__all__ = ["LinearDirectionActor", "whitening", "RandomSearch", "train_random_search"]
+
+
+# --- the linear direction actor -------------------------------------------------
+class LinearDirectionActor:
+    r"""The switching actor :math:`V = V_{max}\,\mathrm{clip}(w \cdot f + b, -1, 1)` on
+    :math:`f = [u/|u|, \log|u|]` of :math:`u = T^T z`, z the raw observation and T a fixed
+    whitening matrix estimated from the agent's own observations (identity if None;
+    ``theta = [w, b]``). ``features=None`` uses f = u instead (a saturated linear
+    state feedback).
+
+    ``predict`` follows SB3's protocol and returns volts, so
+    :func:`baselines.evaluate.rollout` runs it like any baseline.
+    """
+
+    def __init__(
+        self,
+        theta: np.ndarray,
+        v_max: float = 120.0,
+        features: str | None = "direction",
+        transform: np.ndarray | None = None,
+    ):
+        self.theta = np.asarray(theta, dtype=np.float64).copy()
+        self.v_max = float(v_max)
+        self.features = features
+        self.transform = None if transform is None else np.asarray(transform, np.float64)
+
+    @staticmethod
+    def actions(
+        obs: np.ndarray,
+        thetas: np.ndarray,
+        features: str | None = "direction",
+        transform: np.ndarray | None = None,
+    ) -> np.ndarray:
+        """Actions in [-1, 1], shape (n,), of one parameter row per observation row."""
+        u = np.asarray(obs, np.float64)
+        if transform is not None:
+            u = u @ transform
+        f = direction_features(u) if features == "direction" else u
+        return np.clip(np.einsum("ni,ni->n", f, thetas[:, :-1]) + thetas[:, -1], -1.0, 1.0)
+
+    def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
+        """SB3 protocol: ``(voltages, state)``, shape (n, 1) for a batch or (1,)."""
+        obs = np.asarray(observation, dtype=np.float64)
+        batched = obs.ndim == 2
+        obs2 = np.atleast_2d(obs)
+        a = self.actions(
+            obs2,
+            np.broadcast_to(self.theta, (obs2.shape[0], self.theta.size)),
+            self.features,
+            self.transform,
+        )
+        v = (self.v_max * a)[:, None].astype(np.float32)
+        return (v if batched else v[0]), state
+
+    def as_dict(self) -> dict:
+        return {
+            "theta": self.theta.tolist(),
+            "v_max": self.v_max,
+            "features": self.features,
+            "transform": None if self.transform is None else self.transform.tolist(),
+        }
+
+
+def whitening(directions: np.ndarray, ridge: float = 1e-3) -> np.ndarray:
+    r"""ZCA whitening matrix :math:`T = \Sigma^{-1/2}` (ridge-regularised, relative to the
+    largest eigenvalue) of the second moment of the observation directions ``z/|z|``
+    (rows), so that the direction features of ``z @ T`` are isotropic on average."""
+    u = np.asarray(directions, dtype=np.float64)
+    sigma = u.T @ u / max(u.shape[0], 1)
+    lam, vec = np.linalg.eigh(sigma)
+    lam = np.maximum(lam, 0.0) + ridge * lam.max()
+    return (vec / np.sqrt(lam)) @ vec.T
+
+
+@dataclass(frozen=True)
+class RandomSearch:
+    """Settings of ``vrs`` (the ``model:`` mapping of its YAML file).
+
+    Attributes
+    ----------
+    n_directions : int
+        Perturbation directions per iteration (2 x as many candidates).
+    top_directions : int
+        Directions used in the update (the best by max of their two scores).
+    step_size : float
+        ARS step size alpha (the update is divided by the scores' std).
+    noise : float
+        Perturbation std nu.
+    relative : bool
+        Scale step and perturbation by max(1, |theta| / sqrt(dim)): a step of the same
+        relative size as the actor's gain grows (the boundary layer can thin out).
+    objective : str
+        Score of an episode with return R: ``"log"`` -log(-R) (per-load scale-free),
+        ``"return"`` R itself.
+    init_std : float
+        Std of the random initial parameters (seeded).
+    anneal : float
+        Step size and noise fall linearly over the budget to this fraction of their
+        initial values (1: constant), so the final actor jitters less.
+    whiten : bool
+        Estimate a whitening matrix (:func:`whitening`) from the observations of a first
+        round of candidate episodes (counted in the budget) and search the actor on the
+        whitened observation. The scaled observation's components are strongly
+        correlated (up to 0.999), which makes an isotropic search in w ill-conditioned.
+    common_episodes : bool
+        Every candidate of an iteration runs on the same episodes (loads and sensor
+        noise; common random numbers), so a direction's +/- scores differ by the
+        perturbation, not by the loads. False: independent episodes per candidate.
+    """
+
+    n_directions: int = 16
+    top_directions: int = 8
+    step_size: float = 0.02
+    noise: float = 0.03
+    relative: bool = True
+    objective: str = "log"
+    init_std: float = 0.1
+    anneal: float = 1.0
+    whiten: bool = False
+    common_episodes: bool = True
+
+    def __post_init__(self):
+        if not 1 <= self.top_directions <= self.n_directions:
+            raise ValueError("need 1 <= top_directions <= n_directions")
+        if self.objective not in ("log", "return"):
+            raise ValueError(f"objective must be 'log' or 'return', got {self.objective!r}")
+
+
+class _CandidateEnvs:
+    """One native vector env per training load case, with ``per_candidate`` episodes of
+    that case for each of ``n_candidates`` parameter rows (candidate-major)."""
+
+    def __init__(
+        self, env_id: str, loads: dict, n_candidates: int, features: str | None = "direction"
+    ):
+        self.envs = {}
+        self.features = features
+        self.n_candidates = n_candidates
+        for case, n in loads.items():
+            n = int(n)
+            venv = gym.make_vec(env_id, num_envs=n_candidates * n, load_case=case).unwrapped
+            self.envs[case] = (venv, n)
+        first = next(iter(self.envs.values()))[0]
+        self.v_max = float(first.single_action_space.high[0])
+        self.horizon = int(first.horizon)
+        self.n_obs = int(first.single_observation_space.shape[0])
+
+    @property
+    def steps_per_round(self) -> int:
+        return sum(v.num_envs for v, _ in self.envs.values()) * self.horizon
+
+    def returns(
+        self,
+        thetas: np.ndarray,
+        seed: int,
+        common: bool = True,
+        transform: np.ndarray | None = None,
+        collect: list | None = None,
+    ) -> np.ndarray:
+        """Returns, shape (n_candidates, episodes). ``common``: every candidate on the same
+        episodes (episode j of a case seeded ``seed + j``; the cases' seeds are offset);
+        else each candidate on its own episodes. ``collect``: a list that receives
+        observation directions (every 10th step)."""
+        out = []
+        for c_idx, (venv, n) in enumerate(self.envs.values()):
+            stride = 0 if common else n
+            seeds = [
+                seed + 100_000 * c_idx + stride * i + j
+                for i in range(self.n_candidates)
+                for j in range(n)
+            ]
+            obs, _ = venv.reset(seed=seeds)
+            th = np.repeat(thetas, n, axis=0)
+            ret = np.zeros(venv.num_envs)
+            alive = np.ones(venv.num_envs, dtype=bool)
+            for k in range(self.horizon):
+                if collect is not None and k % 10 == 0:
+                    z = np.asarray(obs, np.float64)
+                    r = np.linalg.norm(z, axis=1, keepdims=True)
+                    collect.append((z / np.maximum(r, 1e-12))[r[:, 0] > 0])
+                v = self.v_max * LinearDirectionActor.actions(obs, th, self.features, transform)
+                obs, r, term, trunc, _ = venv.step(v[:, None])
+                ret += np.where(alive, r, 0.0)
+                alive &= ~(term | trunc)
+                if not alive.any():
+                    break
+            out.append(ret.reshape(self.n_candidates, n))
+        return np.concatenate(out, axis=1)
+
+    def close(self) -> None:
+        for venv, _ in self.envs.values():
+            venv.close()
+
+
+def train_random_search(
+    cfg: AlgoConfig,
+    seed: int,
+    env_id: str,
+    callback: CurveCallback | None = None,
+) -> tuple[LinearDirectionActor, dict]:
+    """``vrs``: ARS on the linear direction actor for ``cfg.timesteps`` env steps.
+
+    Returns the final actor and a record (iterations, steps, |theta|)."""
+    rs = RandomSearch(**cfg.model)
+    rng = np.random.default_rng(seed)
+    envs = _CandidateEnvs(env_id, cfg.load_weights, 2 * rs.n_directions, cfg.features)
+    n_obs = envs.n_obs
+    dim = n_obs + 1 + (1 if cfg.features == "direction" else 0)  # features and a bias
+    theta = rng.normal(0.0, rs.init_std, dim)
+    transform = None
+    steps, it = 0, 0
+    schedule = eval_schedule(cfg.timesteps, cfg.eval_points)
+    history = []
+
+    def actor() -> LinearDirectionActor:
+        return LinearDirectionActor(theta, envs.v_max, cfg.features, transform)
+
+    def candidates(scale: float) -> tuple[np.ndarray, np.ndarray]:
+        deltas = rng.normal(0.0, 1.0, (rs.n_directions, dim))
+        return deltas, np.concatenate(
+            [theta + scale * rs.noise * deltas, theta - scale * rs.noise * deltas]
+        )
+
+    def episode_seed() -> int:
+        return int(rng.integers(1_000_000, 2**31 - 10_000_000))
+
+    if rs.whiten and steps + envs.steps_per_round <= cfg.timesteps:
+        if callback is not None and schedule.due(steps):
+            callback(steps, actor())
+        seen: list = []
+        envs.returns(candidates(1.0)[1], episode_seed(), rs.common_episodes, None, seen)
+        steps += envs.steps_per_round
+        transform = whitening(np.concatenate(seen))
+    while True:
+        if callback is not None and schedule.due(steps):
+            callback(steps, actor())
+        if steps + envs.steps_per_round > cfg.timesteps:
+            break
+        scale = max(1.0, float(np.linalg.norm(theta)) / np.sqrt(dim)) if rs.relative else 1.0
+        scale *= 1.0 - (1.0 - rs.anneal) * steps / cfg.timesteps
+        deltas, cands = candidates(scale)
+        R = envs.returns(cands, episode_seed(), rs.common_episodes, transform)
+        steps += envs.steps_per_round
+        score = (-np.log(np.maximum(-R, 1e-12)) if rs.objective == "log" else R).mean(axis=1)
+        plus, minus = score[: rs.n_directions], score[rs.n_directions :]
+        top = np.argsort(-np.maximum(plus, minus))[: rs.top_directions]
+        std = float(np.concatenate([plus[top], minus[top]]).std()) + 1e-12
+        theta = theta + scale * rs.step_size / (rs.top_directions * std) * (
+            (plus[top] - minus[top]) @ deltas[top]
+        )
+        it += 1
+        history.append((steps, float(score.mean())))
+    envs.close()
+    final = actor()
+    return final, {
+        "iterations": it,
+        "steps": steps,
+        "actor": final.as_dict(),
+        "theta_norm": float(np.linalg.norm(theta)),
+        "score_history": history[-5:],
+    }

@@ -2,7 +2,7 @@ r"""The teacher-free benchmark (``python -m train.benchmark``).
 
 Every algorithm learns from the env's observation and reward only: no controller,
 demonstration or controller-derived reward anywhere in training, and nothing read
-from the env's internals. :func:`train_algo` trains one for a fixed env-step budget,
+from the env's internals. :func:`~train.bench.algos.train_algo` trains one for a fixed env-step budget,
 reports learning-curve points through a callback, and returns a policy with SB3's
 ``predict`` in volts.
 
@@ -26,4 +26,10 @@ reports learning-curve points through a callback, and returns a policy with SB3'
   ``SplitCriticPolicy`` (the critic on its own features, e.g. quadratic ones,
   :class:`SplitCriticPolicy`) and ``episode_scale``, advantages normalised per episode
   (:class:`EpisodeScaledRolloutBuffer`).
+
+Modules, in the order of a run: ``config`` (an algorithm's YAML settings), ``search``
+(``vrs``), ``sb3_envs``, ``sb3_policies`` and ``sb3_train`` (the SB3 algorithms),
+``algos`` (:func:`~train.bench.algos.train_algo`), ``evaluate`` (ISE / LQR through the
+env), ``trials`` (one run, many runs, Ray Tune), ``stats`` (IQM, bootstrap) and
+``report`` (tables and learning curves). The command is :mod:`train.benchmark`.
 """

@@ -1,0 +1,190 @@
+"""The benchmark's report: IQM of ISE / LQR with 95 % bootstrap intervals per algorithm
+and case (:func:`summarize`), its markdown table, and the learning-curve figure."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from acld_gym.util.atomic import save_figure
+
+from .evaluate import CASES
+
+__all__ = ["summarize", "markdown", "plot_curves"]
+
+from .trials import REFERENCES
+
+
+def summarize(records: list[dict], refs: dict) -> dict:
+    """Per config: IQM and 95 % stratified-bootstrap CI of ISE / LQR per case over the
+    seeds, the per-seed values, wall time, and the goals of issue 10."""
+    from .stats import iqm, iqm_with_ci
+
+    lqr = refs["lqr"]
+    out: dict = {
+        "env_id": refs["env_id"],
+        "episodes": refs["episodes"],
+        "algorithms": {},
+        "references": {
+            k: {c: refs[k][c] / lqr[c] for c in lqr} for k in ("passive", *REFERENCES) if k in refs
+        },
+    }
+    for name in dict.fromkeys(r["name"] for r in records):
+        runs = sorted((r for r in records if r["name"] == name), key=lambda r: r["seed"])
+        rel = np.array([[r["final_ise"][str(c)] / lqr[str(c)] for c in CASES] for r in runs])
+        stats = {str(c): iqm_with_ci(rel[:, j]) for j, c in enumerate(CASES)}
+        smc = out["references"].get("smc", {})
+        bound = out["references"].get("bound")
+        goals = {
+            "beats_lqr_and_smc_iqm": all(
+                stats[c]["iqm"] < min(1.0, smc.get(c, np.inf)) for c in ("1", "2", "random")
+            ),
+            "every_seed_beats_lqr": bool((rel[:, [0, 1, 3]] < 1.0).all()),
+            "case3_within_2pct_of_lqr": stats["3"]["iqm"] <= 1.02,
+            "train_wall_within_15_min": max(r["train_seconds"] for r in runs) <= 900.0,
+            "train_cpu_within_15_min": max(r.get("train_cpu_seconds", np.inf) for r in runs)
+            <= 900.0,
+        }
+        if bound is not None:
+            goals["stretch_within_1.25x_bound"] = all(
+                stats[c]["iqm"] <= 1.25 * bound[c] for c in ("1", "2")
+            )
+        curve_steps = [p["steps"] for p in runs[0]["curve"]]
+        n_pts = min(len(r["curve"]) for r in runs)
+        curve = []
+        for k in range(n_pts):
+            pt = {"steps": curve_steps[k]}
+            for c in CASES:
+                vals = np.array([r["curve"][k]["ise"][str(c)] / lqr[str(c)] for r in runs])
+                pt[str(c)] = iqm_with_ci(vals, reps=500)
+            curve.append(pt)
+        out["algorithms"][name] = {
+            "algo": runs[0]["algo"],
+            "budget": runs[0]["budget"],
+            "seeds": [r["seed"] for r in runs],
+            "ise_rel_lqr": stats,
+            "goals": goals,
+            "train_seconds": {
+                "iqm": iqm([r["train_seconds"] for r in runs]),
+                "max": max(r["train_seconds"] for r in runs),
+            },
+            "train_cpu_seconds": {
+                "iqm": iqm([r.get("train_cpu_seconds", np.nan) for r in runs]),
+                "max": max(r.get("train_cpu_seconds", np.nan) for r in runs),
+            },
+            "per_seed": [
+                {
+                    "seed": r["seed"],
+                    "train_seconds": r["train_seconds"],
+                    "train_cpu_seconds": r.get("train_cpu_seconds", np.nan),
+                    **{str(c): float(rel[i, j]) for j, c in enumerate(CASES)},
+                }
+                for i, r in enumerate(runs)
+            ],
+            "curve": curve,
+        }
+    return out
+
+
+def markdown(summary: dict) -> str:
+    """The summary as markdown: the IQM table, the goals and the per-seed table."""
+
+    def cell(s):
+        return f"{s['iqm']:.3f} [{s['ci_low']:.3f}, {s['ci_high']:.3f}]"
+
+    n_rand = len(summary["episodes"]["random"])
+    lines = [
+        f"ISE / ISE_LQR on `{summary['env_id']}` (+/-120 V, 1 ms, Kalman observer, "
+        f"deterministic policy): IQM over seeds [95 % stratified-bootstrap CI]; thesis "
+        f"cases seed 0, `random` = mean ISE over {n_rand} held-out episodes / LQR's.",
+        "",
+        "| algorithm | budget [env steps] | seeds | case 1 | case 2 | case 3 | random "
+        "| train wall / CPU time per seed [s] (IQM; max) |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for name, a in summary["algorithms"].items():
+        t, cpu = a["train_seconds"], a["train_cpu_seconds"]
+        lines.append(
+            f"| {name} ({a['algo']}) | {a['budget']:,} | {len(a['seeds'])} | "
+            + " | ".join(cell(a["ise_rel_lqr"][str(c)]) for c in CASES)
+            + f" | {t['iqm']:.0f} / {cpu['iqm']:.0f}; {t['max']:.0f} / {cpu['max']:.0f} |"
+        )
+    for ref, vals in summary["references"].items():
+        lines.append(
+            f"| {ref} (reference) | - | - | "
+            + " | ".join(f"{vals[str(c)]:.3f}" for c in CASES)
+            + " | - |"
+        )
+    lines += [
+        "",
+        "Goals of issue 10 (IQM over seeds; every seed on cases 1, 2, random):",
+        "",
+        "| algorithm | " + " | ".join(next(iter(summary["algorithms"].values()))["goals"]) + " |",
+        "|---" * (1 + len(next(iter(summary["algorithms"].values()))["goals"])) + "|",
+    ]
+    for name, a in summary["algorithms"].items():
+        lines.append(
+            f"| {name} | " + " | ".join("yes" if v else "no" for v in a["goals"].values()) + " |"
+        )
+    lines += [
+        "",
+        "Per seed (ISE / LQR):",
+        "",
+        "| algorithm | seed | case 1 | case 2 | case 3 | random | train wall / CPU [s] |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for name, a in summary["algorithms"].items():
+        for s in a["per_seed"]:
+            vals = " | ".join(f"{s[str(c)]:.3f}" for c in CASES)
+            lines.append(
+                f"| {name} | {s['seed']} | {vals} | {s['train_seconds']:.0f} / "
+                f"{s['train_cpu_seconds']:.0f} |"
+            )
+    return "\n".join(lines) + "\n"
+
+
+def plot_curves(summary: dict, path: Path) -> Path:
+    """IQM ISE / LQR vs env steps per case with 95 % bands and the reference levels."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 4, figsize=(17, 4.2), sharex=False)
+    styles = {
+        "lqr": ("k", "--"),
+        "smc": ("tab:gray", ":"),
+        "mpc": ("tab:purple", "-."),
+        "bound": ("tab:green", "--"),
+    }
+    for ax, case in zip(axes, CASES, strict=True):
+        for name, a in summary["algorithms"].items():
+            steps = np.array([p["steps"] for p in a["curve"]], dtype=float)
+            mid = np.array([p[str(case)]["iqm"] for p in a["curve"]])
+            lo = np.array([p[str(case)]["ci_low"] for p in a["curve"]])
+            hi = np.array([p[str(case)]["ci_high"] for p in a["curve"]])
+            (line,) = ax.plot(steps, mid, marker=".", lw=1.2, label=name)
+            ax.fill_between(steps, lo, hi, color=line.get_color(), alpha=0.2, lw=0)
+        for ref, (color, ls) in styles.items():
+            if ref in summary["references"]:
+                ax.axhline(
+                    summary["references"][ref][str(case)],
+                    color=color,
+                    ls=ls,
+                    lw=1,
+                    label=ref.upper() if ref != "bound" else "bound",
+                )
+        ax.set_xscale("symlog", linthresh=1e4)  # step 0 (the initial actor) included
+        ax.set_xlim(left=0)
+        ax.set_title(f"load case {case}" if case != "random" else "held-out random loads")
+        ax.set_xlabel("env steps")
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("ISE / ISE$_{LQR}$ (IQM over seeds, 95 % CI)")
+    axes[0].legend(fontsize=7)
+    fig.suptitle(f"Teacher-free RL on {summary['env_id']}", fontsize=10)
+    fig.tight_layout()
+    try:
+        return save_figure(fig, path, dpi=110)
+    finally:
+        plt.close(fig)

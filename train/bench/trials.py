@@ -1,0 +1,242 @@
+"""Trials of the benchmark: an algorithm's YAML config, one (config, seed) run with its
+learning curve and final evaluation, the saved agent directory, and many runs one
+after the other or as Ray Tune trials."""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from acld_gym.util.atomic import write_text
+
+from .evaluate import DEFAULT_ENV_ID
+
+__all__ = [
+    "CONFIG_DIR",
+    "DEFAULT_ALGOS",
+    "REFERENCES",
+    "load_algo_config",
+    "run_trial",
+    "agent_dir",
+    "policy_program",
+    "save_agent",
+    "run_trials",
+    "ray_available",
+]
+
+CONFIG_DIR = Path(__file__).resolve().parents[1] / "benchmark"
+#: The benchmark's algorithms (``train/benchmark/<name>.yaml``).
+DEFAULT_ALGOS = ("vrs", "ars", "ppo", "sac", "tqc")
+REFERENCES = ("lqr", "smc", "mpc", "bound")
+
+
+def load_algo_config(spec: str | Path) -> tuple[str, dict]:
+    """``(name, mapping)`` of a config: a name under ``train/benchmark/`` or a YAML path."""
+    path = Path(spec)
+    if not path.suffix:
+        path = CONFIG_DIR / f"{spec}.yaml"
+    if not path.is_file():
+        raise FileNotFoundError(f"config {str(spec)!r}: no file {str(path)!r}")
+    data = yaml.safe_load(path.read_text()) or {}
+    from .config import AlgoConfig
+
+    AlgoConfig.from_dict(data)  # validate early
+    return path.stem, data
+
+
+def run_trial(
+    name: str,
+    config: dict,
+    seed: int,
+    env_id: str = DEFAULT_ENV_ID,
+    random_episodes: int = 20,
+    out: str | Path | None = None,
+) -> dict:
+    """Train one (config, seed) and evaluate it; returns the trial's record (JSON-able):
+    the learning curve (mean ISE per case at each evaluation, batched), the final ISE
+    per case (single-env rollouts) and the training wall time (evaluations excluded).
+    With ``out``, the final policy is saved as an agent in :func:`agent_dir`."""
+    import torch
+
+    from .algos import train_algo
+    from .config import AlgoConfig
+    from .evaluate import batched_ise, eval_episodes, rollout_ise
+
+    torch.set_num_threads(1)
+    cfg = AlgoConfig.from_dict(config)
+    episodes = eval_episodes(random_episodes)
+    curve = []
+
+    def on_eval(steps: int, policy) -> None:
+        ise = batched_ise(policy, env_id, episodes)
+        curve.append({"steps": int(steps), "ise": {str(c): v for c, v in ise.items()}})
+
+    t0 = time.perf_counter()
+    policy, record = train_algo(cfg, seed, env_id, on_eval)
+    wall = time.perf_counter() - t0
+    final = rollout_ise(policy, env_id, episodes)
+    rec = {
+        "name": name,
+        "algo": cfg.algo,
+        "seed": int(seed),
+        "env_id": env_id,
+        "config": config,
+        "random_episodes": int(random_episodes),
+        "budget": cfg.timesteps,
+        "steps": int(record.get("steps", 0)),
+        "train_seconds": float(record["train_seconds"]),
+        "train_cpu_seconds": float(record.get("train_cpu_seconds", np.nan)),
+        "wall_seconds": wall,
+        "final_ise": {str(c): v for c, v in final.items()},
+        "curve": curve,
+        "record": {
+            k: v for k, v in record.items() if k not in ("train_seconds", "train_cpu_seconds")
+        },
+    }
+    if out is not None:
+        save_agent(policy, rec, Path(out))
+    return rec
+
+
+def trial_path(out: Path, name: str, seed: int) -> Path:
+    return out / "trials" / f"{name}-s{seed}.json"
+
+
+def agent_dir(out: Path, name: str, seed: int) -> Path:
+    """Where a trial's final policy is saved as an agent (:class:`train.agent.TrainedAgent`)."""
+    return Path(out) / "agents" / f"{name}-s{seed}"
+
+
+def policy_program(policy):
+    """A trained benchmark policy as a :class:`train.agent.ActorProgram` (numpy arrays and
+    a JSON list of operations: loading it never runs code)."""
+    from ..agent import ActorProgram, export_sb3, linear_program
+    from .sb3_policies import SB3Policy
+    from .search import LinearDirectionActor
+
+    if isinstance(policy, LinearDirectionActor):
+        return linear_program(policy.theta, policy.transform, policy.features)
+    if isinstance(policy, SB3Policy):  # direction features (an env wrapper), then VecNormalize
+        prog = export_sb3(policy.model, policy.obs_norm)
+        if policy.features == "direction":
+            prog = ActorProgram([{"op": "direction"}, *prog.ops], prog.arrays)
+        return prog
+    raise TypeError(f"cannot export a {type(policy).__name__}")
+
+
+def save_agent(policy, rec: dict, out: Path) -> Path:
+    """Save a trial's final policy as an agent directory (``policy.npz``,
+    ``metadata.json`` with ``training: "from scratch"``, no teacher, the command, config,
+    budget, times and the observation fingerprint of the env it was trained on)."""
+    import gymnasium as gym
+
+    from acld_gym.envs.fingerprint import observation_fingerprint
+
+    from ..agent import TrainedAgent
+    from ..callbacks import CURVE_FILE
+    from ..cli import versions
+
+    probe = gym.make(rec["env_id"])
+    meta = {
+        "algo": rec["algo"],
+        "seed": rec["seed"],
+        "benchmark": rec["name"],
+        "command": f"python -m train.benchmark --config {rec['name']} "
+        f"--seeds {rec['seed']} --env-id {rec['env_id']}",
+        "config": rec["config"],
+        "training": "from scratch",
+        "teacher": None,
+        "residual": None,
+        "timesteps": rec["steps"],
+        "budget": rec["budget"],
+        "train_seconds": round(rec["train_seconds"], 1),
+        "train_cpu_seconds": round(rec["train_cpu_seconds"], 1),
+        "final_ise": rec["final_ise"],
+        "versions": versions(),
+        "env": {"id": rec["env_id"], "kwargs": {}},
+        "observation": observation_fingerprint(probe),
+    }
+    probe.close()
+    d = TrainedAgent(policy_program(policy), meta, rec["algo"]).save(
+        agent_dir(out, rec["name"], rec["seed"])
+    )
+    # its learning curve on the thesis cases and the random set, batched evaluations
+    lines = ["timesteps,case,ise"] + [
+        f"{p['steps']},{c},{ise!r}" for p in rec["curve"] for c, ise in p["ise"].items()
+    ]
+    write_text(d / CURVE_FILE, "\n".join(lines) + "\n")
+    return d
+
+
+def _tune_trainable(config: dict) -> None:  # pragma: no cover - runs inside Ray workers
+    from ray import tune
+
+    kwargs = json.loads(config["trial"])
+    out = Path(kwargs["out"])
+    rec = run_trial(**kwargs)
+    # written here too, so that --resume finds the finished runs after an interruption (on a
+    # cluster the driver writes them again from the reported results)
+    write_text(trial_path(out, rec["name"], rec["seed"]), json.dumps(rec) + "\n")
+    tune.report({"train_seconds": rec["train_seconds"], "record": json.dumps(rec)})
+
+
+def run_trials(
+    trials: list[dict],
+    out: Path,
+    backend: str = "local",
+    num_cpus: int = 2,
+    address: str | None = None,
+) -> list[dict]:
+    """Run ``trials`` (keyword arguments of :func:`run_trial`) and write each record to
+    ``out/trials/``; ``backend="ray"`` runs them as Ray Tune trials (one CPU each)."""
+    records = []
+    if backend == "local":
+        for t in trials:
+            rec = run_trial(**t, out=out)
+            write_text(trial_path(out, rec["name"], rec["seed"]), json.dumps(rec) + "\n")
+            print(
+                f"  {rec['name']} seed {rec['seed']}: trained in {rec['train_seconds']:.0f} s",
+                flush=True,
+            )
+            records.append(rec)
+        return records
+    import ray
+    from ray import tune
+
+    if not ray.is_initialized():
+        ray.init(address=address) if address else ray.init(num_cpus=num_cpus)
+    # one grid point per run: run_trial's arguments as JSON text (Tune's loggers sort config
+    # keys, and the load weights mix int and str keys)
+    tuner = tune.Tuner(
+        tune.with_resources(_tune_trainable, {"cpu": 1}),
+        param_space={
+            "trial": tune.grid_search(
+                [json.dumps({**t, "out": str(out.resolve())}) for t in trials]
+            )
+        },
+        tune_config=tune.TuneConfig(trial_dirname_creator=lambda t: f"trial_{t.trial_id}"),
+        run_config=tune.RunConfig(
+            storage_path=str((out / "ray").resolve()), name="benchmark", verbose=0
+        ),
+    )
+    results = tuner.fit()
+    for res in results:
+        if res.error is not None:
+            raise RuntimeError(f"a Ray trial failed: {res.error}")
+        rec = json.loads(res.metrics["record"])
+        write_text(trial_path(out, rec["name"], rec["seed"]), json.dumps(rec) + "\n")
+        records.append(rec)
+    return records
+
+
+def ray_available() -> bool:
+    try:
+        import ray  # noqa: F401
+        from ray import tune  # noqa: F401
+    except ImportError:
+        return False
+    return True

@@ -121,7 +121,7 @@ def test_ppo_with_whitening_quadratic_critic_and_episode_scale():
     from train.bench.sb3_policies import SplitCriticPolicy
     from train.benchmark import policy_program
 
-    data = yaml.safe_load(open("train/benchmark/ppo_lq.yaml"))
+    data = yaml.safe_load(open("train/benchmark/ppo.yaml"))
     data.update(timesteps=4000, n_envs=2, whiten_steps=1000, episode_scale=True,
                 eval_points=1)
     data["model"] = {**data["model"], "n_steps": 500, "batch_size": 500, "n_epochs": 1}

@@ -33,10 +33,15 @@ studies: $(STAMP)
 	$(BIN)/acld-gym mesh --json results/mesh.json
 	$(BIN)/python -m baselines.robustness
 
-## Retrain the shipped DAgger agents (the commands in train/agents/*/metadata.json) and
-## ship each run's best checkpoint. The teacher-free agents come from the benchmark
-## (python -m train.benchmark; README, "Reinforcement learning without a teacher").
+## Retrain the shipped agents. From scratch (no teacher): the benchmark's runs of vrs, ppo
+## and sac (5 seeds each, resumable), then ship vrs seed 0 and the ppo / sac seed that is
+## best on the thesis cases (README, "Reinforcement learning from scratch"). With the
+## opt-in MPC teacher: the DAgger agents, each run's best checkpoint.
 agents: $(STAMP)
+	$(BIN)/python -m train.benchmark --algos vrs ppo sac --seeds 0 1 2 3 4 --resume --out runs/benchmark/v1
+	$(BIN)/python -m train.ship runs/benchmark/v1/agents/vrs-s0 vrs
+	$(BIN)/python -m train.ship runs/benchmark/v1/agents/ppo-s0 ppo
+	$(BIN)/python -m train.ship runs/benchmark/v1/agents/sac-s2 sac
 	$(BIN)/python -m train ppo --config train/ppo_dagger.yaml --seed 0 --out runs/ppo_dagger --no-progress
 	$(BIN)/python -m train sac --config train/sac_dagger.yaml --seed 0 --out runs/sac_dagger --no-progress
 	for a in ppo_dagger sac_dagger; do $(BIN)/python -m train.ship runs/$$a $$a; done

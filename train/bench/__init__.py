@@ -2,7 +2,8 @@ r"""The teacher-free benchmark (``python -m train.benchmark``).
 
 Every algorithm learns from the env's observation and reward only: no controller,
 demonstration or controller-derived reward anywhere in training, and nothing read
-from the env's internals. :func:`~train.bench.algos.train_algo` trains one for a fixed env-step budget,
+from the env's internals. :func:`~train.bench.algos.train_algo` trains one for a fixed
+env-step budget,
 reports learning-curve points through a callback, and returns a policy with SB3's
 ``predict`` in volts.
 

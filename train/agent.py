@@ -25,6 +25,7 @@ from __future__ import annotations
 import json
 import zipfile
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -33,9 +34,8 @@ from acld_gym.util.atomic import write_atomic, write_json
 from .features import direction_features
 from .vec import VoltageMap
 
-__all__ = ["TrainedAgent", "ActorProgram", "AgentFileError", "export_sb3", "linear_program",
-           "POLICY_FILE",
-           "META_FILE", "MODEL_FILE", "STATS_FILE"]
+__all__ = ["TrainedAgent", "ActorProgram", "AgentFileError", "export_sb3", "actor_parts",
+           "linear_program", "POLICY_FILE", "META_FILE", "MODEL_FILE", "STATS_FILE"]
 
 POLICY_FILE = "policy.npz"
 META_FILE = "metadata.json"
@@ -100,6 +100,28 @@ class ActorProgram:
         return np.clip(z, -1.0, 1.0).reshape(-1, 1)
 
 
+def actor_parts(model) -> tuple[Any, list, bool]:
+    """The deterministic actor of an SB3 model as ``(features extractor, layers in order,
+    squash)``: ``squash`` is True where SB3 applies a tanh after the last layer. One walk
+    for :func:`export_sb3` and for folding a whitening into the first linear layer
+    (:func:`train.bench.sb3_train.fold_whitening`)."""
+    import torch.nn as nn
+
+    pol = model.policy
+    actor = getattr(pol, "actor", None)
+    if actor is not None and hasattr(actor, "latent_pi"):  # SAC, TQC: tanh(mu(latent))
+        mu = actor.mu
+        layers = [*actor.latent_pi, *(mu if isinstance(mu, nn.Sequential) else [mu])]
+        return actor.features_extractor, layers, True
+    if actor is not None and hasattr(actor, "mu"):  # TD3: mu is the whole net, Tanh last
+        return actor.features_extractor, list(actor.mu), False
+    if not hasattr(pol, "mlp_extractor"):  # ARS (sb3-contrib): action_net is the actor
+        return pol.features_extractor, list(pol.action_net), False
+    # PPO / A2C: Gaussian mean, clipped to the box
+    return (pol.pi_features_extractor, [*pol.mlp_extractor.policy_net, pol.action_net],
+            bool(pol.squash_output))
+
+
 def export_sb3(model, obs_norm=None) -> ActorProgram:
     """The deterministic actor of an SB3 ``MlpPolicy`` (PPO, SAC, TD3, TQC, ARS, ...) and its
     ``VecNormalize`` observation statistics as an :class:`ActorProgram` (equal to SB3's
@@ -109,7 +131,6 @@ def export_sb3(model, obs_norm=None) -> ActorProgram:
 
     from .features import DirectionFeatures
 
-    pol = model.policy
     ops: list[dict] = []
     arrays: dict[str, np.ndarray] = {}
     if obs_norm is not None and getattr(obs_norm, "norm_obs", False):
@@ -117,24 +138,7 @@ def export_sb3(model, obs_norm=None) -> ActorProgram:
                     "eps": float(obs_norm.epsilon)})
         arrays["mean"] = obs_norm.obs_rms.mean.copy()
         arrays["var"] = obs_norm.obs_rms.var.copy()
-    actor = getattr(pol, "actor", None)
-    if actor is not None and hasattr(actor, "latent_pi"):  # SAC, TQC: tanh(mu(latent))
-        extractor = actor.features_extractor
-        mu = actor.mu
-        layers = [*actor.latent_pi, *(mu if isinstance(mu, nn.Sequential) else [mu])]
-        squash = True
-    elif actor is not None and hasattr(actor, "mu"):  # TD3: mu is the whole net, Tanh last
-        extractor = actor.features_extractor
-        layers = list(actor.mu)
-        squash = False
-    elif not hasattr(pol, "mlp_extractor"):  # ARS (sb3-contrib): action_net is the actor
-        extractor = pol.features_extractor
-        layers = list(pol.action_net)
-        squash = False
-    else:  # PPO / A2C: Gaussian mean, clipped to the box
-        extractor = pol.pi_features_extractor
-        layers = [*pol.mlp_extractor.policy_net, pol.action_net]
-        squash = bool(pol.squash_output)
+    extractor, layers, squash = actor_parts(model)
     if isinstance(extractor, DirectionFeatures):
         ops.append({"op": "direction"})
     elif not isinstance(extractor, FlattenExtractor):

@@ -9,6 +9,7 @@ import torch.nn as nn
 
 import acld_gym  # noqa: F401  (registers the env ids)
 
+from ..agent import actor_parts
 from .config import SB3_ALGOS, AlgoConfig, CurveCallback, eval_schedule
 from .sb3_envs import VecWhiten, make_sb3_env
 from .sb3_policies import EpisodeScaledRolloutBuffer, SB3Policy, SplitCriticPolicy
@@ -54,29 +55,12 @@ def _resolve_policy_kwargs(kwargs: dict) -> dict:
     return kwargs
 
 
-def _first_actor_layer(model) -> nn.Linear:
-    """The first linear layer of an SB3 model's deterministic actor (as ``export_sb3``
-    walks it)."""
-    pol = model.policy
-    actor = getattr(pol, "actor", None)
-    if actor is not None and hasattr(actor, "latent_pi"):  # SAC, TQC
-        layers = [
-            *actor.latent_pi,
-            *(actor.mu if isinstance(actor.mu, nn.Sequential) else [actor.mu]),
-        ]
-    elif actor is not None and hasattr(actor, "mu"):  # TD3
-        layers = list(actor.mu)
-    else:  # PPO
-        layers = [*pol.mlp_extractor.policy_net, pol.action_net]
-    return next(m for m in layers if isinstance(m, nn.Linear))
-
-
 def fold_whitening(model, transform: np.ndarray) -> None:
     """Fold the whitening ``u = T^T z`` into the actor's first layer (``W u = (W T^T) z``),
     so that the trained actor takes the raw observation (and exports as a plain SB3
     actor). Only the deterministic actor stays meaningful afterwards (critic and gSDE
     noise still expect u): call it when training is over."""
-    layer = _first_actor_layer(model)
+    layer = next(m for m in actor_parts(model)[1] if isinstance(m, nn.Linear))
     with torch.no_grad():
         t = torch.as_tensor(np.asarray(transform).T, dtype=layer.weight.dtype)
         layer.weight.copy_(layer.weight @ t)

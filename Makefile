@@ -63,6 +63,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_env.py
 	$(BIN)/python benchmarks/bench_bound.py
 	$(BIN)/python benchmarks/bench_train.py --timesteps 32768 --n-envs 8
+	$(BIN)/python benchmarks/bench_run.py
 
 clean:
 	rm -rf $(VENV) results .pytest_cache

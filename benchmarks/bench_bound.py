@@ -21,20 +21,13 @@ dependency), so each configuration runs in a fresh worker process with
 from __future__ import annotations
 
 import argparse
-import multiprocessing as mp
 import os
 import signal
 import subprocess
 import sys
 import time
 
-
-def _spin(parent: int) -> None:
-    """The busy neighbour: one core's worth of pure-Python work, until its parent is gone."""
-    x = 0
-    while os.getppid() == parent:
-        for _ in range(1_000_000):
-            x = (x + 1) % 1_000_003
+from busy import neighbour  # benchmarks/busy.py, beside this script
 
 
 def _blas_threads() -> str:
@@ -130,7 +123,7 @@ def main() -> None:
     if args.worker:
         _worker(args)
         return
-    # On SIGTERM, unwind through the finally below (stops the neighbour; subprocess.run
+    # On SIGTERM, unwind through `neighbour` (it stops the busy process; subprocess.run
     # kills the worker on the way out).
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(1))
     runs = [(1, False)] + ([(1, True), (2, True)] if args.busy else [])
@@ -154,17 +147,10 @@ def main() -> None:
             "--thesis",
             *map(str, args.thesis),
         ]
-        neighbour = None
         if busy:
             cmd.append("--busy-label")
-            neighbour = mp.Process(target=_spin, args=(os.getpid(),), daemon=True)
-            neighbour.start()
-        try:
+        with neighbour(busy):
             subprocess.run(cmd, env=env, check=True)
-        finally:
-            if neighbour is not None:
-                neighbour.terminate()
-                neighbour.join()
         print()
 
 

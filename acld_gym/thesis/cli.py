@@ -12,10 +12,10 @@ import numpy as np
 
 from acld_gym.design.pipeline import design
 from acld_gym.design.simulate import simulate
-from acld_gym.physics.loads import thesis_load
+from acld_gym.physics.loads import THESIS_CASES, thesis_load
 from acld_gym.physics.params import PRESETS
 from acld_gym.thesis.metrics import peak
-from acld_gym.thesis.reproduce import T_END, format_table2, run_cases
+from acld_gym.thesis.reproduce import CONTROLLERS, T_END, format_table2, run_cases
 from acld_gym.util.atomic import check_directory, check_writable, write_json
 from acld_gym.util.blas import one_blas_thread
 from acld_gym.util.progress import Progress
@@ -49,11 +49,12 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
         plots.mkdir(parents=True, exist_ok=True)
         plot_hankel(plots / "hankel_singular_values.png", d)
         plot_frequency_response(plots / "frequency_response.png", d)
-    bar = Progress(18, "reproduce", args.quiet)
+
+    def on_start(case, controller, saturation):
+        bar.stage(f"case {case} · {controller} · "
+                  f"{'saturated' if saturation else 'unsaturated'}")
 
     def on_result(row, res):
-        bar.stage(f"case {row.case} · {row.controller} · "
-                  f"{'saturated' if row.saturation else 'unsaturated'}")
         if plots is not None:
             sat = "sat" if row.saturation else "nosat"
             title = (f"Case {row.case}: {row.controller.upper()} "
@@ -61,8 +62,9 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
             plot_response(plots / f"case{row.case}_{row.controller}_{sat}.png", res.t, res.y,
                           res.voltage, title, load=res.load)
 
-    rows = run_cases(d, observer=args.observer, t_end=args.t_end, on_result=on_result)
-    bar.close()
+    with Progress(2 * len(THESIS_CASES) * len(CONTROLLERS), "reproduce", args.quiet) as bar:
+        rows = run_cases(d, observer=args.observer, t_end=args.t_end, on_result=on_result,
+                         on_start=on_start)
     print(format_table2(rows, t_end=args.t_end))
     print(f"\n{len(rows)} rows in {time.perf_counter() - t0:.2f} s "
           f"(observer: {args.observer}; settling = last exit from the 5% band of the peak "

@@ -23,11 +23,13 @@ CONTROLLERS = ("passive", "lqr", "smc")
 
 
 def run_cases(d: Design, cases: Iterable[int] = THESIS_CASES, observer: str = "thesis",
-              t_end: float = T_END, on_result: Callable | None = None) -> list[Table2Row]:
+              t_end: float = T_END, on_result: Callable | None = None,
+              on_start: Callable | None = None) -> list[Table2Row]:
     """Simulate every (case, controller, saturation) and return the rows.
 
     The passive beam does not depend on the limit: it is simulated once and
-    reported for both. ``on_result(row, result)`` is called after each run.
+    reported for both. ``on_start(case, controller, saturation)`` is called before each
+    row, ``on_result(row, result)`` after it.
     """
     A, B, E, Cy = d.plant
     obs = d.observer(observer)
@@ -38,6 +40,8 @@ def run_cases(d: Design, cases: Iterable[int] = THESIS_CASES, observer: str = "t
             fb = d.feedback(name)
             res: SimulationResult | None = None
             for sat in (True, False):
+                if on_start is not None:
+                    on_start(case, name, sat)
                 if res is None or name != "passive":
                     res = simulate(A, B, E, Cy, obs, fb, load, t_end=t_end,
                                    v_max=V_LIMIT if sat else None)

@@ -101,13 +101,16 @@ def test_evaluate_quiet_writes_nothing():
     assert "case 3 · passive" in terminal.getvalue()
 
 
-def test_command_lines_off_a_terminal_are_silent(tmp_path, capsys):
-    """The commands, run with stderr captured (not a terminal) and without --quiet."""
+def test_off_a_terminal_without_quiet_is_silent(capsys):
+    """reproduce and the evaluator, with stderr captured (not a terminal), not quiet."""
     from acld_gym.thesis.cli import main
+    from baselines.evaluate import evaluate
+    from baselines.policies import PassivePolicy
 
     assert main(["reproduce", "--t-end", "0.02"]) == 0
+    evaluate({"passive": PassivePolicy()}, cases=(3,), quiet=False)
     err = capsys.readouterr().err
-    assert "stage" not in err and "reproduce:" not in err
+    assert "stage" not in err and "reproduce:" not in err and "evaluate:" not in err
 
 
 def test_reproduce_labels_every_row():

@@ -49,9 +49,9 @@ class Progress:
     def stage(self, label: str) -> None:
         """Stage ``label`` starts: the one before it (if any) counts as finished."""
         if self._bar is not None:
-            self._bar.set_postfix_str(label, refresh=False)
-            self._bar.update(1 if self._running else 0)
-            self._bar.refresh()
+            if self._running:
+                self._bar.update(1)
+            self._bar.set_postfix_str(label)  # redraws now, whatever tqdm's interval
             self._running = True
 
     def close(self) -> None:

@@ -1,7 +1,8 @@
 """acld-gym: an ACLD cantilever (Rodriguez 2006) as a Gymnasium benchmark.
 
-Importing the package registers ``ACLDBeam-v1`` (the mesh-converged beam, canonical
-observation) and ``ACLDBeam-v0`` (the thesis mesh, legacy coordinates);
+Importing the package registers ``ACLDBeam-v1`` (the mesh-converged beam) and
+``ACLDBeam-v0`` (the thesis configuration: its mesh, design model and observers), both
+observing in the canonical modal basis, the same on every machine;
 ``gym.make("acld_gym:ACLDBeam-v1")`` imports it by itself.
 
 The subpackages follow the pipeline: :mod:`acld_gym.physics` (parameters, finite

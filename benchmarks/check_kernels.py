@@ -4,12 +4,14 @@ OpenBLAS picks its kernels by CPU at run time; ``OPENBLAS_CORETYPE`` forces anot
 CPU's kernels on this one. This script runs, in a subprocess per kernel (the machine's
 default, ``Nehalem``, ``Sandybridge``, and ``Haswell`` where the CPU has AVX2):
 
-* the v1 design (reduced model, observation scales, Kalman gains) on both meshes,
-* one ``ACLDBeam-v1`` episode (random load, seeded sensor noise, fixed actions),
+* the design (reduced model, observation scales, Kalman gains) of ``ACLDBeam-v1`` on
+  both meshes and of ``ACLDBeam-v0``,
+* one episode of each (random load, seeded sensor noise, fixed actions),
 * the shipped agents' ISE on thesis case 1 (if ``train/agents`` has them),
 
 and prints the largest relative difference of each against the default kernel, and the
-sign pattern of the v0 (Schur) reduced model's C_r, which is what changes between kernels.
+sign pattern of the raw Schur coordinates' C_r (``basis="schur"``, which no env observes
+since acld-gym 0.3.0; v0 did before), which is what changes between kernels.
 It never runs inside the tests or CI: some machines set these variables on purpose.
 
     python benchmarks/check_kernels.py
@@ -32,29 +34,32 @@ KERNELS = ["default", "Nehalem", "Sandybridge", "Haswell"]
 _CHILD = r"""
 import json, sys
 import numpy as np
+import gymnasium as gym
+import acld_gym
 from acld_gym.envs.beam_env import ACLDBeamEnv
-from acld_gym.envs.episode import nominal
 from acld_gym.design.reduction import schur_balanced_truncation
 from acld_gym.physics.truth import plant
 
 out = {}
-for mesh in ("converged", "thesis"):
-    nom = nominal(mesh=mesh)
+for label, env_id, kw in (("converged", "ACLDBeam-v1", {}),
+                          ("thesis", "ACLDBeam-v1", {"mesh": "thesis"}),
+                          ("v0", "ACLDBeam-v0", {})):
+    env = gym.make(env_id, load_case="random", **kw).unwrapped
+    nom = env.nom
     r = nom.design.reduced
     for name in ("A", "B", "C", "E"):
-        out[f"{mesh}/reduced_{name}"] = getattr(r, name).tolist()
-    out[f"{mesh}/xr_scale"] = nom.xr_scale.tolist()
-    out[f"{mesh}/kalman_Lc"] = nom.kalman.Lc.tolist()
-    env = ACLDBeamEnv(load_case="random", mesh=mesh)
+        out[f"{label}/reduced_{name}"] = getattr(r, name).tolist()
+    out[f"{label}/xr_scale"] = nom.xr_scale.tolist()
+    out[f"{label}/kalman_Lc"] = nom.kalman.Lc.tolist()
     obs, _ = env.reset(seed=3)
     rows = [obs.tolist()]
     rng = np.random.default_rng(0)
     for _ in range(1000):
         obs, *_ = env.step(rng.uniform(-150, 150, 1).astype(np.float32))
         rows.append(obs.tolist())
-    out[f"{mesh}/episode"] = rows
+    out[f"{label}/episode"] = rows
 A, B, E, C = plant("thesis").state_space()
-out["v0_schur_sign_C"] = np.sign(schur_balanced_truncation(A, B, C, 6, E=E,
+out["raw_schur_sign_C"] = np.sign(schur_balanced_truncation(A, B, C, 6, E=E,
                                                           basis="schur").C).tolist()
 try:
     from baselines.evaluate import rollout
@@ -92,7 +97,7 @@ def main() -> int:
             results[k] = run(k, Path(tmp) / f"{k}.json")
             print(f"ran {k}", file=sys.stderr)
     ref = results["default"]
-    keys = [k for k in ref if k not in ("v0_schur_sign_C", "agent_error")]
+    keys = [k for k in ref if k not in ("raw_schur_sign_C", "agent_error")]
     print(f"{'quantity':32s}" + "".join(f"{k:>14s}" for k in kernels[1:]))
     for key in keys:
         cells = []
@@ -101,9 +106,10 @@ def main() -> int:
             rel = float(np.max(np.abs(a - b)) / max(float(np.max(np.abs(b))), 1e-300))
             cells.append(f"{rel:14.1e}")
         print(f"{key:32s}" + "".join(cells))
-    print("\nsign(C_r) of the v0 (Schur) reduced model -- what changes between kernels:")
+    print("\nsign(C_r) in the raw Schur coordinates (basis='schur', observed by no env since "
+          "0.3.0; by v0 before) -- what changes between kernels:")
     for k in kernels:
-        signs = "".join("+" if s > 0 else "-" for s in results[k]["v0_schur_sign_C"][0])
+        signs = "".join("+" if s > 0 else "-" for s in results[k]["raw_schur_sign_C"][0])
         print(f"  {k:12s} {signs}")
     if "agent_error" in ref:
         print(f"\nagents: {ref['agent_error']}")

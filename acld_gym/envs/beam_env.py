@@ -161,17 +161,22 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
       (``model_std`` 0.1), so the baselines stay stable on every randomized plant;
       ``param_noise`` is bounded (0.1; 0.05 on the thesis mesh) and its factors
       truncated at 3 std.
-    * v0: the thesis's 38-state mesh; the reduced state in the Schur method's
-      coordinates, which depend on the CPU's BLAS kernels (:mod:`acld_gym.envs.legacy`).
+    * v0: the thesis configuration (:mod:`acld_gym.envs.legacy`): the thesis's 38-state
+      mesh, its 6-state design model and observers, the same dynamics, reward, spaces
+      and episode. It differs from v1 with ``mesh="thesis"`` in three settings only:
+      random-load harmonics at 179 and 1115 rad/s (v1: the plant's own 178.64 and
+      1115.40), a Kalman filter driven by the load alone (``model_std=0``; v1: 0.1) and
+      ``param_noise`` up to 0.5 (v1: 0.05). Since acld-gym 0.3.0 its observation is in
+      the same canonical modal basis as v1's, identical on every machine; before, it was
+      the Schur method's own coordinates, whose signs changed with the CPU's BLAS kernels
+      (up to a sign flip of whole components), so an agent trained on one machine acted
+      on other coordinates on another.
     """
 
     metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 30}
 
     #: The id this class is registered under (used when it is built without ``gym.make``).
     env_id = "ACLDBeam-v1"
-    #: Coordinates of the reduced model (:data:`acld_gym.design.reduction.BASES`); ACLDBeam-v0's
-    #: class keeps the machine-dependent ``"schur"``.
-    _basis = "modal"
     #: Harmonic targets of random loads [rad/s]; None: the plant's own first two modes.
     _harmonic_modes: tuple[float, float] | None = None
     #: Model-error noise of the Kalman filter (:func:`acld_gym.design.observer.discrete_kalman`).

@@ -113,7 +113,7 @@ def configure(env, *, load_case, mesh, dt, episode_length, observer, obs_mode, s
     env.render_mode = render_mode
     env.v_max = V_LIMIT
     env.obs_hist = 8
-    env.nom = nominal(env.dt, 10, max(env.sensor_noise, 1e-9), mesh=mesh, basis=env._basis,
+    env.nom = nominal(env.dt, 10, max(env.sensor_noise, 1e-9), mesh=mesh,
                       model_std=env._model_std)
     env.harmonic_modes = (env._harmonic_modes if env._harmonic_modes is not None
                           else tuple(float(w) for w in env.nom.modes[:2]))

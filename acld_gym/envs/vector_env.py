@@ -66,7 +66,6 @@ class ACLDBeamVectorEnv(FigureOwner, VectorEnv):
                 "autoreset_mode": AutoresetMode.NEXT_STEP}
 
     env_id = "ACLDBeam-v1"  # see ACLDBeamEnv
-    _basis = "modal"
     _harmonic_modes: tuple[float, float] | None = None
     _model_std = MODEL_STD
     _param_noise_max: float | None = None

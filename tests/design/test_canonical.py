@@ -1,4 +1,5 @@
-"""The canonical reduced realization (issue 15): the same observation on every machine.
+"""The canonical reduced realization (issues 15 and 19): the same observation on every
+machine, for ACLDBeam-v1 on both meshes and for ACLDBeam-v0.
 
 Other CPUs' BLAS kernels return Schur and singular vectors with other signs and
 round-off. These tests perturb the *inputs* of the Schur and SVD steps the same way --
@@ -7,6 +8,14 @@ reduced model, the observation scales, the observer gains and a whole episode's
 observations to come out the same to 1e-9 (relative to each quantity's largest entry).
 They never touch the BLAS settings (``benchmarks/check_kernels.py`` compares kernels by
 hand).
+
+The rotations: the converged plant's coordinates are mass-normalized, so any orthogonal
+transform is well posed. The thesis mesh's coordinates are FE DOFs of five kinds (u, w,
+gamma, z in metres; theta in radians); its rotations are orthogonal within each kind.
+An orthogonal matrix that mixes metres with radians has no consistent units: measured,
+it moves the reduced model by ~5e-8 (a rotation across the two units) or leaves no gap
+in the Schur ordering at all (a rotation of everything), because the diagonal balancing
+before the Gramians can no longer undo the scales.
 """
 
 from __future__ import annotations
@@ -18,9 +27,12 @@ import pytest
 import scipy.linalg as sla
 
 import acld_gym.envs.episode as env_module
+from acld_gym.design.observer import MODEL_STD
 from acld_gym.design.reduction import modal_form, schur_balanced_truncation
 from acld_gym.envs.beam_env import ACLDBeamEnv
 from acld_gym.envs.episode import nominal
+from acld_gym.envs.legacy import V0_SETTINGS, ACLDBeamEnvV0
+from acld_gym.physics.model import parametric_model
 from acld_gym.physics.plant import Plant
 from acld_gym.physics.truth import plant
 from baselines.policies import LQRPolicy
@@ -44,13 +56,46 @@ def _signed_permutation(n: int, rng) -> np.ndarray:
     return np.eye(n)[rng.permutation(n)] * rng.choice([-1.0, 1.0], n)[:, None]
 
 
+def _rotation(n: int, rng) -> np.ndarray:
+    return np.linalg.qr(rng.normal(size=(n, n)))[0]
+
+
+def _dof_kinds() -> list[str]:
+    """The kind (u, w, theta, gamma, z) of each of the thesis mesh's 19 DOFs."""
+    dofs = parametric_model().dofs
+    kinds = [""] * len(dofs.free)
+    for node, names in enumerate(dofs.node_dofs[1:], start=1):
+        for name in names:
+            kinds[dofs.reduced_index(node, name)] = name
+    for g in dofs.z_dofs:
+        kinds[dofs.reduced_of(g)] = "z"
+    return kinds
+
+
+def _rotation_within_kinds(rng) -> np.ndarray:
+    kinds = np.array(_dof_kinds())
+    T = np.zeros((kinds.size, kinds.size))
+    for kind in sorted(set(kinds)):
+        idx = np.flatnonzero(kinds == kind)
+        T[np.ix_(idx, idx)] = _rotation(idx.size, rng)
+    return T
+
+
 def _transforms(mesh: str):
     rng = np.random.default_rng(1)
     n = plant(mesh).n_coordinates
     out = [("signed permutation", _signed_permutation(n, rng))]
     if mesh == "converged":  # mass-normalized coordinates: any rotation is well posed
-        out.append(("rotation", np.linalg.qr(rng.normal(size=(n, n)))[0]))
+        out.append(("rotation", _rotation(n, rng)))
+    else:  # FE DOFs in metres and radians: rotations within each kind of DOF
+        out.append(("rotation within DOF kinds", _rotation_within_kinds(rng)))
     return out
+
+
+#: The designs behind the observations: v1 on both meshes and v0 (thesis mesh, Kalman
+#: filter driven by the load alone).
+DESIGNS = {"v1-converged": ("converged", MODEL_STD), "v1-thesis": ("thesis", MODEL_STD),
+           "v0": ("thesis", V0_SETTINGS["_model_std"])}
 
 
 @pytest.fixture
@@ -58,23 +103,34 @@ def transformed_nominal(monkeypatch):
     """nominal() of a transformed plant, with the nominal cache isolated."""
     original = env_module.nominal_plant
 
-    def build(mesh: str, T: np.ndarray):
+    def build(mesh: str, T: np.ndarray, model_std: float = MODEL_STD):
         monkeypatch.setattr(env_module, "nominal_plant",
                             lambda m, dt: _transformed(original(m, dt), T))
         nominal.cache_clear()
-        return nominal(mesh=mesh)
+        return nominal(mesh=mesh, model_std=model_std)
 
     yield build
     nominal.cache_clear()
 
 
-@pytest.mark.parametrize("mesh", ["thesis", "converged"])
-def test_design_is_invariant_under_renumbering_and_rotation(mesh, transformed_nominal):
-    ref = nominal(mesh=mesh)
+def test_thesis_mesh_rotations_keep_each_kind_of_dof():
+    kinds = np.array(_dof_kinds())
+    assert sorted(set(kinds)) == ["gamma", "theta", "u", "w", "z"]
+    T = _rotation_within_kinds(np.random.default_rng(0))
+    assert np.allclose(T @ T.T, np.eye(kinds.size), atol=1e-12)
+    mixes = np.abs(T) > 0
+    assert all((kinds[i] == kinds[j]) for i, j in zip(*np.nonzero(mixes), strict=True))
+    assert np.count_nonzero(mixes) > 3 * kinds.size  # dense within kinds, not a permutation
+
+
+@pytest.mark.parametrize("which", list(DESIGNS))
+def test_design_is_invariant_under_renumbering_and_rotation(which, transformed_nominal):
+    mesh, model_std = DESIGNS[which]
+    ref = nominal(mesh=mesh, model_std=model_std)
     r0 = ref.design.reduced
     for label, T in _transforms(mesh):
         T2 = sla.block_diag(T, T)
-        nom = transformed_nominal(mesh, T)
+        nom = transformed_nominal(mesh, T, model_std)
         r = nom.design.reduced
         for name in ("A", "B", "C", "E"):
             assert _rel(getattr(r, name), getattr(r0, name)) < RTOL, (label, name)
@@ -90,8 +146,8 @@ def test_design_is_invariant_under_renumbering_and_rotation(mesh, transformed_no
         assert _rel(k1, k0) < 1e-8, label
 
 
-def _episode(seed=0, **kw):
-    env = ACLDBeamEnv(load_case="random", **kw)
+def _episode(seed=0, env_cls=ACLDBeamEnv, **kw):
+    env = env_cls(load_case="random", **kw)
     obs, _ = env.reset(seed=seed)
     rows = [obs]
     rng = np.random.default_rng(5)
@@ -101,12 +157,19 @@ def _episode(seed=0, **kw):
     return np.array(rows, dtype=np.float64)
 
 
-@pytest.mark.parametrize("mesh", ["thesis", "converged"])
-def test_episode_observations_are_invariant(mesh, transformed_nominal):
-    ref = _episode(mesh=mesh)
+#: Env classes and keyword arguments of the episodes (v0: the thesis mesh is its own).
+EPISODES = {"v1-converged": (ACLDBeamEnv, {"mesh": "converged"}),
+            "v1-thesis": (ACLDBeamEnv, {"mesh": "thesis"}), "v0": (ACLDBeamEnvV0, {})}
+
+
+@pytest.mark.parametrize("which", list(EPISODES))
+def test_episode_observations_are_invariant(which, transformed_nominal):
+    mesh, model_std = DESIGNS[which]
+    cls, kw = EPISODES[which]
+    ref = _episode(env_cls=cls, **kw)
     for label, T in _transforms(mesh):
-        transformed_nominal(mesh, T)
-        obs = _episode(mesh=mesh)
+        transformed_nominal(mesh, T, model_std)
+        obs = _episode(env_cls=cls, **kw)
         # float32 observations: compare to the float32 resolution of their largest entry
         assert _rel(obs, ref) < max(RTOL, 2 * np.finfo(np.float32).eps), label
 
@@ -145,14 +208,27 @@ def test_truncation_refuses_a_split_pair_of_hankel_values():
     assert schur_balanced_truncation(A, B, C, 2).order == 2
 
 
-def test_schur_basis_is_kept_for_v0_and_differs_from_modal():
+def test_v0_observes_the_canonical_design_of_the_thesis_mesh():
+    v0 = ACLDBeamEnvV0()
+    v1 = ACLDBeamEnv(mesh="thesis")
+    assert v0.nom.basis == "modal" and v0.observation_fingerprint["basis"] == "modal"
+    r0, r1 = v0.nom.design.reduced, v1.nom.design.reduced
+    for name in ("A", "B", "C", "E"):  # the same 6-state design model, the same numbers
+        assert np.array_equal(getattr(r0, name), getattr(r1, name)), name
+    assert np.array_equal(v0.nom.xr_scale, v1.nom.xr_scale)
+    # Only the Kalman filter's model-error noise differs (v0: 0, v1: MODEL_STD).
+    assert not np.allclose(v0.nom.kalman.Lc, v1.nom.kalman.Lc)
+    assert np.array_equal(v0.nom.kalman.Lc, nominal(mesh="thesis", model_std=0.0).kalman.Lc)
+
+
+def test_raw_schur_coordinates_stay_a_library_option_and_differ_from_modal():
     A, B, E, C = plant("thesis").state_space()
-    legacy = schur_balanced_truncation(A, B, C, 6, E=E, basis="schur")
+    raw = schur_balanced_truncation(A, B, C, 6, E=E, basis="schur")
     canon = schur_balanced_truncation(A, B, C, 6, E=E)
-    assert legacy.basis == "schur" and canon.basis == "modal"
-    assert _rel(legacy.hsv, canon.hsv) == 0.0
+    assert raw.basis == "schur" and canon.basis == "modal"
+    assert _rel(raw.hsv, canon.hsv) == 0.0
     # same transfer function: equal Markov parameters C A^k B
     for k in range(4):
-        m0 = legacy.C @ np.linalg.matrix_power(legacy.A, k) @ legacy.B
+        m0 = raw.C @ np.linalg.matrix_power(raw.A, k) @ raw.B
         m1 = canon.C @ np.linalg.matrix_power(canon.A, k) @ canon.B
         assert m1 == pytest.approx(m0, rel=1e-8)

@@ -179,14 +179,15 @@ def test_observation_modes(mesh, mode, n, order):
     assert info["xr_true"].shape == (order,)
 
 
-def test_v0_is_registered_with_its_old_behaviour():
+def test_v0_is_the_thesis_configuration_in_the_canonical_basis():
     from acld_gym.envs.legacy import ACLDBeamEnvV0
 
     with pytest.warns(DeprecationWarning, match="out of date"):
         env = gym.make("ACLDBeam-v0")
     e = env.unwrapped
-    assert isinstance(e, ACLDBeamEnvV0) and e.mesh == "thesis" and e.nom.basis == "schur"
+    assert isinstance(e, ACLDBeamEnvV0) and e.mesh == "thesis" and e.nom.basis == "modal"
     assert e.observation_space.shape == (7,) and e.harmonic_modes == (179.0, 1115.0)
+    assert e.nom.design.reduced.order == 6 and e.param_noise == 0.0
     assert e.nom.plant.Ad.shape == (38, 38)
     with pytest.raises(TypeError, match="mesh"):
         ACLDBeamEnvV0(mesh="converged")

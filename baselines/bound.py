@@ -53,8 +53,8 @@ from acld_gym.design.discrete import (
     convolution_matrix,
     impulse_response,
 )
+from acld_gym.physics.actuator import V_LIMIT
 from acld_gym.physics.loads import TipLoad
-from acld_gym.thesis.table2 import V_LIMIT
 
 __all__ = ["ATOL", "BoundSolution", "KKTCheck", "METHODS", "RTOL", "clairvoyant_bound",
            "convolution_matrix", "free_response", "impulse_response", "kkt_check",

@@ -20,10 +20,11 @@ from pathlib import Path
 
 import numpy as np
 
+from acld_gym.design.nominal import nominal_design
 from acld_gym.envs.beam_env import ACLDBeamEnv
-from acld_gym.envs.episode import nominal
 from acld_gym.envs.fingerprint import fingerprint_differences, observation_fingerprint
 from acld_gym.envs.step import reward_of
+from acld_gym.physics.loads import THESIS_CASES
 from acld_gym.physics.truth import MESHES
 from acld_gym.thesis.metrics import max_abs, peak, settling_time
 from acld_gym.thesis.table2 import thesis_row
@@ -155,7 +156,7 @@ def episode_rows(policies: dict, case, seed: int = 0, env_kwargs: dict | None = 
     return rows
 
 
-def evaluate(policies: dict | None = None, cases=(1, 2, 3), seed: int = 0,
+def evaluate(policies: dict | None = None, cases=THESIS_CASES, seed: int = 0,
              env_kwargs: dict | None = None, episodes: dict | None = None,
              quiet: bool = True) -> list[EvalRow]:
     """Rows for every (case, policy) plus the bound; fills ``episodes`` if given; a
@@ -203,7 +204,7 @@ def format_thesis_comparison(rows: list[EvalRow]) -> str:
     out = ["\nagainst thesis Table 2 (saturated rows; acceptance: peak 7 %, settling 10 %)",
            f"{'row':>12} {'peak':>8} {'settling':>9}"]
     for r in rows:
-        ref = thesis_row(r.case, r.policy, True) if r.case in (1, 2, 3) else None
+        ref = thesis_row(r.case, r.policy, True) if r.case in THESIS_CASES else None
         if ref is not None:
             out.append(f"{r.policy.upper() + ' case ' + str(r.case):>12} "
                        f"{100 * (r.peak_mm / ref.peak_mm - 1):+7.1f}% "
@@ -255,7 +256,7 @@ def main(argv: list[str] | None = None) -> int:
             check_directory(args.plots, "--plots")
     except ValueError as exc:
         p.error(str(exc))
-    nominal(mesh=args.mesh)  # build the design once before timing anything
+    nominal_design(mesh=args.mesh)  # build the design once before timing anything
     episodes: dict = {}
     rows = evaluate(default_policies(args.mesh), seed=args.seed,
                     env_kwargs={"mesh": args.mesh}, episodes=episodes, quiet=args.quiet)

@@ -1,7 +1,7 @@
 """Reference policies for ``ACLDBeam-v0`` with stable-baselines3's ``predict`` protocol.
 
 They are designed on the nominal reduced model sampled at the env's control
-period (:func:`acld_gym.envs.episode.nominal`) and read the reduced-state estimate
+period (:func:`acld_gym.design.nominal.nominal_design`) and read the reduced-state estimate
 from the ``"estimate"`` observation (``obs[:6] * xr_scale``), so
 ``evaluate_policy`` and :mod:`baselines.evaluate` treat them like agents.
 
@@ -22,9 +22,9 @@ from acld_gym.design.feedback import (
     discrete_lqr_gain,
     passive,
 )
-from acld_gym.envs.episode import Nominal, nominal
+from acld_gym.design.nominal import NominalDesign, nominal_design
 from acld_gym.envs.fingerprint import design_fingerprint
-from acld_gym.thesis.table2 import V_LIMIT
+from acld_gym.physics.actuator import V_LIMIT
 
 __all__ = ["PassivePolicy", "LQRPolicy", "SMCPolicy", "MPCPolicy", "discrete_lqr_gain"]
 
@@ -34,8 +34,9 @@ class _Policy:
 
     name = "policy"
 
-    def __init__(self, dt: float = 1e-3, nom: Nominal | None = None, mesh: str = "converged"):
-        self.nom = nominal(dt, mesh=mesh) if nom is None else nom
+    def __init__(self, dt: float = 1e-3, nom: NominalDesign | None = None,
+                 mesh: str = "converged"):
+        self.nom = nominal_design(dt, mesh=mesh) if nom is None else nom
         self.k = self.nom.design.reduced.order
 
     @classmethod

@@ -29,9 +29,11 @@ from dataclasses import replace
 import numpy as np
 
 from acld_gym.design.discrete import SampledSystem, discretize
+from acld_gym.design.nominal import NominalDesign, nominal_design
 from acld_gym.design.observer import DiscreteObserver
-from acld_gym.envs.episode import PARAM_NOISE_CLIP, PARAM_NOISE_MAX, RANDOMIZED, Nominal, nominal
+from acld_gym.envs.config import PARAM_NOISE_MAX
 from acld_gym.physics.truth import MESHES
+from acld_gym.physics.uncertainty import PARAM_NOISE_CLIP, RANDOMIZED
 
 __all__ = ["closed_loop_matrix", "spectral_radius", "corner_plants", "corner_study", "main"]
 
@@ -52,7 +54,7 @@ def closed_loop_matrix(plant: SampledSystem, output: np.ndarray, observer: Discr
     return M
 
 
-def spectral_radius(plant: SampledSystem, nom: Nominal, gain: np.ndarray,
+def spectral_radius(plant: SampledSystem, nom: NominalDesign, gain: np.ndarray,
                     observer: DiscreteObserver | None = None) -> float:
     """Spectral radius of the small-signal loop of ``gain`` on ``plant`` (default observer:
     the nominal Kalman filter)."""
@@ -61,9 +63,9 @@ def spectral_radius(plant: SampledSystem, nom: Nominal, gain: np.ndarray,
                                                                    gain)))))
 
 
-def corner_plants(nom: Nominal, param_noise: float):
+def corner_plants(nom: NominalDesign, param_noise: float):
     """The sampled plants at the corners of the parameter box: each of
-    :data:`acld_gym.envs.episode.RANDOMIZED` times :math:`e^{\\pm 3\\sigma}` (generator)."""
+    :data:`acld_gym.physics.uncertainty.RANDOMIZED` times :math:`e^{\\pm 3\\sigma}` (generator)."""
     truth = nom.truth
     f = float(np.exp(PARAM_NOISE_CLIP * param_noise))
     for signs in itertools.product((-1, 1), repeat=len(RANDOMIZED)):
@@ -73,7 +75,7 @@ def corner_plants(nom: Nominal, param_noise: float):
         yield signs, discretize(A, B, E, nom.plant.dt, 1)
 
 
-def corner_study(nom: Nominal, policies: dict, param_noise: float) -> dict[str, dict]:
+def corner_study(nom: NominalDesign, policies: dict, param_noise: float) -> dict[str, dict]:
     """Per policy: ``{"nominal": radius, "worst": radius, "unstable": count, "corners": n}``
     over the corners of the box of ``param_noise`` (:func:`corner_plants`)."""
     gains = {name: pol.small_signal_gain() for name, pol in policies.items()}
@@ -101,7 +103,7 @@ def main(argv: list[str] | None = None) -> int:
     print("| mesh | param_noise | policy | nominal | worst corner | unstable corners |")
     print("|---|---|---|---|---|---|")
     for mesh in args.mesh:
-        nom = nominal(mesh=mesh)
+        nom = nominal_design(mesh=mesh)
         sigma = PARAM_NOISE_MAX[mesh] if args.param_noise is None else args.param_noise
         pols = {cls.name: cls(nom=nom) for cls in (LQRPolicy, SMCPolicy, MPCPolicy)}
         for name, rec in corner_study(nom, pols, sigma).items():

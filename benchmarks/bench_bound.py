@@ -56,11 +56,11 @@ def _blas_threads() -> str:
 def _worker(args) -> None:
     import numpy as np
 
-    from acld_gym.envs.episode import nominal, random_load
-    from acld_gym.physics.loads import thesis_load
+    from acld_gym.design.nominal import nominal_design
+    from acld_gym.physics.loads import random_load, thesis_load
     from baselines.bound import clairvoyant_bound
 
-    nom = nominal()
+    nom = nominal_design()
     tip = getattr(nom, "output", None)
     tip = nom.design.model.tip_index if tip is None else tip
     plant, n = nom.plant, args.steps

@@ -9,7 +9,8 @@ from typing import Any
 
 import yaml
 
-from acld_gym.envs.episode import LOAD_CASES, PARAM_NOISE_MAX
+from acld_gym.envs.config import check_param_noise
+from acld_gym.physics.loads import LOAD_CASES, parse_load_case
 from acld_gym.physics.truth import MESHES
 from acld_gym.util.validate import check_int, check_real
 
@@ -19,16 +20,6 @@ ALGOS = ("ppo", "sac")
 RESIDUALS = (None, "lqr")
 FEATURE_NAMES = ("direction",)
 _HERE = Path(__file__).resolve().parent
-
-
-def parse_load_case(value) -> int | str:
-    """A load case from YAML or command-line text: 1, 2, 3 (int or digit string) or
-    ``"random"``; anything else raises a ``ValueError`` naming the choices."""
-    if isinstance(value, str) and value in ("1", "2", "3"):
-        return int(value)
-    if type(value) in (int, str) and value in LOAD_CASES:  # not bool, not 1.0
-        return value
-    raise ValueError(f"load case must be 1, 2, 3 or 'random', got {value!r}")
 
 
 @dataclass(frozen=True)
@@ -94,7 +85,7 @@ class TrainConfig:
                              f"got {self.load_case!r}")
         if self.mesh not in MESHES:
             raise ValueError(f"mesh must be one of {list(MESHES)}, got {self.mesh!r}")
-        check_real("param_noise", self.param_noise, 0.0, PARAM_NOISE_MAX[self.mesh])
+        check_param_noise(self.param_noise, self.mesh)
         if self.residual not in RESIDUALS:
             raise ValueError(f"residual must be one of {list(RESIDUALS)}, got {self.residual!r}")
         if self.shaping is not None:

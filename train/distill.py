@@ -28,7 +28,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from acld_gym.thesis.table2 import V_LIMIT
+from acld_gym.physics.actuator import V_LIMIT
 
 __all__ = ["DistillConfig", "actor_mean", "distill", "fit_sign", "TEACHERS"]
 

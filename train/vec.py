@@ -14,9 +14,9 @@ from gymnasium import spaces
 from stable_baselines3.common.vec_env import VecEnv, VecEnvWrapper, VecNormalize
 
 from acld_gym.design.feedback import discrete_lqr_gain
-from acld_gym.envs.episode import nominal
+from acld_gym.design.nominal import nominal_design
 from acld_gym.envs.sb3 import SB3VecEnv
-from acld_gym.thesis.table2 import V_LIMIT
+from acld_gym.physics.actuator import V_LIMIT
 from baselines.policies import LQRPolicy
 
 __all__ = ["VoltageMap", "VecAgentEnv", "lq_potential", "make_vec_env"]
@@ -62,7 +62,7 @@ def lq_potential(gamma: float, lam: float, y_ref: float = 1e-3, dt: float = 1e-3
     :math:`(\sqrt\gamma A_d, \sqrt\gamma B_d)`, solved in the observation's scaled
     coordinates (entries of order one instead of 1e-6 .. 1e4).
     """
-    nom = nominal(dt, mesh=mesh)
+    nom = nominal_design(dt, mesh=mesh)
     sr, C = nom.reduced, nom.design.reduced.C
     S = np.diag(nom.xr_scale)
     Si = np.diag(1.0 / nom.xr_scale)

@@ -1,5 +1,6 @@
-"""The Gymnasium environments: episode ingredients, the fused step, checks, the single and
-batched envs, v0, rendering and the SB3 adapter."""
+"""The Gymnasium environments: the configuration, the registered presets, episode
+ingredients, the one batched step, the single and batched envs, rendering and the SB3
+adapter."""
 
 from importlib import import_module
 
@@ -8,8 +9,9 @@ _EXPORTS = {
     "ACLDBeamEnv": "beam_env",
     "ACLDBeamVectorEnv": "vector_env",
     "SB3VecEnv": "sb3",
-    "ACLDBeamEnvV0": "legacy",
-    "ACLDBeamVectorEnvV0": "legacy",
+    "EnvConfig": "config",
+    "make_config": "config",
+    "preset": "presets",
 }
 __all__ = sorted(_EXPORTS)
 

@@ -1,55 +1,44 @@
-"""``ACLDBeam-v1``: the ACLD cantilever as a Gymnasium environment (``ACLDBeam-v0``: the
-legacy variant in :mod:`acld_gym.envs.legacy`).
+"""``ACLDBeam``: the ACLD cantilever as a Gymnasium environment, one class for every
+registered id (``ACLDBeam-v1``, ``ACLDBeam-v0`` and the presets are configurations,
+:mod:`acld_gym.envs.presets`).
 
-The class composes the layers below it: :mod:`acld_gym.envs.episode` draws the load and
-the plant, :mod:`acld_gym.envs.step` is the algebra of one step, and
-:mod:`acld_gym.envs.checks` validates the arguments. Its ``step`` advances plant and
-observer, computes the reward and checks the limits, with no physics inline."""
+The class composes the layers below it: :mod:`acld_gym.envs.config` validates the
+configuration, :mod:`acld_gym.envs.episode` draws the load and the plant, and
+:mod:`acld_gym.envs.batch` is the step -- the single env is its N = 1 case, compiled where
+it was built.
+"""
 
 from __future__ import annotations
 
-import math
-import os
 from typing import Any
 
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from acld_gym.design.observer import MODEL_STD
-from acld_gym.envs.checks import check_actions, check_episode_size, configure, episode_spec
-from acld_gym.envs.episode import OBS_MODES, SENSOR_NOISE_M, draw_episode, reset_options
+from acld_gym.envs.batch import COMPILED_STEP, BatchStep, StepResult
+from acld_gym.envs.checks import check_actions, check_render_mode, episode_spec
+from acld_gym.envs.config import ConfigAttributes, EnvConfig, make_config
+from acld_gym.envs.episode import draw_episode, draw_noise, reset_options
 from acld_gym.envs.fingerprint import observation_fingerprint
 from acld_gym.envs.render import FigureOwner
-from acld_gym.envs.step import (
-    Y_SCALE,
-    StepLayout,
-    estimate_map,
-    load_schedule,
-    observation_size,
-    output_matrix,
-    reward_of,
-    step_matrix,
-    termination,
-)
-from acld_gym.physics.loads import TipLoad, thesis_load
+from acld_gym.envs.step import INFO_KEYS, TERMINATED_BY, load_schedule
+from acld_gym.physics.actuator import V_LIMIT
+from acld_gym.physics.loads import case_load, thesis_load
 from acld_gym.util.validate import check_seed
-
-if os.environ.get("ACLD_GYM_PURE_PYTHON") == "1":  # debugging: numpy steps only
-    StepCore = None
-else:
-    try:
-        from ._stepcore import StepCore
-    except ImportError:  # built without a C compiler: the numpy reference step serves
-        StepCore = None
-
-#: Whether ``ACLDBeamEnv.step`` runs its common path compiled (``acld_gym.envs._stepcore``).
-COMPILED_STEP = StepCore is not None
 
 __all__ = ["ACLDBeamEnv", "COMPILED_STEP"]
 
 
-class ACLDBeamEnv(FigureOwner, gym.Env):
+def _not_reset(action):
+    raise RuntimeError("ACLDBeamEnv: call reset() before step()")
+
+
+def _no_fast_path(action):
+    return None
+
+
+class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
     """
     ## Description
 
@@ -65,10 +54,14 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
     exactly with a zero-order hold on the voltage; the tip load is integrated
     within each period (sub-steps with first-order hold, exact for pulses). The
     observer runs on the nominal reduced model (the design model: 8 states on the
-    converged plant, 6 on the thesis mesh), never on
+    converged plant, 6 on the thesis mesh; :mod:`acld_gym.design.nominal`), never on
     the (possibly randomized) plant. A step is one fused matrix-vector product
-    (:func:`output_matrix`); it runs in C (``acld_gym.envs._stepcore``) when that module
-    was built (``COMPILED_STEP``), else in numpy, with the same results.
+    (:func:`acld_gym.envs.step.output_matrix`), the N = 1 case of the batched step
+    (:mod:`acld_gym.envs.batch`); it runs in C (``acld_gym.envs._stepcore``) when that
+    module was built (``COMPILED_STEP``), else in numpy, with the same results.
+
+    The configuration is one :class:`acld_gym.envs.config.EnvConfig` (``config=``, or its
+    fields as keyword arguments, which replace the config's; see Arguments).
 
     ## Action Space
 
@@ -91,7 +84,7 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
     form (:func:`acld_gym.design.reduction.modal_form`): one (cosine, sine)-like pair per
     mode (modes 1-4 in order; 1-3 on the thesis mesh), the same on every machine. Each component is
     divided by its peak magnitude in the passive response to thesis load case 1
-    (``Nominal.xr_scale``), so a 1 N x 1 ms pulse gives values of order one (mode 4,
+    (``NominalDesign.xr_scale``), so a 1 N x 1 ms pulse gives values of order one (mode 4,
     above the Nyquist frequency, is seen by the 1 kHz Kalman filter at about a tenth).
     ``"full"``: for ``mesh="converged"`` q are the 18 mass-normalized Ritz
     coordinates of the plant [kg^0.5 m] and their rates; for ``mesh="thesis"`` the
@@ -100,12 +93,14 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
     ## Rewards
 
     ``r = -(y / y_ref)^2 - lam * (V / 120)^2`` per step, with ``y`` the true
-    tip deflection [m] at the end of the step and ``V`` the applied voltage.
+    tip deflection [m] at the end of the step and ``V`` the applied voltage. The two
+    terms are ``info["reward_deflection"]`` and ``info["reward_voltage"]``.
 
     ## Starting State
 
     The beam at rest (all plant states zero), the observer at zero. The load of
-    the episode is set by ``load_case`` (or ``reset(options={"load_case": ...})``).
+    the episode is set by ``load_case`` (or ``reset(options={"load_case": ...})``, or a
+    :class:`acld_gym.physics.loads.TipLoad` as ``reset(options={"load": ...})``).
 
     ## Episode End
 
@@ -117,32 +112,39 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
       steps (1 s = 1000 steps by default). ``gym.make`` adds no other limit, and
       ``env.spec.max_episode_steps`` is that step count; ``max_episode_steps=n`` can
       only shorten the episode (a ``TimeLimit`` of n steps).
-    * Limits: at most 1,000,000 steps per episode (``checks.MAX_EPISODE_STEPS``) and
+    * Limits: at most 1,000,000 steps per episode (``config.MAX_EPISODE_STEPS``) and
       4,000,000 tabulated steps over a vector env's sub-envs (``MAX_TABLE_STEPS``): the
-      load and noise of an episode are tabulated at reset (about 350 bytes per step of
-      a single env, 350 MB at the limit; 170 bytes per vector sub-env step), so a
-      longer episode is refused at construction with a ``ValueError`` instead of
-      exhausting memory.
+      sensor noise of an episode is tabulated at reset (8 bytes per step; without the
+      compiled step the loads too, 170 bytes per step), so a longer episode is refused at
+      construction with a ``ValueError`` instead of exhausting memory.
 
     ## Arguments
 
-    | kwarg | default | meaning |
+    ``config`` (an ``EnvConfig``, default ``ACLDBeam-v1``'s), ``render_mode``
+    (``"rgb_array"``, ``"human"`` or None) and the config's fields as keywords:
+
+    | field | default | meaning |
     |---|---|---|
-    | ``load_case`` | 1 | 1, 2, 3 (thesis ch. 5) or ``"random"`` (:func:`random_load`) |
+    | ``load_case`` | 1 | 1, 2, 3 (thesis ch. 5), ``"random"`` (:func:`random_load`) or a |
+    | | | ``TipLoad`` (pulses, harmonics, ``Samples``; :mod:`acld_gym.physics.loads`) |
     | ``mesh`` | ``"converged"`` | truth plant: ``"converged"`` or ``"thesis"`` (38 states) |
-    | ``dt`` | 1e-3 | control period [s] |
-    | ``episode_length`` | 1.0 | episode duration [s] |
+    | ``dt`` | 1e-3 | control period [s], in [1e-4, 1e-2] |
+    | ``episode_length`` | 1.0 | episode duration [s], in [1e-4, 1e3] |
     | ``observer`` | ``"kalman"`` | ``"kalman"`` (reduced model, not fed the load) or |
     | | | ``"thesis"`` (full order, fed the load) |
     | ``obs_mode`` | ``"estimate"`` | see Observation Space |
-    | ``sensor_noise`` | 1e-7 | tip-sensor noise std [m] (seeded; 0 for none) |
-    | ``y_ref`` | 1e-3 | deflection scale of the reward [m] |
-    | ``lam`` | 0.01 | voltage weight of the reward |
+    | ``sensor_noise`` | 1e-7 | tip-sensor noise std [m] in [0, 1e-3] (seeded; 0 for none) |
+    | ``y_ref`` | 1e-3 | deflection scale of the reward [m], in [1e-9, 1] |
+    | ``lam`` | 0.01 | voltage weight of the reward, in [0, 1e6] |
     | ``param_noise`` | 0.0 | relative std of per-episode parameter randomization, at |
-    | | | most 0.1 (``"converged"``) or 0.05 (``"thesis"``); log-normal factors |
-    | | | truncated at 3 std |
-    | ``deflection_limit`` | 0.02 | termination limit [m] |
-    | ``render_mode`` | None | ``"rgb_array"`` or ``"human"`` |
+    | | | most ``param_noise_max``; log-normal factors truncated at 3 std |
+    | ``deflection_limit`` | 0.02 | termination limit [m], in [1e-6, 1] |
+    | ``harmonic_modes`` | None | random-load harmonic targets [rad/s]; None: the plant's |
+    | | | own first two damped modes |
+    | ``model_std`` | 0.1 | model-error noise of the Kalman filter (relative) |
+    | ``param_noise_max`` | None | bound of ``param_noise``; None: 0.1 (``"converged"``) |
+    | | | or 0.05 (``"thesis"``), within which the baselines are certified stable |
+    | ``env_id`` | ``"ACLDBeam-v1"`` | the registered id of the configuration (fingerprint) |
 
     Load case 3 is the thesis's resonant harmonic, 0.1 sin(179 t) N for 5.5 cycles,
     on every mesh: the thesis tuned it to its model's first resonance (178.6 rad/s);
@@ -160,72 +162,67 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
       plant (modes 1-4; 6 on the thesis mesh) and the Kalman filter a model-error noise
       (``model_std`` 0.1), so the baselines stay stable on every randomized plant;
       ``param_noise`` is bounded (0.1; 0.05 on the thesis mesh) and its factors
-      truncated at 3 std.
-    * v0: the thesis configuration (:mod:`acld_gym.envs.legacy`): the thesis's 38-state
-      mesh, its 6-state design model and observers, the same dynamics, reward, spaces
-      and episode. It differs from v1 with ``mesh="thesis"`` in three settings only:
-      random-load harmonics at 179 and 1115 rad/s (v1: the plant's own 178.64 and
-      1115.40), a Kalman filter driven by the load alone (``model_std=0``; v1: 0.1) and
-      ``param_noise`` up to 0.5 (v1: 0.05). Since acld-gym 0.3.0 its observation is in
-      the same canonical modal basis as v1's, identical on every machine; before, it was
+      truncated at 3 std. Since acld-gym 0.3.0 the info also has ``requested_voltage``
+      and the reward's terms in the vector env too, and custom loads (``TipLoad``) are
+      accepted; the dynamics, rewards and observations are unchanged.
+    * v0: the thesis configuration (``acld_gym.envs.presets.PRESETS["ACLDBeam-v0"]``):
+      the thesis's 38-state mesh, its 6-state design model and observers, the same
+      dynamics, reward, spaces and episode. It differs from v1 with ``mesh="thesis"`` in
+      three settings only: random-load harmonics at 179 and 1115 rad/s
+      (``harmonic_modes``; v1: the plant's own 178.64 and 1115.40), a Kalman filter
+      driven by the load alone (``model_std=0``; v1: 0.1) and ``param_noise`` up to 0.5
+      (``param_noise_max``; v1: 0.05). Since acld-gym 0.3.0 its observation is in the
+      same canonical modal basis as v1's, identical on every machine; before, it was
       the Schur method's own coordinates, whose signs changed with the CPU's BLAS kernels
       (up to a sign flip of whole components), so an agent trained on one machine acted
-      on other coordinates on another.
+      on other coordinates on another. Since 0.3.0 it is a configuration of this class
+      (before, a subclass); its other fields can be set like v1's.
     """
 
     metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 30}
 
-    #: The id this class is registered under (used when it is built without ``gym.make``).
-    env_id = "ACLDBeam-v1"
-    #: Harmonic targets of random loads [rad/s]; None: the plant's own first two modes.
-    _harmonic_modes: tuple[float, float] | None = None
-    #: Model-error noise of the Kalman filter (:func:`acld_gym.design.observer.discrete_kalman`).
-    _model_std = MODEL_STD
-    #: Bound of ``param_noise`` (None: :data:`PARAM_NOISE_MAX` of the mesh).
-    _param_noise_max: float | None = None
-
-    def __init__(self, load_case: int | str = 1, mesh: str = "converged", dt: float = 1e-3,
-                 episode_length: float = 1.0, observer: str = "kalman",
-                 obs_mode: str = "estimate", sensor_noise: float = SENSOR_NOISE_M,
-                 y_ref: float = 1e-3, lam: float = 0.01, param_noise: float = 0.0,
-                 deflection_limit: float = 0.02, render_mode: str | None = None):
-        configure(self, load_case=load_case, mesh=mesh, dt=dt, episode_length=episode_length,
-                  observer=observer, obs_mode=obs_mode, sensor_noise=sensor_noise,
-                  y_ref=y_ref, lam=lam, param_noise=param_noise,
-                  deflection_limit=deflection_limit, render_mode=render_mode)
-        self.max_steps = check_episode_size(self.episode_length, self.dt)
-        n_obs = observation_size(self.nom, obs_mode, self.obs_hist)
-        self.action_space = spaces.Box(-self.v_max, self.v_max, (1,), np.float32)
-        self.observation_space = spaces.Box(-np.inf, np.inf, (n_obs,), np.float32)
-        self._plant = self.nom.plant
-        self._obs = self.nom.thesis if observer == "thesis" else self.nom.kalman
-        self._est = estimate_map(self._obs, self.nom.xr_scale)
-        self._fig = None
-        self._reset_state(thesis_load(1) if load_case == "random" else thesis_load(load_case))
-        self._core = _NotReset(self._core)  # stepping before reset() raises
-
-    # --- composition of a step ----------------------------------------------
-    # The state lives in one buffer z = [x, xhat, y_meas, V, f0, f1, w'] (x and xhat
-    # are views into it). One product G z (output_matrix) advances plant and observer
-    # and gives the new measurement, the observation and the info's numbers. The step
-    # runs in C (acld_gym.envs._stepcore.StepCore) where it can, else in numpy (_step); the
-    # core holds the step count, voltage, last measurement and last output for both.
     #: Step in C where it can (``COMPILED_STEP``); set False on an instance to force the
     #: numpy reference step from the next reset on (benchmarks and tests compare the two).
     compiled_step = COMPILED_STEP
 
-    k = property(lambda self: self._core.k, lambda self, val: setattr(self._core, "k", val),
-                 doc="Steps taken in the episode.")
-    v = property(lambda self: self._core.v, lambda self, val: setattr(self._core, "v", val),
+    def __init__(self, config: EnvConfig | None = None, render_mode: str | None = None,
+                 **kwargs):
+        self.config = make_config(config, **kwargs)
+        check_render_mode(render_mode, self.metadata["render_modes"])
+        self.render_mode = render_mode
+        self.nom = self.config.nominal()
+        #: Random-load harmonic targets [rad/s] (``config.harmonic_targets``).
+        self.harmonic_modes = self.config.harmonic_targets(self.nom)
+        self.max_steps = self.config.max_steps
+        self._batch = BatchStep(self.config, 1, self.max_steps, self.compiled_step)
+        self.action_space = spaces.Box(-V_LIMIT, V_LIMIT, (1,), np.float32)
+        self.observation_space = spaces.Box(-np.inf, np.inf, (self._batch.n_obs,), np.float32)
+        self._fig = None
+        self.history: list[tuple[float, float, float]] = []
+        self.load = case_load(self.config.load_case) or thesis_load(1)
+        self._batch.start_episodes([0], [self.load], [self.nom.plant],
+                                   np.zeros((1, self.max_steps + 1)))
+        self._started = False
+        self._fast = _not_reset  # the compiled step after reset(); None where it declines
+
+    # --- state ----------------------------------------------------------------------------
+    batch = property(lambda self: self._batch,
+                     doc="The batched step this env is the N = 1 case of "
+                         "(:class:`acld_gym.envs.batch.BatchStep`: its state and step).")
+    k = property(lambda self: int(self._batch.k[0]), doc="Steps taken in the episode.")
+    v = property(lambda self: float(self._batch.Z[0, self._batch.layout.voltage]),
                  doc="Voltage applied in the last step [V].")
-    y_meas = property(lambda self: self._core.y_meas,
-                      lambda self, val: setattr(self._core, "y_meas", val),
+    y_meas = property(lambda self: float(self._batch.Z[0, self._batch.layout.y_meas]),
                       doc="Last tip measurement [m].")
-    _last = property(lambda self: self._core.last,
-                     doc="G z of the last step (:func:`output_matrix`; one buffer).")
-    x = property(lambda self: self._z[self._layout.x],
+    x = property(lambda self: self._batch.Z[0, self._batch.layout.x],
                  doc="True plant state [q; dq/dt] (a view).")
-    xhat = property(lambda self: self._z[self._layout.xhat], doc="Observer state (a view).")
+    xhat = property(lambda self: self._batch.Z[0, self._batch.layout.xhat],
+                    doc="Observer state (a view).")
+    episode_plant = property(lambda self: self._batch.plants[0],
+                             doc="The sampled plant of this episode (randomized with "
+                                 "``param_noise``), a "
+                                 ":class:`acld_gym.design.discrete.SampledSystem`.")
+
     @property
     def spec(self):
         """The registration spec (set by ``gym.make``), with ``max_episode_steps`` the
@@ -237,151 +234,71 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
     def spec(self, value) -> None:
         self._spec = episode_spec(value, self.max_steps)
 
-    episode_plant = property(lambda self: self._plant,
-                             doc="The sampled plant of this episode (randomized with "
-                                 "``param_noise``), a "
-                                 ":class:`acld_gym.design.discrete.SampledSystem`.")
-
     @property
     def observation_fingerprint(self) -> dict:
         """What the observation depends on (:mod:`acld_gym.envs.fingerprint`)."""
         return observation_fingerprint(self)
 
-    def _reset_state(self, load: TipLoad) -> None:
-        self.load = load
-        self._layout = lay = StepLayout(n=self._plant.Ad.shape[0], k=self._obs.n,
-                                        r=self.nom.design.reduced.order,
-                                        substeps=self._plant.substeps)
-        self._z = np.zeros(lay.z_size)
-        self.y_hist = np.zeros(self.obs_hist)
-        self.history: list[tuple[float, float, float]] = []
-        F, tipf = load_schedule(self.nom.plant, load, 0, self.max_steps)
-        self._tipf = np.ascontiguousarray(tipf, dtype=np.float64)
-        self._noise = np.zeros(self.max_steps + 1)
-        self._inputs = np.hstack([F, self._noise[1:, None]])  # per step: [f0, f1, w']
-        self._G = output_matrix(step_matrix(self._plant, self.nom.plant, self._obs), lay,
-                                self.nom.output, self.nom.design.reduced.SL, self._est)
-        self._core = self._make_core()
-
-    def _make_core(self):
-        """The step's core over this episode's arrays (state: at rest)."""
-        if not (self.compiled_step and COMPILED_STEP):
-            return _NumpyCore(self._G.shape[0])
-        core = StepCore(G=self._G, z=self._z, inputs=self._inputs, tipf=self._tipf,
-                        y_hist=self.y_hist, **self._layout.core_kwargs(),
-                        obs_mode=OBS_MODES.index(self.obs_mode),
-                        n_obs=self.observation_space.shape[0], dt=self.dt, y_ref=self.y_ref,
-                        lam=self.lam, v_max=self.v_max, limit=self.deflection_limit,
-                        y_scale=Y_SCALE)
-        core.active = self.render_mode is None  # rendering steps in numpy (draws history)
-        return core
-
     def __getstate__(self):
         state = super().__getstate__()
-        c = self._core
-        state["_core"] = (c.k, c.v, c.y_meas, c.last)  # the C core does not pickle
+        state["_fast"] = None  # a bound method of the compiled core: rebuilt on load
         return state
 
     def __setstate__(self, state):
-        k, v, y_meas, last = state.pop("_core")
         self.__dict__.update(state)
-        self._core = self._make_core()
-        self.k, self.v, self.y_meas = k, v, y_meas
-        self._last[:] = last
+        core = self._batch.core
+        self._fast = _not_reset if not self._started else (
+            core.step_one if core is not None else _no_fast_path)
 
-    def _draw_noise(self) -> None:
-        """The episode's sensor noise, drawn at reset (the vector env draws the same)."""
-        if self.sensor_noise:
-            self._noise = self.np_random.normal(0.0, self.sensor_noise, self.max_steps + 1)
-            self._inputs[:, -1] = self._noise[1:]
-
-    def _voltage(self, action) -> tuple[float, float]:
-        """(applied, requested) voltage; ``ValueError`` (state untouched) on bad input."""
-        if (type(action) is np.ndarray and action.shape == (1,)
-                and action.dtype.kind == "f"):  # fast path (SB3, policies)
-            requested = float(action[0])
-            if math.isfinite(requested):
-                return min(max(requested, -self.v_max), self.v_max), requested
-        req, v = check_actions(action, 1, self.v_max)
-        return float(v[0]), float(req[0])
-
-    def _step_inputs(self, k: int) -> np.ndarray:
-        """``[f0, f1, w']`` of period k: tabulated for the episode, computed beyond it."""
-        if k < self.max_steps:
-            return self._inputs[k]
-        f = load_schedule(self.nom.plant, self.load, k, k + 1)[0][0]
-        w = self.np_random.normal(0.0, self.sensor_noise) if self.sensor_noise else 0.0
-        return np.append(f, w)
-
-    def _observation(self) -> np.ndarray:
-        if self.obs_mode == "estimate":
-            return self._last[self._layout.out_estimate].astype(np.float32)
-        if self.obs_mode == "measurement":
-            return np.append(self.y_hist / Y_SCALE, self.v / self.v_max).astype(np.float32)
-        return self.x.astype(np.float32)
-
-    def _info(self, requested: float | None = None) -> dict[str, Any]:
-        k, lay = self.k, self._layout
-        tip_load = float(self._tipf[k]) if k <= self.max_steps else float(self.load(k * self.dt))
-        return {"tip_deflection": float(self._last[lay.out_y]), "voltage": self.v,
-                "tip_load": tip_load, "time": k * self.dt,
-                "xr_true": self._last[lay.out_xr].copy(),
-                "clipped": requested is not None and requested != self.v,
-                "requested_voltage": self.v if requested is None else requested,
-                "terminated_by": None}
-
-    # --- Gymnasium API -------------------------------------------------------
+    # --- Gymnasium API --------------------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict | None = None):
-        case = reset_options(options, self.load_case)  # validated before seeding:
+        case = reset_options(options, self.config.load_case)  # validated before seeding:
         super().reset(seed=check_seed(seed))  # a rejected reset leaves the RNG as it was
-        load, self._plant = draw_episode(self.np_random, case, self.nom, self.episode_length,
-                                         self.param_noise, self.harmonic_modes)
-        self._reset_state(load)
-        self._draw_noise()
-        w = float(self._noise[0])  # the beam starts at rest: the first measurement is noise
-        lay = self._layout
-        self.y_meas = self._z[lay.y_meas] = w
-        self.y_hist[-1] = w
-        self._last[lay.y_meas] = w
-        self._last[lay.out_estimate] = w * np.append(self._est[-1], 1.0 / Y_SCALE)
-        return self._observation(), self._info()
+        c = self.config
+        load, plant = draw_episode(self.np_random, case, self.nom, c.episode_length,
+                                   c.param_noise, self.harmonic_modes)
+        noise = (draw_noise(self.np_random, c.sensor_noise, self.max_steps + 1)
+                 if c.sensor_noise else np.zeros(self.max_steps + 1))
+        if self._batch.compiled != (self.compiled_step and COMPILED_STEP):
+            self._batch = BatchStep(c, 1, self.max_steps, self.compiled_step)
+        self._batch.start_episodes([0], [load], [plant], noise[None])
+        self.load = load
+        self.history = []
+        self._started = True
+        core = self._batch.core
+        self._fast = core.step_one if core is not None else _no_fast_path
+        b = self._batch
+        info = {"tip_deflection": 0.0, "voltage": 0.0, "requested_voltage": 0.0,
+                "clipped": False, "tip_load": float(b.tip_loads()[0]), "time": 0.0,
+                "xr_true": np.zeros(self.nom.design.reduced.order), "terminated_by": None,
+                "reward_deflection": 0.0, "reward_voltage": 0.0}
+        return b.observations()[0], info
 
     def step(self, action):
-        result = self._core.step(action)  # the compiled path; None where it does not apply
-        return result if result is not None else self._step(action)
-
-    def _step(self, action):
-        """The step in numpy: the reference for :class:`acld_gym.envs._stepcore.StepCore`, and
-        the path for actions of other types, bad actions, rendering and steps past the
-        tabulated episode."""
-        if isinstance(self._core, _NotReset):
-            raise RuntimeError("ACLDBeamEnv: call reset() before step()")
-        v, requested = self._voltage(action)
-        c, z, lay = self._core, self._z, self._layout
-        k = c.k
-        z[lay.voltage] = v
-        z[lay.inputs] = self._step_inputs(k)
-        # 1. plant (ZOH) and 2. observer over one period, 3. the new measurement
-        out = np.dot(self._G, z, out=c.last)
-        z[lay.state] = out[lay.state]
-        c.k = k = k + 1
-        c.v = v
-        c.y_meas = float(out[lay.y_meas])
-        y = float(out[lay.out_y])
-        if self.obs_mode == "measurement":
-            self.y_hist[:-1] = self.y_hist[1:]
-            self.y_hist[-1] = c.y_meas
-        reward = reward_of(y, v, self.y_ref, self.lam, self.v_max)  # 4. on the true deflection
-        why = termination(y, reward, out, self.deflection_limit)  # 5. limits
-        terminated = why is not None
-        truncated = k >= self.max_steps
+        result = self._fast(action)  # the compiled step; None where it does not apply
+        if result is None:
+            result = self._step(action)
         if self.render_mode is not None:  # the history is only drawn, never observed
-            self.history.append((k * self.dt, y, v))
+            info = result[4]
+            self.history.append((info["time"], info["tip_deflection"], info["voltage"]))
             if self.render_mode == "human":
                 self.render()
-        info = self._info(requested)
-        info["terminated_by"] = why
-        return self._observation(), reward, terminated, truncated, info
+        return result
+
+    def _step(self, action):
+        """The step in numpy (:meth:`acld_gym.envs.batch.BatchStep.advance`): the reference
+        of the compiled one, and the path for actions of other types, bad actions and steps
+        past the tabulated episode."""
+        if not self._started:
+            _not_reset(action)
+        requested, v = check_actions(action, 1, V_LIMIT)
+        b, k = self._batch, self.k
+        inputs = None
+        if k >= self.max_steps:  # past the tabulated episode: this period's load and noise
+            f = load_schedule(self.nom.plant, self.load, k, k + 1)[0]
+            w = self.np_random.normal(0.0, self.sensor_noise) if self.sensor_noise else 0.0
+            inputs = np.append(f[0], w)[None]
+        return _single(b.advance(v, inputs), float(v[0]), float(requested[0]), k + 1, self.dt)
 
     def render(self):
         if self.render_mode is None:
@@ -401,27 +318,11 @@ class ACLDBeamEnv(FigureOwner, gym.Env):
         self._close_figure()
 
 
-class _NotReset:
-    """Stands in for the step's core until the first ``reset()`` (Gymnasium's order)."""
-
-    def __init__(self, core):
-        self._inner = core
-
-    def __getattr__(self, name):
-        return getattr(self._inner, name)
-
-    def step(self, action):
-        raise RuntimeError("ACLDBeamEnv: call reset() before step()")
-
-
-class _NumpyCore:
-    """The state :class:`acld_gym.envs._stepcore.StepCore` keeps, without a compiled step
-    (every step goes to ``ACLDBeamEnv._step``)."""
-
-    __slots__ = ("k", "v", "y_meas", "last")
-
-    def __init__(self, m: int):
-        self.k, self.v, self.y_meas, self.last = 0, 0.0, 0.0, np.zeros(m)
-
-    def step(self, action) -> None:
-        return None
+def _single(res: StepResult, v: float, requested: float, k: int, dt: float):
+    """Gymnasium's 5-tuple of env 0 of a batch step (as the compiled ``step_one`` gives it)."""
+    code = int(res.code[0])
+    values = (float(res.y[0]), v, requested, requested != v, float(res.tip_load[0]), k * dt,
+              res.xr[0], TERMINATED_BY[code], float(res.reward_deflection[0]),
+              float(res.reward_voltage[0]))
+    info: dict[str, Any] = dict(zip(INFO_KEYS, values, strict=True))
+    return res.obs[0], float(res.reward[0]), code != 0, bool(res.truncated[0]), info

@@ -24,8 +24,8 @@ RTOL = 1e-6
 
 
 def design_fingerprint(nom) -> dict[str, Any]:
-    """The nominal design's part (:class:`acld_gym.envs.episode.Nominal`): the plant, the reduced
-    model's coordinates and the observation scales. Enough for a reference policy, which
+    """The nominal design's part (:class:`acld_gym.design.nominal.NominalDesign`): the plant,
+    the reduced model's coordinates and the observation scales. Enough for a reference policy, which
     decodes the estimate with them and works with either observer."""
     r = nom.design.reduced
     return {"mesh": nom.mesh, "basis": nom.basis, "dt": float(nom.plant.dt),
@@ -39,7 +39,7 @@ def observation_fingerprint(env) -> dict[str, Any]:
     observation mode and the observer (its gains)."""
     e = getattr(env, "unwrapped", env)
     spec = getattr(e, "spec", None)
-    obs = e.nom.thesis if e.observer_kind == "thesis" else e.nom.kalman
+    obs = e.nom.observer(e.observer_kind)
     return {"env_id": getattr(spec, "id", None) or e.env_id,
             **design_fingerprint(e.nom), "obs_mode": e.obs_mode,
             "observer": e.observer_kind, "observer_Lc": obs.Lc.ravel().tolist(),

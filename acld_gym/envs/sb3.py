@@ -27,13 +27,15 @@ from typing import Any
 import numpy as np
 from stable_baselines3.common.vec_env import VecEnv
 
-from acld_gym.envs.episode import LOAD_CASES
-from acld_gym.envs.vector_env import INFO_KEYS, ACLDBeamVectorEnv
-from acld_gym.util.validate import check_choice, check_seed
+from acld_gym.envs.config import EnvConfig
+from acld_gym.envs.step import INFO_KEYS
+from acld_gym.envs.vector_env import ACLDBeamVectorEnv
+from acld_gym.physics.loads import check_load_case
+from acld_gym.util.validate import check_seed
 
 #: Attributes the env derives its tables and design from at construction.
-_CONFIGURED = ("mesh", "dt", "episode_length", "observer_kind", "obs_mode", "sensor_noise",
-               "param_noise", "num_envs", "nom", "horizon")
+_CONFIGURED = ("config", "mesh", "dt", "episode_length", "observer_kind", "obs_mode",
+               "sensor_noise", "param_noise", "num_envs", "nom", "horizon")
 
 __all__ = ["SB3VecEnv"]
 
@@ -44,15 +46,16 @@ def _scalar(x):
 
 
 class SB3VecEnv(VecEnv):
-    """SB3 ``VecEnv`` over :class:`ACLDBeamVectorEnv` (``num_envs`` and the env's kwargs,
-    or an existing ``venv=``)."""
+    """SB3 ``VecEnv`` over :class:`ACLDBeamVectorEnv` (``num_envs`` and the env's
+    configuration -- ``config=`` and/or its fields as keywords --, or an existing
+    ``venv=``)."""
 
     def __init__(self, num_envs: int = 1, venv: ACLDBeamVectorEnv | None = None,
-                 **env_kwargs):
+                 config: EnvConfig | None = None, **env_kwargs):
         if venv is None:
-            venv = ACLDBeamVectorEnv(num_envs=num_envs, **env_kwargs)
-        elif env_kwargs:
-            raise ValueError("pass either venv= or the env's keyword arguments, not both")
+            venv = ACLDBeamVectorEnv(num_envs=num_envs, config=config, **env_kwargs)
+        elif env_kwargs or config is not None:
+            raise ValueError("pass either venv= or the env's configuration, not both")
         self.venv = venv
         super().__init__(venv.num_envs, venv.single_observation_space,
                          venv.single_action_space)
@@ -69,7 +72,7 @@ class SB3VecEnv(VecEnv):
         return obs
 
     def step_async(self, actions: np.ndarray) -> None:
-        if self.venv._needs_reset:
+        if self.venv.needs_reset:
             raise RuntimeError("SB3VecEnv: call reset() before step()")
         self._actions = np.asarray(actions)
 
@@ -129,7 +132,7 @@ class SB3VecEnv(VecEnv):
         if idx != list(range(self.num_envs)):
             raise ValueError("SB3VecEnv: attributes are shared; set them for all sub-envs")
         if attr_name == "load_case":
-            check_choice("load_case", value, LOAD_CASES)
+            check_load_case(value)
         elif attr_name in _CONFIGURED:
             raise ValueError(f"SB3VecEnv: {attr_name} is fixed at construction; build a new "
                              "env to change it")

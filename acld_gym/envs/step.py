@@ -1,9 +1,10 @@
 """The env's step as algebra: one period of plant and observer as one matrix, the fused output
-matrix of the whole step, the load schedule, the reward and the end of an episode."""
+matrix of the whole step, the load schedule, the reward and the end of an episode, and the
+info schema. Written once here; :mod:`acld_gym.envs.batch` runs it for N envs, and the
+compiled step (``acld_gym.envs._stepcore``) mirrors the reward and the termination."""
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -14,27 +15,42 @@ from acld_gym.design.observer import DiscreteObserver
 from acld_gym.physics.loads import TipLoad
 
 if TYPE_CHECKING:
-    from acld_gym.envs.episode import Nominal
+    from acld_gym.design.nominal import NominalDesign
 
-__all__ = ["StepLayout", "Y_SCALE", "observation_size", "estimate_map", "step_matrix",
-           "output_matrix",
-           "load_schedule", "reward_of", "termination"]
+__all__ = ["StepLayout", "Y_SCALE", "OBS_HIST", "INFO_KEYS", "TERMINATED_BY", "observation_size",
+           "estimate_map", "step_matrix", "output_matrix", "rest_output", "load_schedule",
+           "reward_terms", "reward_of", "termination_codes"]
 
 
 #: Deflection scale of the observations [m].
 Y_SCALE = 1e-3
 
+#: Measurements in the ``"measurement"`` observation.
+OBS_HIST = 8
+
+#: The info of every step, single and vector env alike (the vector env's values are arrays
+#: with ``_key`` masks): the true tip deflection [m] at the end of the step, the voltage
+#: applied [V] and the one requested (the action) [V], whether it was clipped, the tip load
+#: [N] and the time [s] at the end of the step, the true reduced state, why the episode
+#: ended (:data:`TERMINATED_BY`) and the reward's two terms (their sum is the reward, as
+#: Gymnasium's MuJoCo envs report ``reward_*`` terms).
+INFO_KEYS = ("tip_deflection", "voltage", "requested_voltage", "clipped", "tip_load", "time",
+             "xr_true", "terminated_by", "reward_deflection", "reward_voltage")
+
+#: ``info["terminated_by"]`` by termination code (0: the episode goes on).
+TERMINATED_BY = (None, "deflection_limit", "non_finite_state")
+
 
 @dataclass(frozen=True)
 class StepLayout:
     """Which slot of the step's vectors holds what: the one owner of the layout, read by
-    the single env, the vector env and the compiled step (as integers,
+    the batched step (:mod:`acld_gym.envs.batch`) and the compiled step (as integers,
     :meth:`core_kwargs`).
 
     Input ``z = [x, xhat, y_meas, V, f0 (s), f1 (s), w']``: plant state (n), observer
     state (k), last measurement, voltage, the period's load samples at the s sub-steps'
-    starts and ends, and the new measurement's noise (the vector env's Z is z without
-    w'). Output ``G z = [x', xhat', y_meas', y', x_r', e', y_meas' / Y_SCALE]``: the next
+    starts and ends, and the new measurement's noise (one row of the batch's Z per env).
+    Output ``G z = [x', xhat', y_meas', y', x_r', e', y_meas' / Y_SCALE]``: the next
     state (its first :attr:`state` entries replace z's), the true tip deflection, the
     true reduced state (r), and the ``"estimate"`` observation (r + 1).
     """
@@ -104,12 +120,13 @@ class StepLayout:
     def core_kwargs(self) -> dict[str, int]:
         """The layout as the compiled step takes it (``acld_gym.envs._stepcore``)."""
         return {"n_state": self.state.stop, "i_voltage": self.voltage,
-                "i_inputs": self.inputs.start, "o_ymeas": self.y_meas, "o_y": self.out_y,
+                "i_loads": self.loads.start, "i_noise": self.noise, "o_ymeas": self.y_meas,
+                "o_y": self.out_y,
                 "o_xr": self.out_xr.start, "o_obs": self.out_estimate.start, "n_x": self.n,
                 "n_xr": self.r}
 
 
-def observation_size(nom: Nominal, obs_mode: str, hist: int) -> int:
+def observation_size(nom: NominalDesign, obs_mode: str, hist: int = OBS_HIST) -> int:
     return {"estimate": nom.design.reduced.order + 1, "measurement": hist + 1,
             "full": nom.plant.Ad.shape[0]}[obs_mode]
 
@@ -172,17 +189,35 @@ def load_schedule(plant: SampledSystem, load: TipLoad, start: int,
     return F, load(k * plant.dt)
 
 
-def termination(y: float, reward: float, state: np.ndarray, limit: float) -> str | None:
-    """Why a step ends the episode: ``"non_finite_state"`` if the new state or the reward
-    is not finite (never passed off as a normal step), ``"deflection_limit"`` if
-    |y| > ``limit``; else None."""
-    if not (math.isfinite(reward) and np.isfinite(state).all()):
-        return "non_finite_state"
-    if not abs(y) <= limit:
-        return "deflection_limit"
-    return None
+def reward_terms(y, v, y_ref: float, lam: float, v_max: float):
+    """The reward and its terms, ``(r, r_y, r_v)`` with ``r_y = -(y / y_ref)^2`` and
+    ``r_v = -lam (V / v_max)^2``, ``r = r_y + r_v`` (scalars or arrays; the compiled step
+    computes the same in the same order)."""
+    r_y = -((y / y_ref) ** 2)
+    r_v = -(lam * (v / v_max) ** 2)
+    return r_y + r_v, r_y, r_v
 
 
 def reward_of(y, v, y_ref: float, lam: float, v_max: float):
-    """``-(y / y_ref)^2 - lam (V / v_max)^2`` (scalars or arrays)."""
-    return -((y / y_ref) ** 2) - lam * (v / v_max) ** 2
+    """``-(y / y_ref)^2 - lam (V / v_max)^2`` (scalars or arrays; :func:`reward_terms`)."""
+    return reward_terms(y, v, y_ref, lam, v_max)[0]
+
+
+def termination_codes(y: np.ndarray, reward: np.ndarray, out: np.ndarray,
+                      limit: float) -> np.ndarray:
+    """Why each step ends the episode, as a code into :data:`TERMINATED_BY`: 2
+    (``"non_finite_state"``) if the env's output row ``out`` (the new state and everything
+    derived from it) or the reward is not finite -- never passed off as a normal step --,
+    1 (``"deflection_limit"``) if |y| > ``limit``, else 0."""
+    finite = np.isfinite(reward) & np.isfinite(out).all(axis=-1)
+    return np.where(~finite, 2, np.where(np.abs(y) <= limit, 0, 1)).astype(np.int8)
+
+
+def rest_output(layout: StepLayout, est: np.ndarray, w: float) -> np.ndarray:
+    """The output row of a beam and observer at rest whose first measurement is ``w`` (the
+    sensor noise): the measurement slot and the ``"estimate"`` observation of a zero
+    observer state, ``[0, w] M`` (:func:`estimate_map` M) and ``w / Y_SCALE``."""
+    out = np.zeros(layout.out_size)
+    out[layout.y_meas] = w
+    out[layout.out_estimate] = w * np.append(est[-1], 1.0 / Y_SCALE)
+    return out

@@ -8,11 +8,11 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass
 
+from acld_gym.physics.actuator import V_LIMIT  # the saturated runs' limit (sec. 5.3)
+
 __all__ = ["Table2Row", "TABLE2", "PASSIVE_CASE1_PEAK_MM", "FIRST_RESONANCE_RAD_S",
            "V_LIMIT", "thesis_row"]
 
-#: Voltage limit of the saturated runs [V] (sec. 5.3).
-V_LIMIT = 120.0
 #: Passive (PCLD) peak tip deflection for case 1 [mm] (sec. 5.3, Fig. 9).
 PASSIVE_CASE1_PEAK_MM = 0.675
 #: First resonance used for load case 3 [rad/s] (sec. 5.5).

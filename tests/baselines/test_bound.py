@@ -6,8 +6,8 @@ import warnings
 import numpy as np
 import pytest
 
-from acld_gym.envs.episode import nominal, random_load
-from acld_gym.physics.loads import TipLoad, thesis_load
+from acld_gym.design.nominal import nominal_design
+from acld_gym.physics.loads import TipLoad, random_load, thesis_load
 from baselines import bound
 from baselines.bound import (
     ATOL,
@@ -26,7 +26,7 @@ N = 1000
 def plant_and_tip():
     """The nominal plant and its tip output: the output row where the model has one, else
     the tip's state index."""
-    nom = nominal()
+    nom = nominal_design()
     tip = getattr(nom, "output", None)
     return nom.plant, (nom.design.model.tip_index if tip is None else tip)
 

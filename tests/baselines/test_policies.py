@@ -7,8 +7,8 @@ the thesis's Table 2 runs on ``mesh="thesis"``, the thesis's own model.
 import numpy as np
 import pytest
 
+from acld_gym.design.nominal import nominal_design
 from acld_gym.envs.beam_env import ACLDBeamEnv
-from acld_gym.envs.episode import nominal
 from acld_gym.physics.loads import thesis_load
 from acld_gym.thesis.metrics import peak, settling_time
 from acld_gym.thesis.table2 import thesis_row
@@ -34,7 +34,7 @@ def rollout(policy, case, seed=0, mesh="converged"):
 
 @pytest.fixture(scope="module")
 def results():
-    nom = nominal()
+    nom = nominal_design()
     pols = {"passive": PassivePolicy(), "lqr": LQRPolicy(), "smc": SMCPolicy(),
             "mpc": MPCPolicy()}
     out = {}
@@ -130,7 +130,7 @@ def test_sb3_evaluate_policy_accepts_baselines():
 
 
 def test_bad_arguments():
-    nom = nominal()
+    nom = nominal_design()
     with pytest.raises(ValueError, match="eps"):
         SMCPolicy(eps=0.0)
     with pytest.raises(ValueError, match="horizon"):

@@ -16,8 +16,10 @@ import numpy as np
 import pytest
 
 from acld_gym.design.discrete import discretize
+from acld_gym.design.nominal import nominal_design
 from acld_gym.design.observer import discrete_kalman
-from acld_gym.envs.episode import PARAM_NOISE_MAX, RANDOMIZED, nominal
+from acld_gym.envs.config import PARAM_NOISE_MAX
+from acld_gym.physics.uncertainty import RANDOMIZED
 from baselines.policies import LQRPolicy, MPCPolicy, SMCPolicy
 from baselines.robustness import corner_study, spectral_radius
 
@@ -35,7 +37,7 @@ def _policies(nom):
 
 @pytest.mark.parametrize("mesh", ["converged", "thesis"])
 def test_stable_on_the_stiffness_and_actuator_corners(mesh):
-    nom = nominal(mesh=mesh)
+    nom = nominal_design(mesh=mesh)
     f = float(np.exp(3 * PARAM_NOISE_MAX[mesh]))
     for name, pol in _policies(nom).items():
         g = pol.small_signal_gain()
@@ -50,7 +52,7 @@ def test_stable_on_the_stiffness_and_actuator_corners(mesh):
 
 
 def test_small_signal_gains_are_the_policies_laws_about_rest():
-    nom = nominal()
+    nom = nominal_design()
     x = np.random.default_rng(0).normal(size=(3, nom.design.reduced.order)) * 1e-9
     for name, pol in _policies(nom).items():
         want = -x @ pol.small_signal_gain()
@@ -62,7 +64,7 @@ def test_small_signal_gains_are_the_policies_laws_about_rest():
 def test_load_only_kalman_is_not_robust():
     # Why the Kalman filter has a model-error noise (acld_gym.design.observer.discrete_kalman):
     # driven by the load alone (v0's filter) a 10 % softer beam destabilizes the LQR loop.
-    nom = nominal()
+    nom = nominal_design()
     r, sr = nom.design.reduced, nom.reduced
     fragile = discrete_kalman(sr.Ad, sr.Bd, sr.Ed, r.C, sensor_std=1e-7, model_std=0.0)
     g = LQRPolicy(nom=nom).small_signal_gain()
@@ -74,7 +76,7 @@ def test_load_only_kalman_is_not_robust():
 def test_cheap_control_mpc_is_not_robust():
     # Why the MPC keeps a tiny state weight (baselines.policies.STATE_WEIGHT): without it a
     # 10 % stiffer beam makes its small-signal loop unstable (measured radius 1.023).
-    nom = nominal()
+    nom = nominal_design()
     plant = _plant(nom, beam_youngs_modulus=1.1)
     cheap = MPCPolicy(nom=nom, state_weight=0.0).small_signal_gain()
     assert spectral_radius(plant, nom, cheap) > 1.0
@@ -84,7 +86,7 @@ def test_cheap_control_mpc_is_not_robust():
 @pytest.mark.slow
 @pytest.mark.parametrize("mesh", ["converged", "thesis"])
 def test_stable_at_every_corner_of_the_parameter_box(mesh):
-    nom = nominal(mesh=mesh)
+    nom = nominal_design(mesh=mesh)
     study = corner_study(nom, _policies(nom), PARAM_NOISE_MAX[mesh])
     for name, rec in study.items():
         assert rec["corners"] == 1024 and rec["unstable"] == 0, (name, rec)

@@ -26,12 +26,12 @@ import numpy as np
 import pytest
 import scipy.linalg as sla
 
-import acld_gym.envs.episode as env_module
+import acld_gym.design.nominal as design_module
+from acld_gym.design.nominal import nominal_design
 from acld_gym.design.observer import MODEL_STD
 from acld_gym.design.reduction import modal_form, schur_balanced_truncation
 from acld_gym.envs.beam_env import ACLDBeamEnv
-from acld_gym.envs.episode import nominal
-from acld_gym.envs.legacy import V0_SETTINGS, ACLDBeamEnvV0
+from acld_gym.envs.presets import preset
 from acld_gym.physics.model import parametric_model
 from acld_gym.physics.plant import Plant
 from acld_gym.physics.truth import plant
@@ -95,22 +95,22 @@ def _transforms(mesh: str):
 #: The designs behind the observations: v1 on both meshes and v0 (thesis mesh, Kalman
 #: filter driven by the load alone).
 DESIGNS = {"v1-converged": ("converged", MODEL_STD), "v1-thesis": ("thesis", MODEL_STD),
-           "v0": ("thesis", V0_SETTINGS["_model_std"])}
+           "v0": ("thesis", preset("ACLDBeam-v0").model_std)}
 
 
 @pytest.fixture
 def transformed_nominal(monkeypatch):
-    """nominal() of a transformed plant, with the nominal cache isolated."""
-    original = env_module.nominal_plant
+    """nominal_design() of a transformed plant, with the nominal cache isolated."""
+    original = design_module.truth_plant
 
     def build(mesh: str, T: np.ndarray, model_std: float = MODEL_STD):
-        monkeypatch.setattr(env_module, "nominal_plant",
+        monkeypatch.setattr(design_module, "truth_plant",
                             lambda m, dt: _transformed(original(m, dt), T))
-        nominal.cache_clear()
-        return nominal(mesh=mesh, model_std=model_std)
+        nominal_design.cache_clear()
+        return nominal_design(mesh=mesh, model_std=model_std)
 
     yield build
-    nominal.cache_clear()
+    nominal_design.cache_clear()
 
 
 def test_thesis_mesh_rotations_keep_each_kind_of_dof():
@@ -126,7 +126,7 @@ def test_thesis_mesh_rotations_keep_each_kind_of_dof():
 @pytest.mark.parametrize("which", list(DESIGNS))
 def test_design_is_invariant_under_renumbering_and_rotation(which, transformed_nominal):
     mesh, model_std = DESIGNS[which]
-    ref = nominal(mesh=mesh, model_std=model_std)
+    ref = nominal_design(mesh=mesh, model_std=model_std)
     r0 = ref.design.reduced
     for label, T in _transforms(mesh):
         T2 = sla.block_diag(T, T)
@@ -146,8 +146,8 @@ def test_design_is_invariant_under_renumbering_and_rotation(which, transformed_n
         assert _rel(k1, k0) < 1e-8, label
 
 
-def _episode(seed=0, env_cls=ACLDBeamEnv, **kw):
-    env = env_cls(load_case="random", **kw)
+def _episode(seed=0, **kw):
+    env = ACLDBeamEnv(load_case="random", **kw)
     obs, _ = env.reset(seed=seed)
     rows = [obs]
     rng = np.random.default_rng(5)
@@ -157,25 +157,25 @@ def _episode(seed=0, env_cls=ACLDBeamEnv, **kw):
     return np.array(rows, dtype=np.float64)
 
 
-#: Env classes and keyword arguments of the episodes (v0: the thesis mesh is its own).
-EPISODES = {"v1-converged": (ACLDBeamEnv, {"mesh": "converged"}),
-            "v1-thesis": (ACLDBeamEnv, {"mesh": "thesis"}), "v0": (ACLDBeamEnvV0, {})}
+#: The configurations of the episodes (v0: its preset, the thesis mesh its own).
+EPISODES = {"v1-converged": {"mesh": "converged"}, "v1-thesis": {"mesh": "thesis"},
+            "v0": {"config": preset("ACLDBeam-v0")}}
 
 
 @pytest.mark.parametrize("which", list(EPISODES))
 def test_episode_observations_are_invariant(which, transformed_nominal):
     mesh, model_std = DESIGNS[which]
-    cls, kw = EPISODES[which]
-    ref = _episode(env_cls=cls, **kw)
+    kw = EPISODES[which]
+    ref = _episode(**kw)
     for label, T in _transforms(mesh):
         transformed_nominal(mesh, T, model_std)
-        obs = _episode(env_cls=cls, **kw)
+        obs = _episode(**kw)
         # float32 observations: compare to the float32 resolution of their largest entry
         assert _rel(obs, ref) < max(RTOL, 2 * np.finfo(np.float32).eps), label
 
 
 def test_modal_form_is_the_documented_convention():
-    r = nominal().design.reduced
+    r = nominal_design().design.reduced
     mf = modal_form(r.A, r.B, r.C)
     lam = mf.eigenvalues
     assert np.all(np.diff(np.abs(lam)) > 0)  # ordered by |lambda|
@@ -209,7 +209,7 @@ def test_truncation_refuses_a_split_pair_of_hankel_values():
 
 
 def test_v0_observes_the_canonical_design_of_the_thesis_mesh():
-    v0 = ACLDBeamEnvV0()
+    v0 = ACLDBeamEnv(config=preset("ACLDBeam-v0"))
     v1 = ACLDBeamEnv(mesh="thesis")
     assert v0.nom.basis == "modal" and v0.observation_fingerprint["basis"] == "modal"
     r0, r1 = v0.nom.design.reduced, v1.nom.design.reduced
@@ -218,7 +218,7 @@ def test_v0_observes_the_canonical_design_of_the_thesis_mesh():
     assert np.array_equal(v0.nom.xr_scale, v1.nom.xr_scale)
     # Only the Kalman filter's model-error noise differs (v0: 0, v1: MODEL_STD).
     assert not np.allclose(v0.nom.kalman.Lc, v1.nom.kalman.Lc)
-    assert np.array_equal(v0.nom.kalman.Lc, nominal(mesh="thesis", model_std=0.0).kalman.Lc)
+    assert np.array_equal(v0.nom.kalman.Lc, nominal_design(mesh="thesis", model_std=0.0).kalman.Lc)
 
 
 def test_raw_schur_coordinates_stay_a_library_option_and_differ_from_modal():

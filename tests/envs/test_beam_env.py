@@ -12,8 +12,9 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import acld_gym  # noqa: F401  (registers ACLDBeam-v1 and -v0)
+from acld_gym.design.nominal import nominal_design
 from acld_gym.envs.beam_env import ACLDBeamEnv
-from acld_gym.envs.episode import nominal, random_load
+from acld_gym.physics.loads import random_load
 
 # Warnings we chose: the action box is in volts (+/-120, the design card's choice;
 # train with RescaleAction) and observations are unbounded by nature.
@@ -104,7 +105,7 @@ def test_passive_episode_matches_exact_simulation():
     env = ACLDBeamEnv(load_case=2, sensor_noise=0.0)
     env.reset(seed=0)
     ys = [env.step(np.zeros(1, np.float32))[4]["tip_deflection"] for _ in range(300)]
-    d = nominal().design
+    d = nominal_design().design
     ref = simulate(*d.plant, d.observer("thesis"), d.passive, thesis_load(2), t_end=0.3,
                    v_max=None, dt=1e-3)
     grid = np.isclose(ref.t / 1e-3, np.round(ref.t / 1e-3), atol=1e-6)
@@ -161,6 +162,10 @@ def test_reset_options_select_load_case_and_reject_unknown_keys():
         env.reset(options={"load_case": 7})
     with pytest.raises(ValueError, match="options"):
         env.reset(options={"foo": 1})
+    with pytest.raises(ValueError, match="load"):
+        env.reset(options={"load": 1})
+    with pytest.raises(ValueError, match="not both"):
+        env.reset(options={"load": env.load, "load_case": 1})
 
 
 @pytest.mark.parametrize("mesh, mode, n, order", [
@@ -180,17 +185,27 @@ def test_observation_modes(mesh, mode, n, order):
 
 
 def test_v0_is_the_thesis_configuration_in_the_canonical_basis():
-    from acld_gym.envs.legacy import ACLDBeamEnvV0
+    from acld_gym.envs.config import EnvConfig
+    from acld_gym.envs.presets import preset
 
     with pytest.warns(DeprecationWarning, match="out of date"):
         env = gym.make("ACLDBeam-v0")
+        noisy = gym.make("ACLDBeam-v0", param_noise=0.5).unwrapped
     e = env.unwrapped
-    assert isinstance(e, ACLDBeamEnvV0) and e.mesh == "thesis" and e.nom.basis == "modal"
+    assert type(e) is ACLDBeamEnv and e.mesh == "thesis" and e.nom.basis == "modal"
     assert e.observation_space.shape == (7,) and e.harmonic_modes == (179.0, 1115.0)
     assert e.nom.design.reduced.order == 6 and e.param_noise == 0.0
     assert e.nom.plant.Ad.shape == (38, 38)
-    with pytest.raises(TypeError, match="mesh"):
-        ACLDBeamEnvV0(mesh="converged")
+    # one configuration of the one class: its three settings are ordinary fields
+    assert e.config == preset("ACLDBeam-v0") == EnvConfig(
+        mesh="thesis", harmonic_modes=(179.0, 1115.0), model_std=0.0, param_noise_max=0.5,
+        env_id="ACLDBeam-v0")
+    assert e.observation_fingerprint["env_id"] == "ACLDBeam-v0"
+    assert ACLDBeamEnv(config=preset("ACLDBeam-v0")).observation_fingerprint["env_id"] == \
+        "ACLDBeam-v0"
+    assert noisy.param_noise == 0.5
+    with pytest.raises(ValueError, match="param_noise"):
+        gym.make("ACLDBeam-v1", mesh="thesis", param_noise=0.5)
 
 
 def test_v1_random_loads_aim_at_the_plants_own_modes():
@@ -240,11 +255,11 @@ def test_random_loads_are_bounded_and_seeded():
 def test_param_noise_randomizes_plant_not_observer():
     env = ACLDBeamEnv(param_noise=0.1)
     env.reset(seed=1)
-    ad1 = env._plant.Ad.copy()
+    ad1 = env.episode_plant.Ad.copy()
     env.reset(seed=2)
-    assert not np.allclose(env._plant.Ad, ad1)
-    assert env._obs is env.nom.kalman  # the observer keeps the nominal design
-    assert env._plant is not env.nom.plant
+    assert not np.allclose(env.episode_plant.Ad, ad1)
+    assert env.batch.observer is env.nom.kalman  # the observer keeps the nominal design
+    assert env.episode_plant is not env.nom.plant
 
 
 def test_render_rgb_array():

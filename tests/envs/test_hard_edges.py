@@ -13,7 +13,7 @@ import pytest
 
 import acld_gym  # noqa: F401  (registers the ids)
 from acld_gym.envs.beam_env import ACLDBeamEnv
-from acld_gym.envs.checks import MAX_EPISODE_STEPS
+from acld_gym.envs.config import MAX_EPISODE_STEPS
 from acld_gym.envs.sb3 import SB3VecEnv
 from acld_gym.envs.vector_env import ACLDBeamVectorEnv
 from acld_gym.physics.model import build_model
@@ -80,7 +80,7 @@ def test_randomized_plants_at_the_bound_stay_finite():
 def test_vector_env_terminates_on_non_finite_state():
     venv = ACLDBeamVectorEnv(num_envs=3, load_case=1)
     venv.reset(seed=0)
-    venv._Z[1, 0] = np.nan
+    venv.x[1, 0] = np.nan
     _, _, terminated, _, info = venv.step(np.zeros((3, 1)))
     assert terminated.tolist() == [False, True, False]
     assert info["terminated_by"].tolist() == [None, "non_finite_state", None]
@@ -110,10 +110,10 @@ def test_vector_env_takes_n_or_n_by_1_real_actions_only(action):
     venv.reset(seed=0)
     venv.step(np.zeros(4))
     venv.step(np.zeros((4, 1)))
-    before = venv._Z.copy()
+    before = venv.batch.Z.copy()
     with pytest.raises(ValueError, match="action"):
         venv.step(action)
-    assert np.array_equal(venv._Z, before)
+    assert np.array_equal(venv.batch.Z, before)
 
 
 # --- 7. smaller edges -------------------------------------------------------------

@@ -1,8 +1,10 @@
-"""The compiled step (``acld_gym._stepcore``) against the numpy reference step.
+"""The compiled step (``acld_gym.envs._stepcore.BatchCore``) against the numpy reference step.
 
-``ACLDBeamEnv.step`` runs in C where it can and falls back to ``ACLDBeamEnv._step``
-(numpy) elsewhere; both must give the same episode. The two products sum in
-different orders (BLAS vs a column loop), so states agree to rounding, flags exactly.
+Both run the one batched step (:mod:`acld_gym.envs.batch`) on the same arrays; the single
+env is its N = 1 case. ``ACLDBeamEnv.step`` runs compiled where it can and falls back to
+the numpy step (``BatchStep.advance``) elsewhere; both must give the same episode. The two
+products sum in different orders (BLAS or a column loop vs numpy), so states agree to
+rounding, flags exactly.
 """
 
 import copy
@@ -14,8 +16,9 @@ import sys
 import numpy as np
 import pytest
 
-from acld_gym.envs import beam_env as env_module
+from acld_gym.envs import batch as batch_module
 from acld_gym.envs.beam_env import COMPILED_STEP, ACLDBeamEnv
+from acld_gym.envs.step import INFO_KEYS
 
 needs_core = pytest.mark.skipif(not COMPILED_STEP, reason="ACLD_GYM_PURE_PYTHON=1 was set")
 
@@ -51,11 +54,12 @@ def _assert_same(rows_c, rows_p):
         assert rc == pytest.approx(rp, rel=1e-9, abs=1e-12)
         assert (tec, trc) == (tep, trp)
         assert type(tec) is type(tep) is bool and type(trc) is type(trp) is bool
-        assert ic.keys() == ip.keys()
+        assert list(ic) == list(ip) == list(INFO_KEYS)
         for key in ic:  # rounding relative to the vector's size (xr_true components cancel)
             if key == "terminated_by":
                 assert ic[key] == ip[key]
                 continue
+            assert type(ic[key]) is type(ip[key]), key
             scale = np.abs(ip[key]).max()
             np.testing.assert_allclose(ic[key], ip[key], rtol=1e-9, atol=1e-12 * scale + 1e-15,
                                        err_msg=key)
@@ -123,7 +127,7 @@ def test_pickle_and_deepcopy_continue_identically_in_every_obs_mode(mode, compil
         env.step(np.array([30.0], np.float32))
     for duplicate in (lambda e: pickle.loads(pickle.dumps(e)), copy.deepcopy):
         clone = duplicate(env)
-        assert type(clone._core) is type(env._core) and clone.k == env.k == 10
+        assert (clone.batch.core is None) == (env.batch.core is None) and clone.k == env.k == 10
         for _ in range(20):
             a = np.array([-40.0], np.float32)
             o1, r1, *_ = env.step(a)
@@ -144,55 +148,81 @@ def test_info_arrays_are_not_overwritten_by_later_steps():
     np.testing.assert_array_equal(info["xr_true"], kept)
 
 
-def test_rendering_steps_in_numpy_and_records_history():
+def test_rendering_records_history():
     env = ACLDBeamEnv(load_case=1, render_mode="rgb_array")
     env.reset(seed=0)
-    for _ in range(3):
-        env.step(np.zeros(1, np.float32))
-    assert len(env.history) == 3
+    for v in (0.0, 50.0, -20.0):
+        *_, info = env.step(np.array([v], np.float32))
+    assert len(env.history) == 3 and env.history[-1] == (info["time"], info["tip_deflection"],
+                                                         -20.0)
+
+
+def _core_args(env):
+    b = env.batch
+    return dict(GT=b.GT, Z=b.Z, OUT=b.OUT, k=b.k, noise=b.noise, y_hist=b.y_hist,
+                comp=b.codes.comp, ncomp=b.codes.ncomp, pool=b.codes.pool, times=b.times,
+                **b.layout.core_kwargs(), obs_mode=0, n_obs=7, dt=1e-3, y_ref=1e-3, lam=0.01,
+                v_max=120.0, limit=0.02, y_scale=1e-3, dgemm=None)
 
 
 @needs_core
 @pytest.mark.parametrize("change, match", [
-    (dict(G=np.zeros((59, 67), np.float32)), "G must be"),
-    (dict(z=np.zeros(66)), "inconsistent sizes"),
-    (dict(inputs=np.zeros((1000, 20))), "inputs has the wrong shape"),
-    (dict(tipf=np.zeros(1000)), "tipf must hold"),
+    (dict(GT=np.zeros((59, 67), np.float32)), "GT must be"),
+    (dict(Z=np.zeros((1, 66))), "GT must be"),
+    (dict(noise=np.zeros((2, 1001))), "inconsistent sizes"),
+    (dict(k=np.zeros(1, np.int32)), "k must be"),
     (dict(obs_mode=3), "obs_mode"),
     (dict(n_obs=8), "obs_mode"),
     (dict(n_x=100), "inconsistent sizes"),
     (dict(o_obs=55), "obs_mode"),
-    (dict(i_inputs=10), "inconsistent sizes"),
+    (dict(i_loads=10), "inconsistent sizes"),
     (dict(o_xr=58), "inconsistent sizes"),
-    (dict(z=np.zeros(134)[::2]), "z must be"),
-    (dict(tipf=np.zeros(1001, ">f8")), "tipf must be"),
+    (dict(Z=np.zeros((1, 134))[:, ::2]), "Z must be"),
+    (dict(noise=np.zeros((1, 1001), ">f8")), "noise must be"),
+    (dict(comp=np.zeros((1, 8, 7))), "load arrays"),
+    (dict(ncomp=np.array([9])), "not encoded correctly"),
+    (dict(dgemm=3), "dgemm must be"),
 ])
 def test_core_constructor_rejects_inconsistent_arrays(change, match):
-    from acld_gym.envs._stepcore import StepCore
+    from acld_gym.envs._stepcore import BatchCore
 
     env = ACLDBeamEnv(mesh="thesis")  # the sizes below are the thesis mesh's
     env.reset(seed=0)
-    args = dict(G=env._G, z=env._z, inputs=env._inputs, tipf=env._tipf, y_hist=env.y_hist,
-                **env._layout.core_kwargs(), obs_mode=0, n_obs=7, dt=1e-3, y_ref=1e-3,
-                lam=0.01, v_max=120.0, limit=0.02, y_scale=1e-3)
-    StepCore(**args)  # the env's own arguments are accepted
+    args = _core_args(env)
+    BatchCore(**args)  # the env's own arguments are accepted
     with pytest.raises(ValueError, match=match):
-        StepCore(**{**args, **change})
+        BatchCore(**{**args, **change})
+
+
+@needs_core
+def test_core_rejects_a_load_encoding_that_would_read_out_of_bounds():
+    from acld_gym.envs._stepcore import BatchCore
+
+    env = ACLDBeamEnv(load_case="random")
+    env.reset(seed=0)
+    args = _core_args(env)
+    comp = np.zeros_like(args["comp"])
+    comp[0, 0] = (3, 0.0, 1.0, 2e-3, args["pool"].shape[1] - 1, 2, 0, np.nan)  # one too many
+    with pytest.raises(ValueError, match="not encoded correctly"):
+        BatchCore(**{**args, "comp": comp, "ncomp": np.array([1])})
 
 
 @needs_core
 def test_core_declines_what_it_cannot_step_safely():
-    from acld_gym.envs._stepcore import StepCore
+    from acld_gym.envs._stepcore import BatchCore
 
     a = np.zeros(1, np.float32)
-    bare = StepCore.__new__(StepCore)  # never initialized: no arrays
-    assert bare.step(a) is None
+    bare = BatchCore.__new__(BatchCore)  # never initialized: no arrays
+    assert bare.step_one(a) is None
     with pytest.raises(RuntimeError, match="not initialized"):
         bare.product_seconds(1)
+    with pytest.raises(RuntimeError, match="not initialized"):
+        bare.step(a)
     env = ACLDBeamEnv()
     env.reset(seed=0)
-    env._core.k = -1  # out of the tabulated range: the numpy path decides
-    assert env._core.step(a) is None
+    env.batch.k[0] = env.max_steps  # past the tabulated range: the numpy path decides
+    assert env.batch.core.step_one(a) is None
+    assert env.batch.core.step(np.zeros(2)) is None  # not N actions: Python checks them
 
 
 @needs_core
@@ -200,11 +230,19 @@ def test_product_timer_checks_its_argument_and_leaves_the_state():
     env = ACLDBeamEnv(load_case=2)
     env.reset(seed=0)
     env.step(np.zeros(1, np.float32))
-    z = env._z.copy()
-    assert 0 < env._core.product_seconds(100) < 1e-3
-    np.testing.assert_array_equal(env._z, z)
+    z = env.batch.Z.copy()
+    assert 0 < env.batch.core.product_seconds(100) < 1e-3
+    np.testing.assert_array_equal(env.batch.Z, z)
     with pytest.raises(ValueError, match="n must be a positive integer"):
-        env._core.product_seconds(0)
+        env.batch.core.product_seconds(0)
+
+
+@needs_core
+def test_compiled_info_keys_are_the_schema():
+    env = ACLDBeamEnv()
+    env.reset(seed=0)
+    assert env.batch.core.names() == INFO_KEYS
+    assert list(env.step(np.zeros(1, np.float32))[4]) == list(INFO_KEYS)
 
 
 def test_pure_python_switch_is_read_at_import():
@@ -212,7 +250,7 @@ def test_pure_python_switch_is_read_at_import():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True, env={**os.environ, "ACLD_GYM_PURE_PYTHON": "1"})
     assert out.stdout.strip() == "False"
-    assert env_module.COMPILED_STEP is (env_module.StepCore is not None)
+    assert batch_module.COMPILED_STEP is (batch_module.BatchCore is not None)
 
 
 @pytest.mark.parametrize("compiled", [True, False] if COMPILED_STEP else [False])
@@ -221,7 +259,7 @@ def test_non_finite_state_terminates_and_says_why(compiled):
     env = _env(compiled, load_case=1)
     env.reset(seed=0)
     env.step(np.zeros(1, np.float32))
-    env._z[0] = np.nan  # a plant state gone bad, however it happened
+    env.x[0] = np.nan  # a plant state gone bad, however it happened
     _, reward, terminated, truncated, info = env.step(np.zeros(1, np.float32))
     assert terminated and not truncated and info["terminated_by"] == "non_finite_state"
     env.reset(seed=0)
@@ -240,22 +278,22 @@ def test_bad_actions_are_rejected_and_leave_the_state_intact(compiled, action):
     env = _env(compiled, load_case=2)
     env.reset(seed=3)
     env.step(np.array([10.0], np.float32))
-    before = (env._z.copy(), env.k, env.v, env.np_random.bit_generator.state)
+    before = (env.batch.Z.copy(), env.k, env.v, env.np_random.bit_generator.state)
     with pytest.raises(ValueError, match="action"):
         env.step(action)
-    assert np.array_equal(env._z, before[0]) and (env.k, env.v) == before[1:3]
+    assert np.array_equal(env.batch.Z, before[0]) and (env.k, env.v) == before[1:3]
     assert env.np_random.bit_generator.state == before[3]
 
 
 def test_layout_owns_every_slot():
     # The fused step's layout (acld_gym.envs.step.StepLayout): its slots tile z and G z
-    # exactly, and the env's matrix G has its shape.
+    # exactly, and the batch's matrix G has its shape.
     from acld_gym.envs.step import StepLayout
 
     for mesh in ("thesis", "converged"):
         env = ACLDBeamEnv(mesh=mesh)
-        lay = env._layout
-        assert isinstance(lay, StepLayout) and env._G.shape == (lay.out_size, lay.z_size)
+        lay = env.batch.layout
+        assert isinstance(lay, StepLayout) and env.batch.GT.shape == (lay.z_size, lay.out_size)
         z_slots = [lay.x, lay.xhat, slice(lay.y_meas, lay.y_meas + 1),
                    slice(lay.voltage, lay.voltage + 1), lay.loads,
                    slice(lay.noise, lay.noise + 1)]

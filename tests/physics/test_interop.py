@@ -8,8 +8,8 @@ import control
 import numpy as np
 import pytest
 
+from acld_gym.design.nominal import nominal_design
 from acld_gym.design.reduction import frequency_response, hinf_norm
-from acld_gym.envs.episode import nominal
 from acld_gym.physics.model import build_model
 
 
@@ -22,7 +22,7 @@ def test_beam_model_statespace_dc_gain_is_the_static_deflection():
 
 
 def test_reduced_model_norms_agree_with_our_sweep():
-    d = nominal().design
+    d = nominal_design().design
     red, full = d.reduced.to_statespace(), d.truth.to_statespace()
     assert red.nstates == d.reduced.order and full.nstates == d.truth.n_states
     A, B, _, C = d.plant
@@ -38,6 +38,6 @@ def test_reduced_model_norms_agree_with_our_sweep():
 
 
 def test_step_response_runs_on_the_reduced_model():
-    red = nominal().design.reduced.to_statespace()
+    red = nominal_design().design.reduced.to_statespace()
     resp = control.step_response(red[0, 1], T=np.linspace(0, 0.5, 501))
     assert np.isfinite(resp.outputs).all() and abs(resp.outputs[-1]) > 0

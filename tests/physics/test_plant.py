@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from acld_gym.design.reduction import frequency_response
-from acld_gym.envs.episode import PARAM_NOISE_MAX, randomized_parameters
+from acld_gym.envs.config import PARAM_NOISE_MAX
 from acld_gym.physics import plant_cache as plant_cache
 from acld_gym.physics.convergence import (
     converged_responses,
@@ -28,6 +28,7 @@ from acld_gym.physics.model import build_model, parametric_model
 from acld_gym.physics.params import BeamParameters, Mesh
 from acld_gym.physics.plant import band_of
 from acld_gym.physics.truth import plant
+from acld_gym.physics.uncertainty import randomized_parameters
 
 BAND = band_of(1e-3)  # twice the 1 kHz control's Nyquist frequency, 6283 rad/s
 

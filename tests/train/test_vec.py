@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 import scipy.linalg as sla
 
-from acld_gym.envs.episode import nominal
+from acld_gym.design.nominal import nominal_design
 from baselines.policies import LQRPolicy
 from train.config import load_config
 from train.vec import VecAgentEnv, VoltageMap, lq_potential, make_vec_env
@@ -32,7 +32,7 @@ def test_lq_potential_solves_the_discounted_riccati_equation():
     P = lq_potential(gamma, lam)
     assert np.allclose(P, P.T, rtol=1e-8, atol=1e-10 * np.abs(P).max())
     assert np.linalg.eigvalsh(P).min() > 0  # positive definite (observable output)
-    nom = nominal()
+    nom = nominal_design()
     S = np.diag(nom.xr_scale)
     A = np.sqrt(gamma) * np.linalg.solve(S, nom.reduced.Ad @ S)
     B = np.sqrt(gamma) * np.linalg.solve(S, nom.reduced.Bd)

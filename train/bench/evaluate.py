@@ -26,6 +26,7 @@ import gymnasium as gym
 import numpy as np
 
 import acld_gym  # registers the env ids
+from acld_gym.physics.loads import LOAD_CASES
 from acld_gym.util.atomic import write_text
 
 __all__ = [
@@ -40,8 +41,8 @@ __all__ = [
 ]
 
 DEFAULT_ENV_ID = acld_gym.ENV_ID
-#: Evaluation cases, in table order.
-CASES: tuple = (1, 2, 3, "random")
+#: Evaluation cases, in table order (every named load case).
+CASES: tuple = LOAD_CASES
 
 
 def eval_episodes(random_episodes: int | None = None) -> dict:

@@ -1,0 +1,282 @@
+"""The one step of ACLDBeam: N beams and their observers advanced together.
+
+:class:`BatchStep` holds the state of N envs in one buffer (rows of ``Z``, slots of
+:class:`acld_gym.envs.step.StepLayout`) and advances them all with one product by the
+fused matrix (:func:`acld_gym.envs.step.output_matrix`): the single env is its N = 1 case,
+the vector env its N = num_envs case. :meth:`BatchStep.advance` is the step in numpy (the
+reference); the compiled step (``acld_gym.envs._stepcore.BatchCore``, :attr:`core`) runs the
+same step on the same arrays, with the reward and the termination mirrored from
+:mod:`acld_gym.envs.step`. Both return the same :class:`StepResult`.
+
+Loads: the compiled step evaluates each env's encoded load (:mod:`acld_gym.envs.loadcode`)
+at every step; the numpy step reads the episode's load samples from a table filled at reset
+(:func:`acld_gym.envs.step.load_schedule`, when there is no compiled step), or computes
+them per step. The sensor noise of an episode is tabulated at reset for both.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import NamedTuple
+
+import numpy as np
+
+from acld_gym.design.discrete import SampledSystem
+from acld_gym.envs.checks import check_actions
+from acld_gym.envs.config import EnvConfig
+from acld_gym.envs.loadcode import LoadCodes
+from acld_gym.envs.step import (
+    INFO_KEYS,
+    OBS_HIST,
+    TERMINATED_BY,
+    Y_SCALE,
+    StepLayout,
+    estimate_map,
+    load_schedule,
+    observation_size,
+    output_matrix,
+    rest_output,
+    reward_terms,
+    step_matrix,
+    termination_codes,
+)
+from acld_gym.physics.actuator import V_LIMIT
+from acld_gym.physics.loads import TipLoad
+
+if os.environ.get("ACLD_GYM_PURE_PYTHON") == "1":  # debugging: numpy steps only
+    BatchCore = None
+else:
+    try:
+        from ._stepcore import BatchCore
+    except ImportError:  # built without a C compiler: the numpy reference step serves
+        BatchCore = None
+
+#: Whether the step runs compiled (``acld_gym.envs._stepcore``).
+COMPILED_STEP = BatchCore is not None
+
+__all__ = ["BatchStep", "StepResult", "COMPILED_STEP", "WHY"]
+
+#: ``info["terminated_by"]`` by code, as an object array (index it with the codes).
+WHY = np.array(TERMINATED_BY, dtype=object)
+
+
+def _dgemm():
+    """scipy's BLAS ``dgemm`` as a capsule for the compiled step (None if unavailable)."""
+    try:
+        from scipy.linalg.cython_blas import __pyx_capi__
+    except ImportError:  # pragma: no cover - scipy is a dependency
+        return None
+    return __pyx_capi__.get("dgemm")
+
+
+class StepResult(NamedTuple):
+    """One step of N envs: the observations (N, n_obs) float32, the reward and its two terms
+    (:func:`acld_gym.envs.step.reward_terms`), the termination codes
+    (:data:`acld_gym.envs.step.TERMINATED_BY`), whether the episode's steps are used up, the
+    true tip deflection [m], the tip load [N] at the end of the step and the true reduced
+    state (N, r)."""
+
+    obs: np.ndarray
+    reward: np.ndarray
+    reward_deflection: np.ndarray
+    reward_voltage: np.ndarray
+    code: np.ndarray
+    truncated: np.ndarray
+    y: np.ndarray
+    tip_load: np.ndarray
+    xr: np.ndarray
+
+
+class BatchStep:
+    """The state and the step of N envs of one configuration (module docstring).
+
+    Parameters
+    ----------
+    config : the envs' configuration (:class:`acld_gym.envs.config.EnvConfig`).
+    num_envs : N.
+    steps : steps per episode (``config.max_steps``, or fewer for a vector env's
+        ``max_episode_steps``).
+    compiled : step in C where it was built (:data:`COMPILED_STEP`).
+    """
+
+    def __init__(self, config: EnvConfig, num_envs: int, steps: int, compiled: bool = True):
+        self.config = c = config
+        self.nom = nom = c.nominal()
+        self.num_envs = N = int(num_envs)
+        self.steps = int(steps)
+        self.observer = obs = nom.observer(c.observer)
+        self.est = estimate_map(obs, nom.xr_scale)
+        self.layout = lay = StepLayout(n=nom.plant.Ad.shape[0], k=obs.n,
+                                       r=nom.design.reduced.order, substeps=nom.plant.substeps)
+        self.n_obs = observation_size(nom, c.obs_mode)
+        #: G^T of the nominal plant (shared) and, with per-episode plants, per env (N, nz, m).
+        self.GT = np.ascontiguousarray(self.fused_matrix(nom.plant).T)
+        self.GT_env = np.repeat(self.GT[None], N, axis=0) if c.randomized else None
+        self.Z = np.zeros((N, lay.z_size))
+        self.OUT = np.zeros((N, lay.out_size))
+        self.k = np.zeros(N, dtype=np.int64)
+        self.noise = np.zeros((N, self.steps + 1))
+        self.y_hist = np.zeros((N, OBS_HIST))
+        self.loads: list[TipLoad | None] = [None] * N
+        self.plants: list[SampledSystem] = [nom.plant] * N
+        self.codes = LoadCodes(N)
+        self.times = np.ascontiguousarray(nom.plant.times)
+        self.compiled = bool(compiled and COMPILED_STEP)
+        # The numpy step's load table (without a compiled step): per env (steps, 2 s) samples
+        # and (steps + 1) tip loads.
+        self.tables = None if self.compiled else (
+            np.zeros((N, self.steps, 2 * lay.substeps)), np.zeros((N, self.steps + 1)))
+        self.core = None
+        self._make_core()
+
+    # --- construction ---------------------------------------------------------------------
+    def fused_matrix(self, plant: SampledSystem) -> np.ndarray:
+        """The whole step's matrix G for ``plant`` (the observer keeps the nominal design)."""
+        return output_matrix(step_matrix(plant, self.nom.plant, self.observer), self.layout,
+                             self.nom.output, self.nom.design.reduced.SL, self.est)
+
+    def _make_core(self) -> None:
+        if not self.compiled:
+            self.core = None
+            return
+        c = self.config
+        self._codes_version = self.codes.version
+        self.core = BatchCore(
+            GT=self.GT if self.GT_env is None else self.GT_env, Z=self.Z, OUT=self.OUT, k=self.k,
+            noise=self.noise, y_hist=self.y_hist, comp=self.codes.comp, ncomp=self.codes.ncomp,
+            pool=self.codes.pool, times=self.times, **self.layout.core_kwargs(),
+            obs_mode=("estimate", "measurement", "full").index(c.obs_mode), n_obs=self.n_obs,
+            dt=c.dt, y_ref=c.y_ref, lam=c.lam, v_max=V_LIMIT, limit=c.deflection_limit,
+            y_scale=Y_SCALE, dgemm=_dgemm())
+
+    def __getstate__(self):
+        state = self.__dict__.copy()
+        state["core"] = None  # the compiled core does not pickle; rebuilt over the arrays
+        return state
+
+    def __setstate__(self, state):
+        self.__dict__.update(state)
+        self._make_core()
+
+    # --- episodes -------------------------------------------------------------------------
+    def start_episodes(self, rows, loads, plants, noise: np.ndarray | None = None) -> None:
+        """Start new episodes of the envs ``rows``: at rest, with the tip loads ``loads``,
+        the sampled plants ``plants`` (the nominal one or a randomized one) and the sensor
+        noise ``noise`` (len(rows), steps + 1) [m] (its first value is the first
+        measurement; None: already in :attr:`noise`'s rows)."""
+        rows = np.asarray(rows, dtype=np.intp)
+        lay, nom = self.layout, self.nom
+        for j, i in enumerate(rows.tolist()):
+            load, plant = loads[j], plants[j]
+            self.loads[i] = load
+            if self.compiled:
+                self.codes.set(i, load)
+            else:
+                self.tables[0][i], self.tables[1][i] = load_schedule(nom.plant, load, 0,
+                                                                     self.steps)
+            if self.GT_env is not None:
+                self.GT_env[i] = self.fused_matrix(plant).T if plant is not nom.plant \
+                    else self.GT
+            self.plants[i] = plant
+        if self.compiled and self.codes.version != self._codes_version:
+            self.core.set_loads(self.codes.comp, self.codes.ncomp, self.codes.pool)
+            self._codes_version = self.codes.version
+        if noise is not None:
+            self.noise[rows] = noise
+        w = self.noise[rows, 0]
+        self.Z[rows] = 0.0
+        self.Z[rows, lay.y_meas] = w
+        self.y_hist[rows] = 0.0
+        self.y_hist[rows, -1] = w
+        self.k[rows] = 0
+        self.OUT[rows] = rest_output(lay, self.est, 1.0)[None] * w[:, None]
+
+    # --- the step -------------------------------------------------------------------------
+    def vector_step(self, actions):
+        """Gymnasium's vector 5-tuple of a step of every env with ``actions`` (N,) or (N, 1)
+        [V], ``info`` with the keys of :data:`acld_gym.envs.step.INFO_KEYS` and their masks:
+        compiled if it can, else :meth:`advance`. Bad actions raise ``ValueError`` before
+        anything changes (:func:`acld_gym.envs.checks.check_actions`)."""
+        core = self.core
+        if core is not None:
+            res = core.step(actions)  # None unless finite float32/float64 of the right shape
+            if res is not None:
+                return res
+        requested, v = check_actions(actions, self.num_envs, V_LIMIT, vector=True)
+        if core is not None:  # the checked, clipped voltages step compiled
+            res = core.step(v)
+            res[4]["requested_voltage"] = requested
+            res[4]["clipped"] = requested != v
+            return res
+        r = self.advance(v)
+        values = (r.y, v, requested, requested != v, r.tip_load, self.k * self.config.dt, r.xr,
+                  WHY[r.code], r.reward_deflection, r.reward_voltage)
+        ones = np.ones(self.num_envs, dtype=bool)
+        info = {}
+        for key, val in zip(INFO_KEYS, values, strict=True):
+            info[key] = val
+            info["_" + key] = ones
+        return r.obs, r.reward, r.code != 0, r.truncated, info
+
+    def advance(self, v: np.ndarray, inputs: np.ndarray | None = None) -> StepResult:
+        """The step in numpy (the reference of the compiled one): voltages ``v`` (N,) [V]
+        and, if given, the period's inputs ``[f0, f1, w']`` (N, 2 s + 1) instead of the
+        episode's (a single env past its tabulated episode)."""
+        Z, lay = self.Z, self.layout
+        Z[:, lay.voltage] = v
+        Z[:, lay.inputs] = self._inputs() if inputs is None else inputs
+        if self.GT_env is None:
+            np.matmul(Z, self.GT, out=self.OUT)
+        else:
+            np.matmul(Z[:, None, :], self.GT_env, out=self.OUT[:, None, :])
+        Z[:, lay.state] = self.OUT[:, lay.state]
+        self.k += 1
+        if self.config.obs_mode == "measurement":
+            self.y_hist[:, :-1] = self.y_hist[:, 1:]
+            self.y_hist[:, -1] = self.OUT[:, lay.y_meas]
+        c = self.config
+        y = self.OUT[:, lay.out_y].copy()
+        reward, r_y, r_v = reward_terms(y, v, c.y_ref, c.lam, V_LIMIT)
+        return StepResult(obs=self.observations(), reward=reward, reward_deflection=r_y,
+                          reward_voltage=r_v,
+                          code=termination_codes(y, reward, self.OUT, c.deflection_limit),
+                          truncated=self.k >= self.steps, y=y, tip_load=self.tip_loads(),
+                          xr=self.OUT[:, lay.out_xr].copy())
+
+    def _inputs(self) -> np.ndarray:
+        """``[f0, f1, w']`` of every env's current period (loads from the table, or computed)."""
+        idx, k, s = np.arange(self.num_envs), self.k, self.layout.substeps
+        out = np.empty((self.num_envs, 2 * s + 1))
+        if self.tables is not None:
+            out[:, :-1] = self.tables[0][idx, np.minimum(k, self.steps - 1)]
+        else:
+            for i in range(self.num_envs):
+                out[i, :-1] = load_schedule(self.nom.plant, self.loads[i], int(k[i]),
+                                            int(k[i]) + 1)[0][0]
+        out[:, -1] = self.noise[idx, np.minimum(k + 1, self.steps)]
+        return out
+
+    # --- what the envs read ---------------------------------------------------------------
+    def observations(self, rows=None) -> np.ndarray:
+        """The observations of ``rows`` (default all) from the current state, float32."""
+        rows = slice(None) if rows is None else rows
+        lay, mode = self.layout, self.config.obs_mode
+        if mode == "estimate":
+            out = self.OUT[rows, lay.out_estimate]
+        elif mode == "measurement":
+            out = np.concatenate([self.y_hist[rows] / Y_SCALE,
+                                  self.Z[rows, lay.voltage, None] / V_LIMIT], axis=-1)
+        else:
+            out = self.Z[rows, lay.x]
+        return out.astype(np.float32)
+
+    def tip_loads(self, rows=None) -> np.ndarray:
+        """The tip load [N] of ``rows`` (default all) at their current time ``k dt``."""
+        rows = np.arange(self.num_envs) if rows is None else np.asarray(rows, dtype=np.intp)
+        if self.core is not None:
+            return self.core.tip_loads(rows)
+        k = self.k[rows]
+        if self.tables is not None and np.all(k <= self.steps):
+            return self.tables[1][rows, k]
+        return np.array([float(self.loads[i](k_i * self.config.dt))
+                         for i, k_i in zip(rows.tolist(), k.tolist(), strict=True)])

@@ -1,0 +1,232 @@
+"""The environment's configuration: one frozen :class:`EnvConfig`, validated once, here.
+
+Every env class takes it (:class:`acld_gym.envs.beam_env.ACLDBeamEnv`, the vector env, the
+SB3 adapter), either as ``config=`` or as keyword arguments (:func:`make_config` merges
+them: the keywords replace fields of the config). ``ACLDBeam-v0``, ``ACLDBeam-v1`` and the
+difficulty presets are configurations (:mod:`acld_gym.envs.presets`), not classes.
+
+Each field's unit, range and meaning are in its ``metadata`` (:func:`config_table` prints
+them; the env's docstring has the same table). The ranges are physical or practical limits:
+beyond them a result would be meaningless (a tip sensor with 1 m of noise), overflow (a
+deflection scale of 1e-300 m makes the reward infinite) or exhaust memory (the episode's
+sensor noise is tabulated at reset).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from typing import Any
+
+from acld_gym.design.nominal import SENSOR_NOISE_M
+from acld_gym.design.observer import MODEL_STD
+from acld_gym.envs.step import OBS_HIST
+from acld_gym.physics.actuator import V_LIMIT
+from acld_gym.physics.loads import TipLoad, check_load_case
+from acld_gym.physics.truth import MESHES
+from acld_gym.util.validate import check_choice, check_real
+
+__all__ = ["EnvConfig", "ConfigAttributes", "make_config", "config_table", "check_param_noise",
+           "check_episode_size", "PARAM_NOISE_MAX", "OBS_MODES", "OBSERVERS", "MAX_EPISODE_STEPS",
+           "MAX_TABLE_STEPS", "SENSOR_NOISE_M"]
+
+OBS_MODES = ("estimate", "measurement", "full")
+OBSERVERS = ("kalman", "thesis")
+
+#: Largest accepted ``param_noise`` per mesh (relative std of the log-normal factors,
+#: which are truncated at 3 std). Every drawn plant is a physical beam, hence stable;
+#: within these bounds the nominal Kalman observer with LQR, SMC and MPC also stays
+#: stable on every plant: checked at all 1024 corners of the box of +/-3 std
+#: (tests/baselines/test_robustness.py). At 0.1 on the thesis mesh 512 corners are unstable.
+PARAM_NOISE_MAX = {"converged": 0.1, "thesis": 0.05}
+
+#: Largest episode of a single env, in steps: its sensor noise (and, in the numpy reference
+#: step, its loads) are tabulated at reset, up to about 180 bytes per step.
+MAX_EPISODE_STEPS = 1_000_000
+
+#: Largest number of tabulated env-steps of a vector env (num_envs x steps per episode):
+#: 8 bytes each of sensor noise, 170 more in the numpy reference step (680 MB at the limit).
+MAX_TABLE_STEPS = 4_000_000
+
+
+def _f(default, unit: str, doc: str, low=None, high=None) -> Any:
+    return field(default=default, metadata={"unit": unit, "doc": doc, "low": low, "high": high})
+
+
+@dataclass(frozen=True)
+class EnvConfig:
+    """Everything that defines an ACLDBeam task (units and ranges in each field's
+    ``metadata``; :func:`config_table`). Frozen and validated on construction: a bad value
+    raises ``ValueError`` naming the field and what was expected.
+    :func:`dataclasses.replace` (or :meth:`replace`) validates again.
+    """
+
+    load_case: int | str | TipLoad = _f(
+        1, "-", "1, 2, 3 (thesis ch. 5), 'random' (a new random load per episode) or a "
+                "TipLoad (a custom load, acld_gym.physics.loads)")
+    mesh: str = _f("converged", "-", "truth plant: 'converged' (36 states) or 'thesis' (38)")
+    dt: float = _f(1e-3, "s", "control period of a piezo rig; the plant is built for 2 pi/dt",
+                   1e-4, 1e-2)
+    episode_length: float = _f(1.0, "s", "episode duration, at most MAX_EPISODE_STEPS steps",
+                               1e-4, 1e3)
+    observer: str = _f("kalman", "-", "'kalman' (reduced model, not fed the load) or 'thesis' "
+                                      "(full order, fed the load)")
+    obs_mode: str = _f("estimate", "-", "'estimate', 'measurement' or 'full' (privileged)")
+    sensor_noise: float = _f(SENSOR_NOISE_M, "m", "std of the tip sensor (seeded; 0 for none)",
+                             0.0, 1e-3)
+    y_ref: float = _f(1e-3, "m", "deflection scale of the reward", 1e-9, 1.0)
+    lam: float = _f(0.01, "-", "voltage weight of the reward", 0.0, 1e6)
+    param_noise: float = _f(0.0, "-", "relative std of the per-episode log-normal parameter "
+                                      "factors (truncated at 3 std), at most param_noise_max",
+                            0.0, None)
+    deflection_limit: float = _f(0.02, "m", "termination limit of |tip deflection|", 1e-6, 1.0)
+    harmonic_modes: tuple[float, float] | None = _f(
+        None, "rad/s", "targets of the random loads' harmonics; None: the plant's own first two "
+                       "damped modes")
+    model_std: float = _f(MODEL_STD, "-", "model-error noise of the Kalman filter "
+                                          "(acld_gym.design.observer.discrete_kalman)", 0.0, 1e3)
+    param_noise_max: float | None = _f(
+        None, "-", "bound of param_noise; None: PARAM_NOISE_MAX of the mesh, within which the "
+                   "baselines are certified stable", 0.0, 1.0)
+    env_id: str = _f("ACLDBeam-v1", "-", "the registered id this configuration belongs to "
+                                         "(recorded in the observation fingerprint)")
+
+    def __post_init__(self) -> None:
+        set_ = object.__setattr__
+        set_(self, "load_case", check_load_case(self.load_case))
+        check_choice("mesh", self.mesh, MESHES)
+        check_choice("observer", self.observer, OBSERVERS)
+        check_choice("obs_mode", self.obs_mode, OBS_MODES)
+        for f in dataclasses.fields(self):
+            md = f.metadata
+            if f.type == "float" and md.get("low") is not None:
+                set_(self, f.name, check_real(f.name, getattr(self, f.name), md["low"],
+                                              md["high"], unit=md["unit"]))
+        if self.param_noise_max is not None:
+            set_(self, "param_noise_max", check_real("param_noise_max", self.param_noise_max,
+                                                     0.0, 1.0, low_open=True))
+        set_(self, "param_noise", check_param_noise(self.param_noise, self.mesh,
+                                                    self.param_noise_max))
+        if self.harmonic_modes is not None:
+            modes = self.harmonic_modes
+            if not isinstance(modes, (tuple, list)) or len(modes) != 2:
+                raise ValueError(f"harmonic_modes must be None or two frequencies [rad/s], got "
+                                 f"{modes!r}")
+            set_(self, "harmonic_modes", tuple(
+                check_real("harmonic_modes", w, 0.0, 1e7, low_open=True, unit="rad/s")
+                for w in modes))
+        if not isinstance(self.env_id, str) or not self.env_id:
+            raise ValueError(f"env_id must be a non-empty string, got {self.env_id!r}")
+        check_episode_size(self.episode_length, self.dt)
+
+    # --- derived --------------------------------------------------------------------
+    @property
+    def max_steps(self) -> int:
+        """Steps of an episode, ``round(episode_length / dt)``."""
+        return int(round(self.episode_length / self.dt))
+
+    @property
+    def randomized(self) -> bool:
+        """Whether each episode draws its own plant (the design stays nominal)."""
+        return self.param_noise > 0
+
+    def nominal(self):
+        """The nominal design of this configuration (:func:`acld_gym.design.nominal.
+        nominal_design`, cached)."""
+        from acld_gym.design.nominal import nominal_design
+
+        return nominal_design(self.dt, 10, max(self.sensor_noise, 1e-9), mesh=self.mesh,
+                              model_std=self.model_std)
+
+    def harmonic_targets(self, nom) -> tuple[float, float]:
+        """The random loads' harmonic targets [rad/s]: :attr:`harmonic_modes`, or the first
+        two damped modes of the nominal plant of ``nom``."""
+        if self.harmonic_modes is not None:
+            return self.harmonic_modes
+        return tuple(float(w) for w in nom.modes[:2])
+
+    def replace(self, **changes) -> EnvConfig:
+        """A copy with ``changes`` (validated; ``TypeError`` on an unknown field)."""
+        return make_config(self, **changes)
+
+
+_FIELDS = tuple(f.name for f in dataclasses.fields(EnvConfig))
+
+
+def make_config(config: EnvConfig | None = None, **kwargs) -> EnvConfig:
+    """``config`` (default: :class:`EnvConfig`'s defaults, ``ACLDBeam-v1``) with the fields
+    in ``kwargs`` replaced; ``TypeError`` on a keyword that is no field."""
+    if config is not None and not isinstance(config, EnvConfig):
+        raise TypeError(f"config must be an EnvConfig or None, got {type(config).__name__}")
+    unknown = sorted(set(kwargs) - set(_FIELDS))
+    if unknown:
+        raise TypeError(f"unexpected keyword argument(s) {unknown}; the env takes the fields of "
+                        f"EnvConfig: {', '.join(_FIELDS)}")
+    if config is None:
+        return EnvConfig(**kwargs)
+    return dataclasses.replace(config, **kwargs) if kwargs else config
+
+
+def check_param_noise(value, mesh: str, bound: float | None = None) -> float:
+    """``param_noise`` as a float in [0, bound] (default bound :data:`PARAM_NOISE_MAX` of
+    ``mesh``); ``ValueError`` naming it. The one check of ``param_noise`` (the env's config,
+    the training configs)."""
+    limit = bound if bound is not None else PARAM_NOISE_MAX.get(mesh, 0.0)
+    v = check_real("param_noise", value, 0.0)
+    if v > limit:
+        raise ValueError(f"param_noise must be at most {limit} for mesh={mesh!r} (relative std; "
+                         f"beyond it the nominal observer and baselines are not validated), got "
+                         f"{value!r}")
+    return v
+
+
+def check_episode_size(episode_length: float, dt: float, num_envs: int = 1) -> int:
+    """The episode's step count, ``round(episode_length / dt)``; ``ValueError`` beyond
+    :data:`MAX_EPISODE_STEPS` (or :data:`MAX_TABLE_STEPS` over ``num_envs``)."""
+    steps = int(round(episode_length / dt))
+    if steps < 1:
+        raise ValueError(f"episode_length must be at least dt, got {episode_length!r}")
+    if steps > MAX_EPISODE_STEPS:
+        raise ValueError(f"episode_length / dt = {steps} steps exceeds {MAX_EPISODE_STEPS} "
+                         "(an episode's noise is tabulated at reset, ~350 bytes per step)")
+    if num_envs * steps > MAX_TABLE_STEPS:
+        raise ValueError(f"num_envs x episode steps = {num_envs * steps} exceeds "
+                         f"{MAX_TABLE_STEPS} (the vector env tabulates every sub-env's "
+                         "episode, ~170 bytes per step)")
+    return steps
+
+
+def config_table() -> str:
+    """A Markdown table of :class:`EnvConfig`'s fields: default, unit, range, meaning."""
+    rows = ["| field | default | unit | range | meaning |", "|---|---|---|---|---|"]
+    for f in dataclasses.fields(EnvConfig):
+        md = f.metadata
+        rng = ("" if md.get("low") is None else
+               f"[{md['low']:g}, {'inf' if md['high'] is None else format(md['high'], 'g')}]")
+        rows.append(f"| `{f.name}` | `{f.default!r}` | {md['unit']} | {rng} | {md['doc']} |")
+    return "\n".join(rows)
+
+
+class ConfigAttributes:
+    """The configuration's fields as read-only attributes of an env (``env.dt``,
+    ``env.obs_mode``, ...; ``env.observer_kind`` is ``config.observer``), for code that
+    reads them from an env or through SB3's ``get_attr``."""
+
+    config: EnvConfig
+
+    load_case = property(lambda self: self.config.load_case, doc="The default load case.")
+    mesh = property(lambda self: self.config.mesh)
+    dt = property(lambda self: self.config.dt, doc="Control period [s].")
+    episode_length = property(lambda self: self.config.episode_length, doc="[s]")
+    observer_kind = property(lambda self: self.config.observer)
+    obs_mode = property(lambda self: self.config.obs_mode)
+    sensor_noise = property(lambda self: self.config.sensor_noise, doc="[m]")
+    y_ref = property(lambda self: self.config.y_ref, doc="[m]")
+    lam = property(lambda self: self.config.lam)
+    param_noise = property(lambda self: self.config.param_noise)
+    deflection_limit = property(lambda self: self.config.deflection_limit, doc="[m]")
+    env_id = property(lambda self: self.config.env_id)
+    #: Voltage limit of the action [V] (:data:`acld_gym.physics.actuator.V_LIMIT`).
+    v_max = V_LIMIT
+    #: Measurements in the ``"measurement"`` observation.
+    obs_hist = OBS_HIST

@@ -72,6 +72,11 @@ typedef struct {
     npy_intp N, m, nz, K, P, hist, steps, s;
     int per_env, obs_mode, block_rows;
     npy_intp n_state, i_volt, i_loads, i_noise, o_ymeas, o_y, o_xr, o_obs, n_x, n_xr, n_obs;
+    /* the actuator (acld_gym.envs.step.StepLayout; -1: none): the patch voltage in the
+       output, the command reaching the amplifier, the voltage held over the last period and
+       the amplifier's output this period (slew limit: at most slew_step per period) */
+    npy_intp o_volt, i_cmd, i_held, i_amp;
+    double slew_step;
     double dt, eps, y_ref, lam, v_max, limit, y_scale;
     double last_tip;  /* the single env's tip load at the end of its last step [N] */
 } BatchCore;
@@ -270,6 +275,7 @@ static int outcome(const BatchCore *self, npy_intp i, double v, double *ry, doub
 {
     const double *o = (const double *)PyArray_DATA(self->OUT) + i * self->m;
     const double y = o[self->o_y];
+    if (self->o_volt >= 0) v = o[self->o_volt];  /* the patch voltage at the end of the step */
     const double qy = y / self->y_ref, qv = v / self->v_max;
     *ry = -(qy * qy);
     *rv = -(self->lam * (qv * qv));
@@ -317,6 +323,7 @@ typedef struct {
     double *reward, *ry, *rv, *y, *tip, *xr;
     npy_int8 *code;
     npy_bool *trunc;
+    double *pv;  /* the patch voltage at the end of the step [V] */
 } Results;
 
 static int outcome(const BatchCore *self, npy_intp i, double v, double *ry, double *rv,
@@ -357,6 +364,11 @@ static void advance(BatchCore *self, const double *v, Results *r)
                          r != NULL ? r->tip + i : &self->last_tip);
             z[self->i_noise] = noise[i * (self->steps + 1)
                                      + (kk < self->steps ? kk + 1 : self->steps)];
+            if (self->slew_step > 0) {  /* the amplifier moves towards the command */
+                const double held = z[self->i_held], d = z[self->i_cmd] - held;
+                z[self->i_amp] = held + (d < -self->slew_step ? -self->slew_step
+                                         : (d > self->slew_step ? self->slew_step : d));
+            }
         }
         if (self->per_env) {
             for (npy_intp i = i0; i < i1; i++)
@@ -384,6 +396,7 @@ static void advance(BatchCore *self, const double *v, Results *r)
             r->trunc[i] = k[i] >= self->steps;
             observe(self, i, r->obs + i * self->n_obs);
             r->y[i] = o[self->o_y];
+            r->pv[i] = self->o_volt >= 0 ? o[self->o_volt] : v[i];
             memcpy(r->xr + i * self->n_xr, o + self->o_xr, (size_t)self->n_xr * sizeof(double));
         }
     }
@@ -459,17 +472,20 @@ core_init(BatchCore *self, PyObject *args, PyObject *kwds)
 {
     static char *kwlist[] = {"GT", "Z", "OUT", "k", "noise", "y_hist", "comp", "ncomp", "pool",
                              "times", "n_state", "i_voltage", "i_loads", "i_noise", "o_ymeas",
-                             "o_y", "o_xr", "o_obs", "n_x", "n_xr", "obs_mode", "n_obs", "dt",
-                             "y_ref", "lam", "v_max", "limit", "y_scale", "dgemm", NULL};
+                             "o_y", "o_xr", "o_obs", "n_x", "n_xr", "o_volt", "i_cmd", "i_held",
+                             "i_amp", "obs_mode", "n_obs", "dt", "y_ref", "lam", "v_max",
+                             "limit", "y_scale", "slew_step", "dgemm", NULL};
     PyObject *GT, *Z, *OUT, *k, *noise, *y_hist, *comp, *ncomp, *pool, *times, *cap = Py_None;
     Py_ssize_t n_state, i_volt, i_loads, i_noise, o_ymeas, o_y, o_xr, o_obs, n_x, n_xr, n_obs;
+    Py_ssize_t o_volt, i_cmd, i_held, i_amp;
     int obs_mode;
-    double dt, y_ref, lam, v_max, limit, y_scale;
-    if (!PyArg_ParseTupleAndKeywords(args, kwds, "$OOOOOOOOOOnnnnnnnnnninddddddO", kwlist,
+    double dt, y_ref, lam, v_max, limit, y_scale, slew_step;
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "$OOOOOOOOOOnnnnnnnnnnnnnnindddddddO", kwlist,
                                      &GT, &Z, &OUT, &k, &noise, &y_hist, &comp, &ncomp, &pool,
                                      &times, &n_state, &i_volt, &i_loads, &i_noise, &o_ymeas,
-                                     &o_y, &o_xr, &o_obs, &n_x, &n_xr, &obs_mode, &n_obs, &dt,
-                                     &y_ref, &lam, &v_max, &limit, &y_scale, &cap))
+                                     &o_y, &o_xr, &o_obs, &n_x, &n_xr, &o_volt, &i_cmd, &i_held,
+                                     &i_amp, &obs_mode, &n_obs, &dt, &y_ref, &lam, &v_max,
+                                     &limit, &y_scale, &slew_step, &cap))
         return -1;
     if (check_array(Z, "Z", 2, NPY_DOUBLE) || check_array(OUT, "OUT", 2, NPY_DOUBLE)
         || check_array(k, "k", 1, NPY_INT64) || check_array(noise, "noise", 2, NPY_DOUBLE)
@@ -497,7 +513,10 @@ core_init(BatchCore *self, PyObject *args, PyObject *kwds)
         || n_state > m || i_volt < n_state || i_loads <= i_volt || i_loads + 2 * s > i_noise
         || i_noise >= nz || n_xr < 0 || o_ymeas < 0 || o_ymeas >= m || o_y < 0 || o_y >= m
         || o_xr < 0 || o_xr + n_xr > m || o_obs < 0 || o_obs > m || m > INT32_MAX
-        || nz > INT32_MAX || N > INT32_MAX) {
+        || nz > INT32_MAX || N > INT32_MAX || o_volt < -1 || o_volt >= n_state
+        || i_cmd < 0 || i_cmd >= nz || i_held < -1 || i_held >= n_state
+        || i_amp < -1 || i_amp >= nz || !(slew_step >= 0)
+        || (slew_step > 0 && (i_held < 0 || i_amp <= i_noise))) {
         PyErr_SetString(PyExc_ValueError, "BatchCore: inconsistent sizes of the arrays and the layout");
         return -1;
     }
@@ -541,6 +560,8 @@ core_init(BatchCore *self, PyObject *args, PyObject *kwds)
     self->n_state = n_state; self->i_volt = i_volt; self->i_loads = i_loads;
     self->i_noise = i_noise; self->o_ymeas = o_ymeas; self->o_y = o_y; self->o_xr = o_xr;
     self->o_obs = o_obs; self->n_x = n_x; self->n_xr = n_xr; self->n_obs = n_obs;
+    self->o_volt = o_volt; self->i_cmd = i_cmd; self->i_held = i_held; self->i_amp = i_amp;
+    self->slew_step = slew_step;
     self->dt = dt; self->eps = 1e-9 * dt; self->y_ref = y_ref; self->lam = lam;
     self->v_max = v_max; self->limit = limit; self->y_scale = y_scale;
     return 0;
@@ -609,7 +630,8 @@ core_step_one(BatchCore *self, PyObject *action)
     memcpy(PyArray_DATA((PyArrayObject *)xr), o + self->o_xr, (size_t)self->n_xr * sizeof(double));
     PyObject *why = code == END_NONFINITE ? s_nonfinite : (code == END_LIMIT ? s_limit : Py_None);
     Py_INCREF(why);
-    PyObject *vals[N_INFO] = {PyFloat_FromDouble(o[self->o_y]), PyFloat_FromDouble(v),
+    PyObject *vals[N_INFO] = {PyFloat_FromDouble(o[self->o_y]),
+                              PyFloat_FromDouble(self->o_volt >= 0 ? o[self->o_volt] : v),
                               PyFloat_FromDouble(requested), PyBool_FromLong(requested != v),
                               PyFloat_FromDouble(self->last_tip),
                               PyFloat_FromDouble((double)kk * self->dt), xr, why,
@@ -664,10 +686,10 @@ core_step(BatchCore *self, PyObject *action)
        path must check the actions (it then steps with their clipped values as float64) */
     if (!ready(self)) return NULL;
     npy_intp N = self->N, d_obs[2] = {N, self->n_obs}, d_xr[2] = {N, self->n_xr};
-    enum { OBS, REW, TERM, TRUNC, Y, V, REQ, CLIP, TIP, TIME, XR, WHYA, RY, RV, ONES, NA };
+    enum { OBS, REW, TERM, TRUNC, Y, V, REQ, CLIP, TIP, TIME, XR, WHYA, RY, RV, ONES, PV, NA };
     const int types[NA] = {NPY_FLOAT32, NPY_DOUBLE, NPY_BOOL, NPY_BOOL, NPY_DOUBLE, NPY_DOUBLE,
                            NPY_DOUBLE, NPY_BOOL, NPY_DOUBLE, NPY_DOUBLE, NPY_DOUBLE, NPY_OBJECT,
-                           NPY_DOUBLE, NPY_DOUBLE, NPY_BOOL};
+                           NPY_DOUBLE, NPY_DOUBLE, NPY_BOOL, NPY_DOUBLE};
     PyObject *arr[NA] = {NULL};
     for (int j = 0; j < NA; j++) {
         arr[j] = j == OBS ? PyArray_SimpleNew(2, d_obs, types[j])
@@ -683,7 +705,7 @@ core_step(BatchCore *self, PyObject *action)
     npy_int8 *code = PyMem_Malloc((size_t)N);
     if (code == NULL) { PyErr_NoMemory(); goto fail; }
     Results r = {(float *)PyArray_DATA((PyArrayObject *)arr[OBS]), D(REW), D(RY), D(RV), D(Y),
-                 D(TIP), D(XR), code, B(TRUNC)};
+                 D(TIP), D(XR), code, B(TRUNC), D(PV)};
     advance(self, D(V), &r);
     PyObject **why = PyArray_DATA((PyArrayObject *)arr[WHYA]);
     const npy_int64 *k = PyArray_DATA(self->k);
@@ -703,7 +725,7 @@ core_step(BatchCore *self, PyObject *action)
                               k_rv};
     PyObject *mask_keys[N_INFO] = {m_tip, m_volt, m_req, m_clip, m_load, m_time, m_xr, m_term,
                                    m_ry, m_rv};
-    const int vals[N_INFO] = {Y, V, REQ, CLIP, TIP, TIME, XR, WHYA, RY, RV};
+    const int vals[N_INFO] = {Y, PV, REQ, CLIP, TIP, TIME, XR, WHYA, RY, RV};
     for (int j = 0; j < N_INFO; j++) {
         if (PyDict_SetItem(info, keys[j], arr[vals[j]]) < 0
             || PyDict_SetItem(info, mask_keys[j], arr[ONES]) < 0) {

@@ -24,6 +24,7 @@ import numpy as np
 from acld_gym.design.discrete import SampledSystem
 from acld_gym.envs.checks import check_actions
 from acld_gym.envs.config import EnvConfig
+from acld_gym.envs.episode import fixed_plant
 from acld_gym.envs.loadcode import LoadCodes
 from acld_gym.envs.step import (
     INFO_KEYS,
@@ -37,7 +38,6 @@ from acld_gym.envs.step import (
     output_matrix,
     rest_output,
     reward_terms,
-    step_matrix,
     termination_codes,
 )
 from acld_gym.physics.actuator import V_LIMIT
@@ -73,8 +73,8 @@ class StepResult(NamedTuple):
     """One step of N envs: the observations (N, n_obs) float32, the reward and its two terms
     (:func:`acld_gym.envs.step.reward_terms`), the termination codes
     (:data:`acld_gym.envs.step.TERMINATED_BY`), whether the episode's steps are used up, the
-    true tip deflection [m], the tip load [N] at the end of the step and the true reduced
-    state (N, r)."""
+    true tip deflection [m], the patch voltage [V] and the tip load [N] at the end of the
+    step and the true reduced state (N, r)."""
 
     obs: np.ndarray
     reward: np.ndarray
@@ -83,6 +83,7 @@ class StepResult(NamedTuple):
     code: np.ndarray
     truncated: np.ndarray
     y: np.ndarray
+    voltage: np.ndarray
     tip_load: np.ndarray
     xr: np.ndarray
 
@@ -107,10 +108,16 @@ class BatchStep:
         self.observer = obs = nom.observer(c.observer)
         self.est = estimate_map(obs, nom.xr_scale)
         self.layout = lay = StepLayout(n=nom.plant.Ad.shape[0], k=obs.n,
-                                       r=nom.design.reduced.order, substeps=nom.plant.substeps)
+                                       r=nom.design.reduced.order, substeps=nom.plant.substeps,
+                                       delay=c.actuator_delay,
+                                       lag=c.amplifier_bandwidth is not None,
+                                       slew=c.slew_rate is not None)
         self.n_obs = observation_size(nom, c.obs_mode)
-        #: G^T of the nominal plant (shared) and, with per-episode plants, per env (N, nz, m).
-        self.GT = np.ascontiguousarray(self.fused_matrix(nom.plant).T)
+        #: The configuration's plant (the nominal one, shifted to its temperature, with its
+        #: amplifier); an episode's own when drawn (param_noise, temperature_range).
+        self.base_plant = fixed_plant(nom, c)
+        #: G^T of the base plant (shared) and, with per-episode plants, per env (N, nz, m).
+        self.GT = np.ascontiguousarray(self.fused_matrix(self.base_plant).T)
         self.GT_env = np.repeat(self.GT[None], N, axis=0) if c.randomized else None
         self.Z = np.zeros((N, lay.z_size))
         self.OUT = np.zeros((N, lay.out_size))
@@ -118,7 +125,7 @@ class BatchStep:
         self.noise = np.zeros((N, self.steps + 1))
         self.y_hist = np.zeros((N, OBS_HIST))
         self.loads: list[TipLoad | None] = [None] * N
-        self.plants: list[SampledSystem] = [nom.plant] * N
+        self.plants: list[SampledSystem] = [self.base_plant] * N
         self.codes = LoadCodes(N)
         self.times = np.ascontiguousarray(nom.plant.times)
         self.compiled = bool(compiled and COMPILED_STEP)
@@ -132,8 +139,8 @@ class BatchStep:
     # --- construction ---------------------------------------------------------------------
     def fused_matrix(self, plant: SampledSystem) -> np.ndarray:
         """The whole step's matrix G for ``plant`` (the observer keeps the nominal design)."""
-        return output_matrix(step_matrix(plant, self.nom.plant, self.observer), self.layout,
-                             self.nom.output, self.nom.design.reduced.SL, self.est)
+        return output_matrix(plant, self.nom.plant, self.observer, self.layout, self.nom.output,
+                             self.nom.design.reduced.SL, self.est)
 
     def _make_core(self) -> None:
         if not self.compiled:
@@ -147,7 +154,7 @@ class BatchStep:
             pool=self.codes.pool, times=self.times, **self.layout.core_kwargs(),
             obs_mode=("estimate", "measurement", "full").index(c.obs_mode), n_obs=self.n_obs,
             dt=c.dt, y_ref=c.y_ref, lam=c.lam, v_max=V_LIMIT, limit=c.deflection_limit,
-            y_scale=Y_SCALE, dgemm=_dgemm())
+            y_scale=Y_SCALE, slew_step=c.slew_step or 0.0, dgemm=_dgemm())
 
     def __getstate__(self):
         state = self.__dict__.copy()
@@ -161,13 +168,14 @@ class BatchStep:
     # --- episodes -------------------------------------------------------------------------
     def start_episodes(self, rows, loads, plants, noise: np.ndarray | None = None) -> None:
         """Start new episodes of the envs ``rows``: at rest, with the tip loads ``loads``,
-        the sampled plants ``plants`` (the nominal one or a randomized one) and the sensor
+        the sampled plants ``plants`` (None: :attr:`base_plant`; else drawn) and the sensor
         noise ``noise`` (len(rows), steps + 1) [m] (its first value is the first
         measurement; None: already in :attr:`noise`'s rows)."""
         rows = np.asarray(rows, dtype=np.intp)
         lay, nom = self.layout, self.nom
         for j, i in enumerate(rows.tolist()):
             load, plant = loads[j], plants[j]
+            plant = self.base_plant if plant is None else plant
             self.loads[i] = load
             if self.compiled:
                 self.codes.set(i, load)
@@ -175,7 +183,7 @@ class BatchStep:
                 self.tables[0][i], self.tables[1][i] = load_schedule(nom.plant, load, 0,
                                                                      self.steps)
             if self.GT_env is not None:
-                self.GT_env[i] = self.fused_matrix(plant).T if plant is not nom.plant \
+                self.GT_env[i] = self.fused_matrix(plant).T if plant is not self.base_plant \
                     else self.GT
             self.plants[i] = plant
         if self.compiled and self.codes.version != self._codes_version:
@@ -209,7 +217,8 @@ class BatchStep:
             res[4]["clipped"] = requested != v
             return res
         r = self.advance(v)
-        values = (r.y, v, requested, requested != v, r.tip_load, self.k * self.config.dt, r.xr,
+        values = (r.y, r.voltage, requested, requested != v, r.tip_load, self.k * self.config.dt,
+                  r.xr,
                   WHY[r.code], r.reward_deflection, r.reward_voltage)
         ones = np.ones(self.num_envs, dtype=bool)
         info = {}
@@ -222,9 +231,13 @@ class BatchStep:
         """The step in numpy (the reference of the compiled one): voltages ``v`` (N,) [V]
         and, if given, the period's inputs ``[f0, f1, w']`` (N, 2 s + 1) instead of the
         episode's (a single env past its tabulated episode)."""
-        Z, lay = self.Z, self.layout
+        Z, lay, c = self.Z, self.layout, self.config
         Z[:, lay.voltage] = v
         Z[:, lay.inputs] = self._inputs() if inputs is None else inputs
+        if lay.slew:  # the amplifier moves from its last output towards the command, at most
+            held = Z[:, lay.held]  # slew_step per period
+            Z[:, lay.amplifier] = held + np.clip(Z[:, lay.command] - held, -c.slew_step,
+                                                 c.slew_step)
         if self.GT_env is None:
             np.matmul(Z, self.GT, out=self.OUT)
         else:
@@ -234,14 +247,14 @@ class BatchStep:
         if self.config.obs_mode == "measurement":
             self.y_hist[:, :-1] = self.y_hist[:, 1:]
             self.y_hist[:, -1] = self.OUT[:, lay.y_meas]
-        c = self.config
         y = self.OUT[:, lay.out_y].copy()
-        reward, r_y, r_v = reward_terms(y, v, c.y_ref, c.lam, V_LIMIT)
+        volts = v if lay.out_voltage is None else self.OUT[:, lay.out_voltage].copy()
+        reward, r_y, r_v = reward_terms(y, volts, c.y_ref, c.lam, V_LIMIT)
         return StepResult(obs=self.observations(), reward=reward, reward_deflection=r_y,
                           reward_voltage=r_v,
                           code=termination_codes(y, reward, self.OUT, c.deflection_limit),
-                          truncated=self.k >= self.steps, y=y, tip_load=self.tip_loads(),
-                          xr=self.OUT[:, lay.out_xr].copy())
+                          truncated=self.k >= self.steps, y=y, voltage=volts,
+                          tip_load=self.tip_loads(), xr=self.OUT[:, lay.out_xr].copy())
 
     def _inputs(self) -> np.ndarray:
         """``[f0, f1, w']`` of every env's current period (loads from the table, or computed)."""

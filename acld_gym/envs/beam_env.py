@@ -65,10 +65,14 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
 
     ## Action Space
 
-    ``Box(-120, 120, (1,), float32)``: piezo voltage [V], held for one period.
+    ``Box(-120, 120, (1,), float32)``: the commanded piezo voltage [V], held for one period.
     Out-of-range actions are clipped to +/-120 V and reported in
     ``info["clipped"]``; NaN or inf raise ``ValueError`` and leave the state
-    untouched. (Train with ``gymnasium.wrappers.RescaleAction`` for [-1, 1].)
+    untouched. (Train with ``gymnasium.wrappers.RescaleAction`` for [-1, 1].) By default
+    the command is the patch voltage; with the actuator options it reaches the patch
+    ``actuator_delay`` periods later, through an amplifier that moves at most
+    ``slew_rate`` and lags with ``amplifier_bandwidth`` (``info["voltage"]`` is the patch
+    voltage at the end of the step, ``info["requested_voltage"]`` the action).
 
     ## Observation Space
 
@@ -93,8 +97,9 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
     ## Rewards
 
     ``r = -(y / y_ref)^2 - lam * (V / 120)^2`` per step, with ``y`` the true
-    tip deflection [m] at the end of the step and ``V`` the applied voltage. The two
-    terms are ``info["reward_deflection"]`` and ``info["reward_voltage"]``.
+    tip deflection [m] at the end of the step and ``V`` the patch voltage at the end of
+    the step (``info["voltage"]``: the clipped action unless the actuator options are set).
+    The two terms are ``info["reward_deflection"]`` and ``info["reward_voltage"]``.
 
     ## Starting State
 
@@ -144,7 +149,26 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
     | ``model_std`` | 0.1 | model-error noise of the Kalman filter (relative) |
     | ``param_noise_max`` | None | bound of ``param_noise``; None: 0.1 (``"converged"``) |
     | | | or 0.05 (``"thesis"``), within which the baselines are certified stable |
+    | ``actuator_delay`` | 0 | latency from the action to the amplifier [control periods], |
+    | | | in [0, 100]: the command of step k drives the patch in step k + delay |
+    | ``amplifier_bandwidth`` | None | [Hz] in [1, 1e6]: a first-order lag from the |
+    | | | amplifier's input to the patch voltage, sampled exactly (in the fused matrix; the |
+    | | | patch voltage becomes a plant state); None: ideal |
+    | ``slew_rate`` | None | [V/s] in [1, 1e9]: the amplifier's output moves at most |
+    | | | ``slew_rate * dt`` per period (its current limit on the patch's 22.7 nF, |
+    | | | ``acld_gym.physics.actuator``; a +/-150 V bender driver, 95 mA: 4.2e6 V/s); None |
+    | ``temperature`` | 20 | viscoelastic layer [°C] in [16.5, 40]: its GHM modulus follows |
+    | | | time-temperature superposition (WLF, ``acld_gym.physics.temperature``); 20 °C is |
+    | | | where the thesis's GHM parameters hold, so the default plant is v1's |
+    | ``temperature_range`` | None | (low, high) [°C]: a temperature per episode, uniform |
     | ``env_id`` | ``"ACLDBeam-v1"`` | the registered id of the configuration (fingerprint) |
+
+    The actuator chain, per period: the action is clipped (the command, which the
+    observer and the ``"measurement"`` observation see), waits ``actuator_delay`` periods,
+    drives the amplifier, whose output moves towards it by at most ``slew_rate * dt`` and
+    is held over the period (zero-order hold), and reaches the patch through the lag. The
+    design model, the observer and the baselines stay nominal: they know none of these
+    options, nor the temperature (model mismatch, like ``param_noise``).
 
     Load case 3 is the thesis's resonant harmonic, 0.1 sin(179 t) N for 5.5 cycles,
     on every mesh: the thesis tuned it to its model's first resonance (178.6 rad/s);
@@ -163,8 +187,10 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
       (``model_std`` 0.1), so the baselines stay stable on every randomized plant;
       ``param_noise`` is bounded (0.1; 0.05 on the thesis mesh) and its factors
       truncated at 3 std. Since acld-gym 0.3.0 the info also has ``requested_voltage``
-      and the reward's terms in the vector env too, and custom loads (``TipLoad``) are
-      accepted; the dynamics, rewards and observations are unchanged.
+      and the reward's terms in the vector env too, custom loads (``TipLoad``) are
+      accepted, and the actuator (``actuator_delay``, ``amplifier_bandwidth``,
+      ``slew_rate``) and temperature (``temperature``, ``temperature_range``) options
+      exist, all off by default: v1's dynamics, rewards and observations are unchanged.
     * v0: the thesis configuration (``acld_gym.envs.presets.PRESETS["ACLDBeam-v0"]``):
       the thesis's 38-state mesh, its 6-state design model and observers, the same
       dynamics, reward, spaces and episode. It differs from v1 with ``mesh="thesis"`` in
@@ -200,8 +226,7 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
         self._fig = None
         self.history: list[tuple[float, float, float]] = []
         self.load = case_load(self.config.load_case) or thesis_load(1)
-        self._batch.start_episodes([0], [self.load], [self.nom.plant],
-                                   np.zeros((1, self.max_steps + 1)))
+        self._batch.start_episodes([0], [self.load], [None], np.zeros((1, self.max_steps + 1)))
         self._started = False
         self._fast = _not_reset  # the compiled step after reset(); None where it declines
 
@@ -255,8 +280,7 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
         case = reset_options(options, self.config.load_case)  # validated before seeding:
         super().reset(seed=check_seed(seed))  # a rejected reset leaves the RNG as it was
         c = self.config
-        load, plant = draw_episode(self.np_random, case, self.nom, c.episode_length,
-                                   c.param_noise, self.harmonic_modes)
+        load, plant = draw_episode(self.np_random, case, self.nom, c, self.harmonic_modes)
         noise = (draw_noise(self.np_random, c.sensor_noise, self.max_steps + 1)
                  if c.sensor_noise else np.zeros(self.max_steps + 1))
         if self._batch.compiled != (self.compiled_step and COMPILED_STEP):
@@ -298,7 +322,7 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
             f = load_schedule(self.nom.plant, self.load, k, k + 1)[0]
             w = self.np_random.normal(0.0, self.sensor_noise) if self.sensor_noise else 0.0
             inputs = np.append(f[0], w)[None]
-        return _single(b.advance(v, inputs), float(v[0]), float(requested[0]), k + 1, self.dt)
+        return _single(b.advance(v, inputs), float(requested[0]), float(v[0]), k + 1, self.dt)
 
     def render(self):
         if self.render_mode is None:
@@ -318,10 +342,11 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
         self._close_figure()
 
 
-def _single(res: StepResult, v: float, requested: float, k: int, dt: float):
+def _single(res: StepResult, requested: float, command: float, k: int, dt: float):
     """Gymnasium's 5-tuple of env 0 of a batch step (as the compiled ``step_one`` gives it)."""
     code = int(res.code[0])
-    values = (float(res.y[0]), v, requested, requested != v, float(res.tip_load[0]), k * dt,
+    values = (float(res.y[0]), float(res.voltage[0]), requested, requested != command,
+              float(res.tip_load[0]), k * dt,
               res.xr[0], TERMINATED_BY[code], float(res.reward_deflection[0]),
               float(res.reward_voltage[0]))
     info: dict[str, Any] = dict(zip(INFO_KEYS, values, strict=True))

@@ -23,8 +23,9 @@ from acld_gym.design.observer import MODEL_STD
 from acld_gym.envs.step import OBS_HIST
 from acld_gym.physics.actuator import V_LIMIT
 from acld_gym.physics.loads import TipLoad, check_load_case
+from acld_gym.physics.temperature import T_REF, TEMPERATURE_RANGE, check_temperature
 from acld_gym.physics.truth import MESHES
-from acld_gym.util.validate import check_choice, check_real
+from acld_gym.util.validate import check_choice, check_int, check_real
 
 __all__ = ["EnvConfig", "ConfigAttributes", "make_config", "config_table", "check_param_noise",
            "check_episode_size", "PARAM_NOISE_MAX", "OBS_MODES", "OBSERVERS", "MAX_EPISODE_STEPS",
@@ -39,6 +40,9 @@ OBSERVERS = ("kalman", "thesis")
 #: stable on every plant: checked at all 1024 corners of the box of +/-3 std
 #: (tests/baselines/test_robustness.py). At 0.1 on the thesis mesh 512 corners are unstable.
 PARAM_NOISE_MAX = {"converged": 0.1, "thesis": 0.05}
+
+#: Largest actuator delay [control periods].
+MAX_DELAY = 100
 
 #: Largest episode of a single env, in steps: its sensor noise (and, in the numpy reference
 #: step, its loads) are tabulated at reset, up to about 180 bytes per step.
@@ -88,6 +92,23 @@ class EnvConfig:
     param_noise_max: float | None = _f(
         None, "-", "bound of param_noise; None: PARAM_NOISE_MAX of the mesh, within which the "
                    "baselines are certified stable", 0.0, 1.0)
+    actuator_delay: int = _f(
+        0, "periods", "latency from the action to the amplifier, in whole control periods "
+                      "(computation and conversion delay)", 0, MAX_DELAY)
+    amplifier_bandwidth: float | None = _f(
+        None, "Hz", "small-signal bandwidth of the amplifier: a first-order lag from the "
+                    "command to the patch voltage, sampled exactly; None: ideal", 1.0, 1e6)
+    slew_rate: float | None = _f(
+        None, "V/s", "largest rate of change of the amplifier's output (its current limit on "
+                     "the patch's capacitance, acld_gym.physics.actuator); None: unlimited",
+        1.0, 1e9)
+    temperature: float = _f(
+        T_REF, "°C", "temperature of the viscoelastic layer (time-temperature superposition, "
+                     "acld_gym.physics.temperature); 20 °C: the thesis's GHM parameters",
+        *TEMPERATURE_RANGE)
+    temperature_range: tuple[float, float] | None = _f(
+        None, "°C", "draw the temperature per episode, uniform in (low, high); None: "
+                    "always temperature")
     env_id: str = _f("ACLDBeam-v1", "-", "the registered id this configuration belongs to "
                                          "(recorded in the observation fingerprint)")
 
@@ -99,7 +120,7 @@ class EnvConfig:
         check_choice("obs_mode", self.obs_mode, OBS_MODES)
         for f in dataclasses.fields(self):
             md = f.metadata
-            if f.type == "float" and md.get("low") is not None:
+            if f.type == "float" and md.get("low") is not None:  # incl. temperature
                 set_(self, f.name, check_real(f.name, getattr(self, f.name), md["low"],
                                               md["high"], unit=md["unit"]))
         if self.param_noise_max is not None:
@@ -115,6 +136,21 @@ class EnvConfig:
             set_(self, "harmonic_modes", tuple(
                 check_real("harmonic_modes", w, 0.0, 1e7, low_open=True, unit="rad/s")
                 for w in modes))
+        set_(self, "actuator_delay", check_int("actuator_delay", self.actuator_delay, 0,
+                                               MAX_DELAY))
+        for name in ("amplifier_bandwidth", "slew_rate"):
+            value, md = getattr(self, name), self.__dataclass_fields__[name].metadata
+            if value is not None:
+                set_(self, name, check_real(name, value, md["low"], md["high"], unit=md["unit"]))
+        if self.temperature_range is not None:
+            rng = self.temperature_range
+            if not isinstance(rng, (tuple, list)) or len(rng) != 2:
+                raise ValueError(f"temperature_range must be None or (low, high) [°C], got "
+                                 f"{rng!r}")
+            lo, hi = (check_temperature("temperature_range", t) for t in rng)
+            if not lo < hi:
+                raise ValueError(f"temperature_range must have low < high [°C], got {rng!r}")
+            set_(self, "temperature_range", (lo, hi))
         if not isinstance(self.env_id, str) or not self.env_id:
             raise ValueError(f"env_id must be a non-empty string, got {self.env_id!r}")
         check_episode_size(self.episode_length, self.dt)
@@ -128,7 +164,12 @@ class EnvConfig:
     @property
     def randomized(self) -> bool:
         """Whether each episode draws its own plant (the design stays nominal)."""
-        return self.param_noise > 0
+        return self.param_noise > 0 or self.temperature_range is not None
+
+    @property
+    def slew_step(self) -> float | None:
+        """The largest change of the amplifier's output per control period [V]."""
+        return None if self.slew_rate is None else self.slew_rate * self.dt
 
     def nominal(self):
         """The nominal design of this configuration (:func:`acld_gym.design.nominal.

@@ -9,10 +9,13 @@ import numpy as np
 
 from acld_gym.design.discrete import SampledSystem, discretize
 from acld_gym.design.nominal import NominalDesign
+from acld_gym.physics.actuator import with_amplifier
 from acld_gym.physics.loads import TipLoad, case_load, check_load_case, random_load
+from acld_gym.physics.temperature import shifted_parameters
 from acld_gym.physics.uncertainty import randomized_parameters
 
-__all__ = ["reset_options", "draw_episode", "draw_noise", "randomized_plant", "RESET_OPTIONS"]
+__all__ = ["reset_options", "draw_episode", "draw_noise", "fixed_plant", "sampled_plant",
+           "randomized_plant", "RESET_OPTIONS"]
 
 #: The keys of ``reset(options=...)``: a named case or a TipLoad (``"load_case"``), or a
 #: TipLoad (``"load"``), for this episode only.
@@ -39,19 +42,49 @@ def reset_options(options, default_case):
     return check_load_case(options.get("load_case", default_case))
 
 
-def draw_episode(rng: np.random.Generator, case, nom: NominalDesign, episode_length: float,
-                 param_noise: float,
-                 harmonic_modes: tuple[float, float]) -> tuple[TipLoad, SampledSystem]:
-    """The load and the (possibly randomized) plant of an episode, drawn from ``rng``
-    in a fixed order: load first (a random one for ``"random"``, aimed at
-    ``harmonic_modes`` [rad/s]), then parameters (``param_noise`` > 0)."""
+def draw_episode(rng: np.random.Generator, case, nom: NominalDesign, config,
+                 harmonic_modes: tuple[float, float]) -> tuple[TipLoad, SampledSystem | None]:
+    """The load and the plant of an episode, drawn from ``rng`` in a fixed order: the load (a
+    random one for ``"random"``, aimed at ``harmonic_modes`` [rad/s]), the parameters
+    (``config.param_noise`` > 0), the temperature (``config.temperature_range``). The plant
+    is None when the configuration has one fixed plant (:func:`fixed_plant`)."""
     plant = nom.plant
     load = case_load(case)
     if load is None:  # the random case
-        load = random_load(rng, episode_length, plant.dt / plant.substeps, harmonic_modes)
-    if param_noise > 0:
-        plant = randomized_plant(rng, param_noise, nom)
-    return load, plant
+        load = random_load(rng, config.episode_length, plant.dt / plant.substeps,
+                           harmonic_modes)
+    if not config.randomized:
+        return load, None
+    params = nom.truth.params
+    if config.param_noise > 0:
+        params = randomized_parameters(rng, config.param_noise, params)
+    temperature = config.temperature
+    if config.temperature_range is not None:
+        temperature = float(rng.uniform(*config.temperature_range))
+    return load, sampled_plant(nom, shifted_parameters(params, temperature),
+                               config.amplifier_bandwidth)
+
+
+def fixed_plant(nom: NominalDesign, config) -> SampledSystem:
+    """The sampled plant of a configuration without per-episode draws: the nominal one (the
+    same object), at ``config.temperature``, driven through its amplifier."""
+    params = shifted_parameters(nom.truth.params, config.temperature)
+    return sampled_plant(nom, None if params is nom.truth.params else params,
+                         config.amplifier_bandwidth)
+
+
+def sampled_plant(nom: NominalDesign, params, bandwidth: float | None) -> SampledSystem:
+    """The truth plant with material parameters ``params`` (None: the nominal ones) and, with
+    an amplifier ``bandwidth`` [Hz], its first-order lag (:func:`acld_gym.physics.actuator.
+    with_amplifier`: the state gains the patch voltage), sampled like the nominal plant. A
+    randomized plant is the Galerkin projection of the physical beam with those parameters,
+    hence stable (:mod:`acld_gym.physics.truth`)."""
+    if params is None and bandwidth is None:
+        return nom.plant
+    A, B, E, _ = nom.truth.state_space(params)
+    if bandwidth is not None:
+        A, B, E = with_amplifier(A, B, E, bandwidth)
+    return discretize(A, B, E, nom.plant.dt, nom.plant.substeps)
 
 
 def draw_noise(rng: np.random.Generator, std: float, n: int | None = None,
@@ -68,8 +101,5 @@ def randomized_plant(rng: np.random.Generator, param_noise: float,
                      nom: NominalDesign) -> SampledSystem:
     """The nominal truth plant with randomized material parameters
     (:func:`acld_gym.physics.uncertainty.randomized_parameters`), sampled like the nominal
-    one. It is the Galerkin projection of the physical beam with those parameters, hence
-    stable (:mod:`acld_gym.physics.truth`)."""
-    truth = nom.truth
-    A, B, E, _ = truth.state_space(randomized_parameters(rng, param_noise, truth.params))
-    return discretize(A, B, E, nom.plant.dt, nom.plant.substeps)
+    one (:func:`sampled_plant`)."""
+    return sampled_plant(nom, randomized_parameters(rng, param_noise, nom.truth.params), None)

@@ -18,7 +18,7 @@ if TYPE_CHECKING:
     from acld_gym.design.nominal import NominalDesign
 
 __all__ = ["StepLayout", "Y_SCALE", "OBS_HIST", "INFO_KEYS", "TERMINATED_BY", "observation_size",
-           "estimate_map", "step_matrix", "output_matrix", "rest_output", "load_schedule",
+           "estimate_map", "output_matrix", "rest_output", "load_schedule",
            "reward_terms", "reward_of", "termination_codes"]
 
 
@@ -47,44 +47,84 @@ class StepLayout:
     the batched step (:mod:`acld_gym.envs.batch`) and the compiled step (as integers,
     :meth:`core_kwargs`).
 
-    Input ``z = [x, xhat, y_meas, V, f0 (s), f1 (s), w']``: plant state (n), observer
-    state (k), last measurement, voltage, the period's load samples at the s sub-steps'
-    starts and ends, and the new measurement's noise (one row of the batch's Z per env).
-    Output ``G z = [x', xhat', y_meas', y', x_r', e', y_meas' / Y_SCALE]``: the next
-    state (its first :attr:`state` entries replace z's), the true tip deflection, the
-    true reduced state (r), and the ``"estimate"`` observation (r + 1).
+    Input ``z = [x, a, xhat, y_meas, u, f0 (s), f1 (s), w', (s_amp)]``: the beam's state
+    (n), the actuator's state ``a`` (below), the observer's state (k), the last
+    measurement, the command u (the clipped action), the period's load samples at the s
+    sub-steps' starts and ends, the new measurement's noise and, with a slew limit, the
+    amplifier's output this period (one row of the batch's Z per env). Output
+    ``G z = [x', a', xhat', y_meas', y', x_r', e', y_meas' / Y_SCALE]``: the next state
+    (its first :attr:`state` entries replace z's), the true tip deflection, the true
+    reduced state (r), and the ``"estimate"`` observation (r + 1).
+
+    The actuator's state (empty without actuator options, so that the layout is v1's):
+    the patch voltage V_p (with ``amplifier_bandwidth``; the amplifier's lag makes it a
+    state of the plant, right after x), the ``delay`` last commands (the oldest first: it
+    drives this period) and the voltage held over the last period (the amplifier's
+    output, which a slew limit moves from).
     """
 
     n: int
     k: int
     r: int
     substeps: int
+    delay: int = 0
+    lag: bool = False
+    slew: bool = False
+
+    @property
+    def actuated(self) -> bool:
+        """Whether the actuator has a state (any of delay, lag, slew)."""
+        return self.delay > 0 or self.lag or self.slew
 
     # --- input z -------------------------------------------------------------------
     @property
     def x(self) -> slice:
+        """The beam's state [q; dq/dt]."""
         return slice(0, self.n)
 
     @property
+    def plant(self) -> slice:
+        """The sampled plant's state: x, and V_p with the amplifier's lag."""
+        return slice(0, self.n + int(self.lag))
+
+    @property
+    def patch(self) -> int | None:
+        """The patch voltage V_p (with the amplifier's lag)."""
+        return self.n if self.lag else None
+
+    @property
+    def buffer(self) -> slice:
+        """The delayed commands, oldest first."""
+        start = self.n + int(self.lag)
+        return slice(start, start + self.delay)
+
+    @property
+    def held(self) -> int | None:
+        """The amplifier's output over the last period (any actuator option)."""
+        return self.buffer.stop if self.actuated else None
+
+    @property
     def xhat(self) -> slice:
-        return slice(self.n, self.n + self.k)
+        start = self.buffer.stop + int(self.actuated)
+        return slice(start, start + self.k)
 
     @property
     def state(self) -> slice:
-        """x, xhat and y_meas: what one step advances."""
-        return slice(0, self.n + self.k + 1)
+        """x, a, xhat and y_meas: what one step advances."""
+        return slice(0, self.xhat.stop + 1)
 
     @property
     def y_meas(self) -> int:
-        return self.n + self.k
+        return self.xhat.stop
 
     @property
     def voltage(self) -> int:
-        return self.n + self.k + 1
+        """The command u, the step's clipped action [V]."""
+        return self.xhat.stop + 1
 
     @property
     def loads(self) -> slice:
-        return slice(self.n + self.k + 2, self.n + self.k + 2 + 2 * self.substeps)
+        return slice(self.voltage + 1, self.voltage + 1 + 2 * self.substeps)
 
     @property
     def noise(self) -> int:
@@ -92,17 +132,33 @@ class StepLayout:
 
     @property
     def inputs(self) -> slice:
-        """The per-step inputs ``[f0, f1, w']`` (tabulated for an episode)."""
-        return slice(self.loads.start, self.z_size)
+        """The per-step inputs ``[f0, f1, w']``."""
+        return slice(self.loads.start, self.noise + 1)
+
+    @property
+    def amplifier(self) -> int | None:
+        """The amplifier's output this period, computed before the product (slew limit)."""
+        return self.noise + 1 if self.slew else None
+
+    @property
+    def command(self) -> int:
+        """Where the command reaching the amplifier this period is: the oldest delayed one,
+        or u."""
+        return self.buffer.start if self.delay else self.voltage
+
+    @property
+    def drive(self) -> int:
+        """The voltage that drives the plant (or the amplifier's lag) this period."""
+        return self.amplifier if self.slew else self.command
 
     @property
     def z_size(self) -> int:
-        return self.noise + 1
+        return self.noise + 1 + int(self.slew)
 
     # --- output G z ----------------------------------------------------------------
     @property
     def out_y(self) -> int:
-        return self.n + self.k + 1
+        return self.state.stop
 
     @property
     def out_xr(self) -> slice:
@@ -117,13 +173,21 @@ class StepLayout:
     def out_size(self) -> int:
         return self.out_estimate.stop
 
+    @property
+    def out_voltage(self) -> int | None:
+        """The patch voltage at the end of the step in G z (None: it is u)."""
+        return self.patch if self.lag else self.held
+
     def core_kwargs(self) -> dict[str, int]:
         """The layout as the compiled step takes it (``acld_gym.envs._stepcore``)."""
+        none = -1
         return {"n_state": self.state.stop, "i_voltage": self.voltage,
                 "i_loads": self.loads.start, "i_noise": self.noise, "o_ymeas": self.y_meas,
-                "o_y": self.out_y,
-                "o_xr": self.out_xr.start, "o_obs": self.out_estimate.start, "n_x": self.n,
-                "n_xr": self.r}
+                "o_y": self.out_y, "o_xr": self.out_xr.start, "o_obs": self.out_estimate.start,
+                "n_x": self.n, "n_xr": self.r,
+                "o_volt": none if self.out_voltage is None else self.out_voltage,
+                "i_cmd": self.command, "i_held": none if self.held is None else self.held,
+                "i_amp": none if self.amplifier is None else self.amplifier}
 
 
 def observation_size(nom: NominalDesign, obs_mode: str, hist: int = OBS_HIST) -> int:
@@ -139,41 +203,53 @@ def estimate_map(obs: DiscreteObserver, xr_scale: np.ndarray) -> np.ndarray:
     return M / xr_scale
 
 
-def step_matrix(plant: SampledSystem, nom_plant: SampledSystem,
-                obs: DiscreteObserver) -> np.ndarray:
-    """One period of plant and observer as one matrix S:
-    ``[x', xhat'] = S [x, xhat, y_prev, V, f0, f1]`` with ``y_prev`` the last
-    measurement, ``f0, f1`` the period's load samples (:func:`load_schedule`).
-    The plant may be randomized; the observer uses the nominal load weights."""
-    n, k, s = plant.Ad.shape[0], obs.n, plant.substeps
-    S = np.zeros((n + k, n + k + 2 + 2 * s))
-    S[:n, :n] = plant.Ad
-    S[:n, n + k + 1] = plant.Bd[:, 0]
-    S[:n, n + k + 2:] = np.hstack([plant.W0, plant.W1])
-    lp = obs.Lp[:, 0]
-    S[n:, n:n + k] = obs.A - np.outer(lp, obs.C[0])
-    S[n:, n + k] = lp
-    S[n:, n + k + 1] = obs.B[:, 0]
-    if obs.fed_load:
-        S[n:, n + k + 2:] = np.hstack([nom_plant.W0, nom_plant.W1])
-    return S
-
-
-def output_matrix(S: np.ndarray, layout: StepLayout, output: np.ndarray, SL: np.ndarray,
+def output_matrix(plant: SampledSystem, nom_plant: SampledSystem, obs: DiscreteObserver,
+                  layout: StepLayout, output: np.ndarray, SL: np.ndarray,
                   est: np.ndarray) -> np.ndarray:
-    """The single env's whole step as one matrix G, from :func:`step_matrix` S, in the
-    slots of ``layout`` (:class:`StepLayout`): ``y' = output @ x'`` the true tip
-    deflection, ``y_meas' = y' + w'``, ``x_r' = S_L^T x'`` the true reduced state and
-    ``e' = [xhat', y_meas'] M`` the scaled estimate (:func:`estimate_map` M).
+    """The whole step as one matrix G, ``G z`` in the slots of ``layout``
+    (:class:`StepLayout`):
+
+    * the plant (possibly randomized; with the amplifier's lag its state includes V_p):
+      ``x_p' = A_d x_p + B_d V_d + W_0 f_0 + W_1 f_1``, V_d the voltage that drives it;
+    * the actuator: the delay line moves by one (the new command u enters at its end),
+      the held voltage becomes V_d;
+    * the observer on the nominal design, driven by u:
+      ``xhat' = (A - L_p C) xhat + L_p y_meas + B u`` (plus the nominal load weights if it
+      is fed the load);
+    * ``y' = output @ x'`` the true tip deflection, ``y_meas' = y' + w'``,
+      ``x_r' = S_L^T x'`` the true reduced state and ``e' = [xhat', y_meas'] M`` the scaled
+      estimate (:func:`estimate_map` M).
     """
-    n, k = layout.n, layout.k
-    X = np.hstack([S[:n + k], np.zeros((n + k, 1))])  # S's input and the noise w'
-    y = output @ X[layout.x]
+    lay = layout
+    G = np.zeros((lay.out_size, lay.z_size))
+    P = lay.plant
+    G[P, P] = plant.Ad
+    G[P, lay.drive] = plant.Bd[:, 0]
+    G[P, lay.loads] = np.hstack([plant.W0, plant.W1])
+    buf = lay.buffer
+    for j in range(buf.start, buf.stop - 1):
+        G[j, j + 1] = 1.0
+    if lay.delay:
+        G[buf.stop - 1, lay.voltage] = 1.0
+    if lay.held is not None:
+        G[lay.held, lay.drive] = 1.0
+    xh, k = lay.xhat, obs.n
+    lp = obs.Lp[:, 0]
+    G[xh, xh] = obs.A - np.outer(lp, obs.C[0])
+    G[xh, lay.y_meas] = lp
+    G[xh, lay.voltage] = obs.B[:, 0]
+    if obs.fed_load:
+        G[xh, lay.loads] = np.hstack([nom_plant.W0, nom_plant.W1])
+    X = G[lay.x]
+    y = output @ X
     y_meas = y.copy()
-    y_meas[layout.noise] = 1.0
-    e = est[:k].T @ X[layout.xhat] + np.outer(est[k], y_meas)
-    G = np.vstack([X, y_meas, y, SL.T @ X[layout.x], e, y_meas / Y_SCALE])
-    assert G.shape == (layout.out_size, layout.z_size)
+    y_meas[lay.noise] = 1.0
+    G[lay.y_meas] = y_meas
+    G[lay.out_y] = y
+    G[lay.out_xr] = SL.T @ X
+    G[lay.out_estimate.start:lay.out_estimate.stop - 1] = est[:k].T @ G[xh] + np.outer(est[k],
+                                                                                       y_meas)
+    G[lay.out_estimate.stop - 1] = y_meas / Y_SCALE
     return G
 
 

@@ -92,8 +92,7 @@ class ACLDBeamVectorEnv(ConfigAttributes, FigureOwner, VectorEnv):
         self._rngs: list[np.random.Generator] = [seeding.np_random(None)[0]
                                                  for _ in range(num_envs)]
         load = case_load(c.load_case) or thesis_load(1)
-        self._batch.start_episodes(np.arange(num_envs), [load] * num_envs,
-                                   [self.nom.plant] * num_envs,
+        self._batch.start_episodes(np.arange(num_envs), [load] * num_envs, [None] * num_envs,
                                    np.zeros((num_envs, steps + 1)))
         self._fig = None
         self._needs_reset = True
@@ -145,8 +144,7 @@ class ACLDBeamVectorEnv(ConfigAttributes, FigureOwner, VectorEnv):
         loads, plants = [], []
         for i in rows.tolist():
             rng = self._rngs[i]
-            load, plant = draw_episode(rng, case, nom, c.episode_length, c.param_noise,
-                                       self.harmonic_modes)
+            load, plant = draw_episode(rng, case, nom, c, self.harmonic_modes)
             loads.append(load)
             plants.append(plant)
             if c.sensor_noise:

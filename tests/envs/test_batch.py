@@ -46,6 +46,16 @@ OPTIONS = {
     "limit": dict(load_case=3, deflection_limit=5e-4),  # terminates early, then autoresets
     "reward": dict(load_case=1, y_ref=5e-4, lam=0.3),
     "v0": dict(PRESETS["ACLDBeam-v0"], load_case="random"),
+    "delay": dict(load_case="random", actuator_delay=3),
+    "lag": dict(load_case=2, amplifier_bandwidth=400.0),
+    "slew": dict(load_case="random", slew_rate=3e4, obs_mode="measurement"),
+    "actuator": dict(load_case="random", actuator_delay=1, amplifier_bandwidth=800.0,
+                     slew_rate=6e4, observer="thesis"),
+    "temperature": dict(load_case="random", temperature=24.0),
+    "temperature-range": dict(load_case="random", temperature_range=(17.0, 30.0),
+                              param_noise=0.03),
+    "thesis-actuator": dict(load_case=3, mesh="thesis", actuator_delay=2, slew_rate=2e4,
+                            temperature=22.0),
 }
 
 

@@ -162,7 +162,7 @@ def _core_args(env):
     return dict(GT=b.GT, Z=b.Z, OUT=b.OUT, k=b.k, noise=b.noise, y_hist=b.y_hist,
                 comp=b.codes.comp, ncomp=b.codes.ncomp, pool=b.codes.pool, times=b.times,
                 **b.layout.core_kwargs(), obs_mode=0, n_obs=7, dt=1e-3, y_ref=1e-3, lam=0.01,
-                v_max=120.0, limit=0.02, y_scale=1e-3, dgemm=None)
+                v_max=120.0, limit=0.02, y_scale=1e-3, slew_step=0.0, dgemm=None)
 
 
 @needs_core

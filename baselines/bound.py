@@ -56,9 +56,9 @@ from acld_gym.design.discrete import (
 from acld_gym.physics.actuator import V_LIMIT
 from acld_gym.physics.loads import TipLoad
 
-__all__ = ["ATOL", "BoundSolution", "KKTCheck", "METHODS", "RTOL", "clairvoyant_bound",
-           "convolution_matrix", "free_response", "impulse_response", "kkt_check",
-           "reversed_gram"]
+__all__ = ["ATOL", "BoundSolution", "KKTCheck", "METHODS", "RTOL", "SlewCertificate",
+           "clairvoyant_bound", "convolution_matrix", "free_response", "impulse_response",
+           "kkt_check", "reversed_gram", "slew_certificate"]
 
 #: Solvers accepted by :func:`clairvoyant_bound`.
 METHODS = ("pdas", "bvls")
@@ -79,6 +79,9 @@ class BoundSolution:
     voltage: np.ndarray
     y: np.ndarray
     dt: float
+    #: With a binding slew limit, the :class:`SlewCertificate` of the solution (its
+    #: ``lower`` is a certified lower bound of the optimum, in the solver's scaled units).
+    certificate: object = None
 
     @property
     def ise(self) -> float:
@@ -469,14 +472,115 @@ def _solve_pdas(h: np.ndarray, y: np.ndarray, rtol: float = RTOL, atol: float = 
 # --- the bound -------------------------------------------------------------------------------
 
 
+@dataclass(frozen=True)
+class SlewCertificate:
+    r"""Optimality certificate of ``w`` for the slew-limited problem
+    :math:`\min f(w) = \tfrac12\|y + Gw\|^2` over
+    :math:`\mathcal C = \{|w_m| \le 1, |w_m - w_{m-1}| \le \rho\}` (:math:`w_{-1} = 0`;
+    scaled units, as :class:`KKTCheck`).
+
+    By convexity, for every :math:`u \in \mathcal C`,
+    :math:`f(u) \ge f(w) + g^T (u - w)` with :math:`g = \nabla f(w)`, and for every
+    multiplier vector :math:`\lambda` of the difference constraints :math:`|Du| \le \rho`,
+
+    .. math::
+
+        g^T u = (g + D^T\lambda)^T u - \lambda^T D u
+              \ge -\|g + D^T\lambda\|_1 - \rho\|\lambda\|_1 ,
+
+    so :math:`f^* \ge` ``lower`` :math:`= f(w) - g^T w - \|g + D^T\lambda\|_1 -
+    \rho \|\lambda\|_1`: a dual-feasible point's dual objective, a lower bound of the
+    optimum for *any* w and :math:`\lambda` (the solver's multipliers make it tight).
+    ``objective`` is f at the feasible ``w``, so ``lower <= f* <= objective``."""
+
+    objective: float
+    lower: float
+    free_objective: float
+    feasible: bool
+
+    @property
+    def gap(self) -> float:
+        return self.objective - self.lower
+
+    def certifies(self, rtol: float = 1e-6, atol: float = ATOL) -> bool:
+        """Feasible and ``gap <= rtol * objective + atol * free_objective``."""
+        return self.feasible and self.gap <= rtol * self.objective + atol * self.free_objective
+
+
+def _difference(n: int):
+    """The difference operator D (n x n): (D w)_m = w_m - w_{m-1}, w_{-1} = 0 (sparse)."""
+    import scipy.sparse as sp
+
+    return sp.eye(n, format="csc") - sp.eye(n, k=-1, format="csc")
+
+
+def slew_certificate(h: np.ndarray, y: np.ndarray, w: np.ndarray, lam: np.ndarray,
+                     rho: float) -> SlewCertificate:
+    """:class:`SlewCertificate` of ``w`` with multipliers ``lam`` (scaled units)."""
+    n = h.size
+    r = y + np.convolve(h, w)[:n]
+    g = np.correlate(r, h, "full")[n - 1:]  # G^T r
+    dl = lam - np.append(lam[1:], 0.0)  # D^T lam
+    lower = 0.5 * float(r @ r) - float(g @ w) - float(np.abs(g + dl).sum()) \
+        - rho * float(np.abs(lam).sum())
+    steps = np.diff(np.concatenate([[0.0], w]))
+    feasible = bool(np.all(np.abs(w) <= 1.0 + 1e-12) and np.all(np.abs(steps) <= rho * (1 + 1e-12)))
+    return SlewCertificate(objective=0.5 * float(r @ r), lower=lower,
+                           free_objective=0.5 * float(y @ y), feasible=feasible)
+
+
+def _feasible(w: np.ndarray, rho: float) -> np.ndarray:
+    """``w`` moved into the slew-limited box, step by step (each w_m clipped to
+    [w_{m-1} - rho, w_{m-1} + rho] and [-1, 1], which meet since |w_{m-1}| <= 1)."""
+    out = np.empty_like(w)
+    prev = 0.0
+    for m, wm in enumerate(w.tolist()):
+        prev = min(max(wm, prev - rho, -1.0), prev + rho, 1.0)
+        out[m] = prev
+    return out
+
+
+#: OSQP's tolerances and iteration budget for the slew-limited bound: the certificate, not
+#: the solver, decides what the bound is worth (its lower bound holds for any answer).
+EPS = 1e-7
+MAX_ITER = 20_000
+
+
+def _solve_slew(h: np.ndarray, y: np.ndarray, rho: float) -> tuple[np.ndarray, SlewCertificate]:
+    r"""The slew-limited problem (:class:`SlewCertificate`) by OSQP, an ADMM method on the
+    quadratic program :math:`\min \tfrac12 w^T G^T G w + (G^T y)^T w` subject to
+    :math:`l \le [I; D] w \le u`: the box and the slew limit, a general linear
+    inequality, are rows of one constraint matrix (OSQP factors its KKT matrix once and
+    iterates; polished). Its answer is moved into the feasible set (:func:`_feasible`) and
+    certified with its multipliers of the difference rows."""
+    import osqp
+    import scipy.sparse as sp
+
+    n = h.size
+    G = convolution_matrix(h)
+    P = sp.csc_matrix(np.triu(G.T @ G))
+    A = sp.vstack([sp.eye(n, format="csc"), _difference(n)], format="csc")
+    one = np.ones(n)
+    solver = osqp.OSQP()
+    solver.setup(P, G.T @ y, A, np.concatenate([-one, -rho * one]),
+                 np.concatenate([one, rho * one]), eps_abs=EPS, eps_rel=EPS,
+                 max_iter=MAX_ITER, polishing=True, verbose=False)
+    res = solver.solve(raise_error=False)
+    w = _feasible(np.asarray(res.x, dtype=float), rho)
+    return w, slew_certificate(h, y, w, np.asarray(res.y, dtype=float)[n:], rho)
+
+
 def clairvoyant_bound(plant: SampledSystem, tip_index: int | np.ndarray, load: TipLoad,
-                      n_steps: int, *, method: str = "pdas") -> BoundSolution:
-    """Solve the bound for ``load`` over ``n_steps`` periods of ``plant``.
+                      n_steps: int, *, method: str = "pdas", delay: int = 0,
+                      slew_step: float | None = None,
+                      v_max: float = V_LIMIT) -> BoundSolution:
+    r"""Solve the bound for ``load`` over ``n_steps`` periods of ``plant``.
 
     Parameters
     ----------
     plant : SampledSystem
-        Sampled plant (any state dimension).
+        Sampled plant (any state dimension; with an amplifier's lag its state includes the
+        patch voltage and its input is the amplifier's output).
     tip_index : int or ndarray
         State index of the tip deflection, or its output row (y = row @ x).
     load : TipLoad
@@ -487,6 +591,18 @@ def clairvoyant_bound(plant: SampledSystem, tip_index: int | np.ndarray, load: T
         ``"pdas"``: the structured, certified solver (falls back to BVLS with a
         ``RuntimeWarning`` if it cannot certify its optimum); ``"bvls"``:
         ``scipy.optimize.lsq_linear`` on the dense matrix (the reference).
+    delay : int
+        Periods from a command to the amplifier (``actuator_delay``): the first ``delay``
+        voltages are zero, the tip's response to the rest is the plant's impulse response
+        ``delay`` periods late. The bound's voltages are the amplifier's outputs (the
+        commands ``delay`` periods earlier).
+    slew_step : float or None
+        Largest change of the amplifier's output per period [V] (``slew_rate * dt``): a
+        constraint :math:`|V_k - V_{k-1}| \le` ``slew_step``, handled by
+        :func:`_solve_slew` and certified by :class:`SlewCertificate` (if it cannot bind,
+        ``slew_step >= 2 v_max``, the box problem is the same one and PDAS solves it).
+    v_max : float
+        The voltage limit [V].
 
     Returns
     -------
@@ -495,10 +611,22 @@ def clairvoyant_bound(plant: SampledSystem, tip_index: int | np.ndarray, load: T
     _check_steps(n_steps, "n_steps")
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
-    h = impulse_response(plant, tip_index, n_steps)
+    if isinstance(delay, bool) or not isinstance(delay, (int, np.integer)) \
+            or not 0 <= delay < n_steps:
+        raise ValueError(f"delay must be an integer in [0, n_steps), got {delay!r}")
     y_free = free_response(plant, tip_index, load, n_steps)
-    hs, ys = h * (_V_UNIT / _Y_UNIT), y_free / _Y_UNIT
-    if method == "pdas":
+    m = n_steps - delay  # the voltages that reach the tip within the episode
+    h = impulse_response(plant, tip_index, m)
+    hs, ys = h * (v_max / _Y_UNIT), y_free[delay:] / _Y_UNIT
+    if slew_step is not None and slew_step < 2 * v_max:
+        v, certificate = _solve_slew(hs, ys, slew_step / v_max)
+        cert = certificate
+        if not cert.certifies():
+            warnings.warn(f"clairvoyant_bound: the slew-limited solution is certified only to "
+                          f"a relative gap of {cert.gap / max(cert.objective, 1e-300):.1e}",
+                          RuntimeWarning, stacklevel=2)
+    elif method == "pdas":
+        certificate = None
         res = _solve_pdas(hs, ys)
         v = res.v
         if not res.check.certifies():
@@ -507,7 +635,9 @@ def clairvoyant_bound(plant: SampledSystem, tip_index: int | np.ndarray, load: T
                           f"{RTOL:g}); using BVLS", RuntimeWarning, stacklevel=2)
             v = _solve_bvls(hs, ys)
     else:
+        certificate = None
         v = _solve_bvls(hs, ys)
-    voltage = _V_UNIT * v
-    return BoundSolution(voltage=voltage, y=y_free + np.convolve(h, voltage)[:n_steps],
-                         dt=plant.dt)
+    voltage = np.concatenate([np.zeros(delay), v_max * v])
+    y = y_free.copy()
+    y[delay:] += np.convolve(h, voltage[delay:])[:m]
+    return BoundSolution(voltage=voltage, y=y, dt=plant.dt, certificate=certificate)

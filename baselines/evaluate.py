@@ -1,10 +1,15 @@
-"""Evaluate the reference policies on the thesis's three load cases in ``ACLDBeam-v1``.
+"""Evaluate the reference policies on the thesis's three load cases in ``ACLDBeam-v1`` (or any
+registered id).
 
-``python -m baselines.evaluate [--mesh converged|thesis] [--json PATH] [--plots DIR]``
-prints a table per case (peak [mm], 5 % settling [s], ISE [m^2 s], max |V| [V],
-return) for passive, LQR, SMC, MPC and the clairvoyant bound, all with the +/-120 V
-limit, 1 ms control and the default Kalman observer; on the thesis mesh it also prints
-the saturated LQR/SMC rows against thesis Table 2. Any object with SB3's
+``python -m baselines.evaluate [--env-id ID] [--mesh converged|thesis] [--json PATH]
+[--plots DIR]`` prints a table per case (peak [mm], 5 % settling [s], ISE [m^2 s], max |V|
+[V], return) for passive, LQR, SMC, MPC and the clairvoyant bound, all with the +/-120 V
+limit, 1 ms control and the default Kalman observer, in the configuration of ``--env-id``
+(default ``ACLDBeam-v1``; ``--mesh`` replaces its mesh); on the thesis mesh it also prints
+the saturated LQR/SMC rows against thesis Table 2. The policies are designed on the env's
+nominal model (:meth:`baselines.policies.LQRPolicy.for_env`: through the measurement
+observation they run the nominal observer themselves) and the bound has the env's actuator
+inside. Any object with SB3's
 ``predict`` can be evaluated with :func:`rollout`, so trained agents use the same
 code; a policy that records an ``observation_fingerprint`` is checked against the
 env's before it acts.
@@ -20,9 +25,9 @@ from pathlib import Path
 
 import numpy as np
 
-from acld_gym.design.nominal import nominal_design
 from acld_gym.envs.beam_env import ACLDBeamEnv
 from acld_gym.envs.fingerprint import fingerprint_differences, observation_fingerprint
+from acld_gym.envs.presets import PRESETS, preset
 from acld_gym.envs.step import reward_of
 from acld_gym.physics.loads import THESIS_CASES
 from acld_gym.physics.truth import MESHES
@@ -34,7 +39,7 @@ from acld_gym.util.progress import Progress
 from acld_gym.util.validate import arg_type
 
 __all__ = ["EvalRow", "Episode", "rollout", "check_compatible", "bound_episode", "episode_rows",
-           "evaluate", "default_policies",
+           "evaluate", "default_policies", "policies_for",
            "mean_rows", "format_tables", "format_thesis_comparison", "plot_episodes"]
 
 
@@ -87,9 +92,12 @@ def rollout(policy, env: ACLDBeamEnv, seed: int = 0, options: dict | None = None
     t, y, v, r = [], [], [], []
     spent = 0.0
     done = False
+    state, start = None, np.ones(1, dtype=bool)  # SB3's recurrent-policy protocol
     while not done:
         t0 = time.perf_counter()
-        action, _ = policy.predict(obs, deterministic=True)
+        action, state = policy.predict(obs, state=state, episode_start=start,
+                                       deterministic=True)
+        start = np.zeros(1, dtype=bool)
         spent += time.perf_counter() - t0
         obs, reward, term, trunc, info = env.step(action)
         t.append(info["time"])
@@ -101,18 +109,32 @@ def rollout(policy, env: ACLDBeamEnv, seed: int = 0, options: dict | None = None
 
 
 def bound_episode(env: ACLDBeamEnv) -> Episode:
-    """The clairvoyant bound for ``env``'s current load and plant (the episode's own,
-    randomized with ``param_noise``)."""
+    """The clairvoyant bound for ``env``'s current load and plant (the episode's own:
+    randomized with ``param_noise``, at its temperature, with its amplifier's lag), with the
+    env's actuator inside: the delay shifts the impulse response, the lag is part of the
+    sampled plant, the slew limit is a constraint (:func:`baselines.bound.clairvoyant_bound`).
+    Its voltages are the patch's (the amplifier's output through the lag)."""
+    from acld_gym.design.discrete import impulse_response
+
     from .bound import clairvoyant_bound
 
     env = env.unwrapped
+    plant, c, n = env.episode_plant, env.config, env.max_steps
+    tip = np.zeros(plant.Ad.shape[0])
+    tip[:env.nom.output.size] = env.nom.output
     t0 = time.perf_counter()
     with one_blas_thread():  # small dense problems (acld_gym.util.blas)
-        sol = clairvoyant_bound(env.episode_plant, env.nom.output, env.load, env.max_steps)
+        sol = clairvoyant_bound(plant, tip, env.load, n, delay=c.actuator_delay,
+                                slew_step=c.slew_step)
     spent = time.perf_counter() - t0
-    t = np.arange(1, env.max_steps + 1) * env.dt
-    reward = reward_of(sol.y, sol.voltage, env.y_ref, env.lam, env.v_max)
-    return Episode(t, sol.y, sol.voltage, reward, spent / env.max_steps)
+    volts = sol.voltage
+    if c.amplifier_bandwidth is not None:
+        patch = np.zeros(plant.Ad.shape[0])
+        patch[env.nom.output.size] = 1.0  # the patch voltage, a state of the lagged plant
+        volts = np.convolve(impulse_response(plant, patch, n), sol.voltage)[:n]
+    t = np.arange(1, n + 1) * env.dt
+    reward = reward_of(sol.y, volts, env.y_ref, env.lam, env.v_max)
+    return Episode(t, sol.y, volts, reward, spent / n)
 
 
 def metrics_row(case, name: str, ep: Episode) -> EvalRow:
@@ -129,6 +151,14 @@ def default_policies(mesh: str = "converged", dt: float = 1e-3) -> dict:
 
     return {cls.name: cls(dt=dt, mesh=mesh)
             for cls in (PassivePolicy, LQRPolicy, SMCPolicy, MPCPolicy)}
+
+
+def policies_for(env) -> dict:
+    """Passive, LQR, SMC and MPC designed for ``env`` (its nominal model and observation)."""
+    from .policies import LQRPolicy, MPCPolicy, PassivePolicy, SMCPolicy
+
+    return {cls.name: cls.for_env(env) for cls in (PassivePolicy, LQRPolicy, SMCPolicy,
+                                                   MPCPolicy)}
 
 
 def episode_rows(policies: dict, case, seed: int = 0, env_kwargs: dict | None = None,
@@ -162,7 +192,7 @@ def evaluate(policies: dict | None = None, cases=THESIS_CASES, seed: int = 0,
     """Rows for every (case, policy) plus the bound; fills ``episodes`` if given; a
     progress line on a terminal unless ``quiet``."""
     if policies is None:
-        policies = default_policies((env_kwargs or {}).get("mesh", "converged"))
+        policies = policies_for(ACLDBeamEnv(**(env_kwargs or {})))
     with Progress(len(cases) * (len(policies) + 1), "evaluate", quiet) as progress:
         return [row for case in cases
                 for row in episode_rows(policies, case, seed, env_kwargs, episodes, progress)]
@@ -245,8 +275,11 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--plots", metavar="DIR", help="write one figure per case to DIR")
     p.add_argument("--seed", type=arg_type(int, 0, 2**63 - 1), default=0,
                    help="episode seed (sensor noise)")
-    p.add_argument("--mesh", choices=MESHES, default="converged",
-                   help="truth plant: the mesh-converged beam (default) or the thesis mesh")
+    p.add_argument("--env-id", choices=list(PRESETS), default="ACLDBeam-v1",
+                   help="the registered configuration (default ACLDBeam-v1)")
+    p.add_argument("--mesh", choices=MESHES, default=None,
+                   help="truth plant: the mesh-converged beam or the thesis mesh (default: "
+                        "the configuration's)")
     p.add_argument("--quiet", action="store_true", help="no progress line")
     args = p.parse_args(argv)
     try:  # unusable output paths fail now, before any computing
@@ -256,12 +289,13 @@ def main(argv: list[str] | None = None) -> int:
             check_directory(args.plots, "--plots")
     except ValueError as exc:
         p.error(str(exc))
-    nominal_design(mesh=args.mesh)  # build the design once before timing anything
+    config = preset(args.env_id, **({} if args.mesh is None else {"mesh": args.mesh}))
+    probe = ACLDBeamEnv(config=config)  # build the design once before timing anything
     episodes: dict = {}
-    rows = evaluate(default_policies(args.mesh), seed=args.seed,
-                    env_kwargs={"mesh": args.mesh}, episodes=episodes, quiet=args.quiet)
+    rows = evaluate(policies_for(probe), seed=args.seed, env_kwargs={"config": config},
+                    episodes=episodes, quiet=args.quiet)
     print(format_tables(rows))
-    if args.mesh == "thesis":
+    if config.mesh == "thesis":
         print(format_thesis_comparison(rows))
     if args.json:
         write_json(args.json, [r.as_dict() for r in rows])

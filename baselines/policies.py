@@ -26,7 +26,8 @@ from acld_gym.design.nominal import NominalDesign, nominal_design
 from acld_gym.envs.fingerprint import design_fingerprint
 from acld_gym.physics.actuator import V_LIMIT
 
-__all__ = ["PassivePolicy", "LQRPolicy", "SMCPolicy", "MPCPolicy", "discrete_lqr_gain"]
+__all__ = ["PassivePolicy", "LQRPolicy", "SMCPolicy", "MPCPolicy", "MeasurementFeedback",
+           "discrete_lqr_gain"]
 
 
 class _Policy:
@@ -41,8 +42,14 @@ class _Policy:
 
     @classmethod
     def for_env(cls, env, **kwargs):
-        """The policy designed on ``env``'s nominal model (any Gymnasium wrapper)."""
-        return cls(nom=env.unwrapped.nom, **kwargs)
+        """The policy designed on ``env``'s nominal model (any Gymnasium wrapper); for an env
+        observed through ``obs_mode="measurement"`` wrapped in :class:`MeasurementFeedback`
+        (it runs the env's nominal observer itself)."""
+        e = env.unwrapped
+        policy = cls(nom=e.nom, **kwargs)
+        if e.obs_mode == "measurement":
+            return MeasurementFeedback(policy, e.nom.observer(e.observer_kind))
+        return policy
 
     @property
     def observation_fingerprint(self) -> dict:
@@ -257,3 +264,62 @@ class MPCPolicy(_Policy):
                 raise RuntimeError(f"MPC: OSQP returned status {res.info.status!r}")
             out[i] = V_LIMIT * float(res.x[0])
         return out
+
+
+class MeasurementFeedback:
+    r"""A reference policy for the ``"measurement"`` observation (the last 8 tip
+    measurements and the last command): it runs the nominal observer itself -- the same
+    sampled filter the env runs for its ``"estimate"`` observation,
+
+    .. math::
+
+        \hat x_k = (A - L_p C)\,\hat x_{k-1} + L_p y_{k-1} + B u_{k-1}, \qquad
+        e_k = [\hat x_k, y_k]\,M,
+
+    from rest at the episode's start -- and gives ``policy`` the estimate as the
+    ``"estimate"`` observation would. It keeps its filter in SB3's ``state``
+    (``predict(obs, state, episode_start)``; a None state or ``episode_start`` starts an
+    episode), so it acts on what it observes: measurements rounded to float32 as the
+    observation carries them.
+    """
+
+    def __init__(self, policy: _Policy, observer):
+        if observer.fed_load:
+            raise ValueError("MeasurementFeedback needs an observer that is not fed the load "
+                             "(observer='kalman'): the measurement observation has no load")
+        from acld_gym.envs.step import estimate_map
+
+        self.policy = policy
+        self.name = policy.name
+        self.observer = observer
+        self._est = estimate_map(observer, policy.nom.xr_scale)
+
+    @property
+    def observation_fingerprint(self) -> dict:
+        return self.policy.observation_fingerprint
+
+    def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
+        """SB3 protocol with state: ``(actions, state)``, state = the filter ``[xhat, y]``."""
+        from acld_gym.envs.step import OBS_HIST, Y_SCALE
+
+        obs = np.asarray(observation, dtype=np.float64)
+        batched = obs.ndim == 2
+        o = np.atleast_2d(obs)
+        if o.shape[-1] != OBS_HIST + 1:
+            raise ValueError(f"obs: MeasurementFeedback needs the env's 'measurement' "
+                             f"observation ({OBS_HIST + 1} values), got shape {obs.shape}")
+        ob, k = self.observer, self.observer.n
+        y, u_prev = o[:, OBS_HIST - 1] * Y_SCALE, o[:, OBS_HIST] * V_LIMIT
+        xhat = np.zeros((o.shape[0], k))
+        if state is not None:
+            old = np.atleast_2d(np.asarray(state, dtype=np.float64))
+            lp = ob.Lp[:, 0]
+            xhat = (old[:, :k] @ (ob.A - np.outer(lp, ob.C[0])).T + np.outer(old[:, k], lp)
+                    + np.outer(u_prev, ob.B[:, 0]))
+            if episode_start is not None:
+                xhat[np.atleast_1d(np.asarray(episode_start, dtype=bool))] = 0.0
+        estimate = np.hstack([xhat, y[:, None]]) @ self._est
+        e = np.hstack([estimate, y[:, None] / Y_SCALE]).astype(np.float32)
+        action, _ = self.policy.predict(e if batched else e[0], deterministic=deterministic)
+        return action, np.hstack([xhat, y[:, None]])
+

@@ -107,11 +107,7 @@ class BatchStep:
         self.steps = int(steps)
         self.observer = obs = nom.observer(c.observer)
         self.est = estimate_map(obs, nom.xr_scale)
-        self.layout = lay = StepLayout(n=nom.plant.Ad.shape[0], k=obs.n,
-                                       r=nom.design.reduced.order, substeps=nom.plant.substeps,
-                                       delay=c.actuator_delay,
-                                       lag=c.amplifier_bandwidth is not None,
-                                       slew=c.slew_rate is not None)
+        self.layout = lay = StepLayout.of(c, nom, obs)
         self.n_obs = observation_size(nom, c.obs_mode)
         #: The configuration's plant (the nominal one, shifted to its temperature, with its
         #: amplifier); an episode's own when drawn (param_noise, temperature_range).

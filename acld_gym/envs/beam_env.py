@@ -179,6 +179,13 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
 
     ## Version History
 
+    * ACLDBeamLab-v1 (new in acld-gym 0.3.0): v1 with a laboratory rig's actuator and
+      sensor -- ``actuator_delay=1`` (computation delay), ``slew_rate=4.18e6`` V/s (a
+      +/-150 V bender driver's 95 mA on the patch's 22.7 nF), ``amplifier_bandwidth=60e3``
+      Hz, ``sensor_noise=1.8e-7`` m (a 14-bit laser sensor's quantization);
+      :mod:`acld_gym.envs.presets` has the sources. Reference table: ``docs/variants.md``.
+    * ACLDBeamHard-v1 (new in 0.3.0): the lab rig, the polymer's temperature drawn per
+      episode in 18-28 °C, ``param_noise=0.05`` and ``obs_mode="measurement"``.
     * v1: the truth plant is the mesh-converged beam (``mesh="converged"``; the thesis
       mesh is ``mesh="thesis"``); the reduced-state estimate is in canonical
       coordinates (real modal form), identical on every machine; random loads aim at

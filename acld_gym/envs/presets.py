@@ -7,20 +7,51 @@ arguments of ``gym.make`` replace them). This module imports nothing heavy, so t
 * ``ACLDBeam-v0``: the thesis configuration -- the thesis mesh, its random-load harmonics at
   179 and 1115 rad/s, a Kalman filter driven by the load alone and ``param_noise`` up to 0.5
   (the env's Version History).
+* ``ACLDBeamLab-v1``: v1 with the actuator and sensor of a laboratory rig (:data:`LAB`):
+
+  - ``actuator_delay=1``: the controller samples the tip, computes and writes the voltage at
+    the next sampling instant, a one-period computation delay (the usual implementation on
+    a real-time target; Franklin, Powell & Workman, *Digital Control of Dynamic Systems*,
+    3rd ed., 1998, on computation delay);
+  - ``slew_rate=4.18e6`` V/s: a +/-150 V bender driver's peak current, 95 mA (PiezoDrive
+    BD150), on the patch's 22.7 nF (:data:`acld_gym.physics.actuator.REFERENCE_SLEW_RATE`);
+  - ``amplifier_bandwidth=60e3`` Hz: the signal bandwidth of PiezoDrive's miniature bender
+    driver PDu100B (60 kHz unloaded; its datasheet); the BD150's is not stated in the data
+    cited;
+  - ``sensor_noise=1.8e-7`` m: a laser triangulation sensor's digital output, Micro-Epsilon
+    optoNCDT 1700-10 (10 mm range, 14-bit values: one step is 6.23167e-5 of the range, 0.623
+    um, manual sec. 7.3), whose quantization has a standard deviation of a step / sqrt(12).
+
+  At 1 kHz the amplifier barely matters (a 240 V swing takes 57 us, the lag is 2.7 us); the
+  delay does.
+* ``ACLDBeamHard-v1``: the lab rig (:data:`HARD`) plus a polymer temperature drawn per episode
+  in 18-28 °C (an unconditioned laboratory; its transition, :mod:`acld_gym.physics.
+  temperature`), parameter noise 0.05 and partial observation: ``obs_mode="measurement"``
+  (the last 8 tip measurements and the last command, no state estimate).
 """
 
 from __future__ import annotations
 
-__all__ = ["PRESETS", "ENTRY_POINT", "VECTOR_ENTRY_POINT", "preset", "register_presets"]
+__all__ = ["PRESETS", "LAB", "HARD", "ENTRY_POINT", "VECTOR_ENTRY_POINT", "preset",
+           "register_presets"]
 
 ENTRY_POINT = "acld_gym.envs.beam_env:ACLDBeamEnv"
 VECTOR_ENTRY_POINT = "acld_gym.envs.vector_env:ACLDBeamVectorEnv"
+
+#: The lab rig's actuator and sensor (module docstring, with the sources).
+LAB = {"actuator_delay": 1, "slew_rate": 4.18e6, "amplifier_bandwidth": 60e3,
+       "sensor_noise": 1.8e-7}
+#: The hard level: the lab rig, the temperature, parameter noise and partial observation.
+HARD = {**LAB, "temperature_range": (18.0, 28.0), "param_noise": 0.05,
+        "obs_mode": "measurement"}
 
 #: id -> the EnvConfig fields it sets (JSON-able; the rest are EnvConfig's defaults).
 PRESETS: dict[str, dict] = {
     "ACLDBeam-v1": {},
     "ACLDBeam-v0": {"mesh": "thesis", "harmonic_modes": (179.0, 1115.0), "model_std": 0.0,
                     "param_noise_max": 0.5, "env_id": "ACLDBeam-v0"},
+    "ACLDBeamLab-v1": {**LAB, "env_id": "ACLDBeamLab-v1"},
+    "ACLDBeamHard-v1": {**HARD, "env_id": "ACLDBeamHard-v1"},
 }
 
 

@@ -71,6 +71,14 @@ class StepLayout:
     lag: bool = False
     slew: bool = False
 
+    @classmethod
+    def of(cls, config, nom: NominalDesign, obs: DiscreteObserver) -> StepLayout:
+        """The layout of a configuration (:class:`acld_gym.envs.config.EnvConfig`): the
+        plant's and the observer's sizes, and the actuator options."""
+        return cls(n=nom.plant.Ad.shape[0], k=obs.n, r=nom.design.reduced.order,
+                   substeps=nom.plant.substeps, delay=config.actuator_delay,
+                   lag=config.amplifier_bandwidth is not None, slew=config.slew_rate is not None)
+
     @property
     def actuated(self) -> bool:
         """Whether the actuator has a state (any of delay, lag, slew)."""

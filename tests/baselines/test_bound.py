@@ -167,3 +167,54 @@ def test_bad_input_names_the_argument():
         impulse_response(plant, plant.Ad.shape[0], 10)
     with pytest.raises(ValueError, match="output"):
         impulse_response(plant, np.ones(3), 10)
+
+
+# --- the bound of each actuator option (issue 21) ------------------------------------------
+OPTIONS = {"delay": dict(actuator_delay=2), "lag": dict(amplifier_bandwidth=300.0),
+           "slew": dict(slew_rate=2e4),
+           "all": dict(actuator_delay=1, amplifier_bandwidth=500.0, slew_rate=3e4,
+                       temperature=23.0)}
+
+
+@pytest.mark.parametrize("name", list(OPTIONS))
+def test_with_each_option_the_bound_is_below_every_policy_and_certified(name):
+    import warnings
+
+    from acld_gym.envs.beam_env import ACLDBeamEnv
+    from baselines.evaluate import bound_episode, default_policies, metrics_row, rollout
+
+    env = ACLDBeamEnv(load_case=2, episode_length=0.3, **OPTIONS[name])
+    policies = {key: type(p).for_env(env) for key, p in default_policies().items()}
+    ise = {key: metrics_row(2, key, rollout(p, env, seed=0)).ise for key, p in policies.items()}
+    env.reset(seed=0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # an uncertified solution warns
+        ep = bound_episode(env)
+    bound = metrics_row(2, "bound", ep).ise
+    assert all(bound < v for v in ise.values()), (bound, ise)
+    # the bound's voltages are feasible for this actuator
+    assert np.all(np.abs(ep.voltage) <= 120.0 + 1e-9)
+    if "actuator_delay" in OPTIONS[name]:
+        assert np.all(ep.voltage[:OPTIONS[name]["actuator_delay"]] == 0.0)
+
+
+def test_slew_certificate_is_a_lower_bound_of_every_feasible_point():
+    from baselines.bound import _feasible, _solve_slew, slew_certificate
+
+    nom = nominal_design()
+    n, rho = 80, 0.1
+    h = impulse_response(nom.plant, nom.output, n) * 120 / 1e-3
+    y = free_response(nom.plant, nom.output, thesis_load(1), n) / 1e-3
+    w, cert = _solve_slew(h, y, rho)
+    assert cert.feasible and cert.lower <= cert.objective and cert.certifies()
+    rng = np.random.default_rng(0)
+    for _ in range(200):  # any feasible sequence costs at least the certified lower bound
+        u = _feasible(w + rng.normal(0.0, 0.3, n), rho)
+        assert slew_certificate(h, y, u, np.zeros(n), rho).objective >= cert.lower
+    # a wrong multiplier still gives a valid (looser) lower bound
+    loose = slew_certificate(h, y, w, rng.normal(0.0, 1.0, n), rho)
+    assert loose.lower <= cert.objective
+    # the slew limit binds: without it the optimum is lower
+    free = clairvoyant_bound(nom.plant, nom.output, thesis_load(1), n)
+    assert np.sum(free.y ** 2) < np.sum((y + np.convolve(h, w)[:n]) ** 2) * 1e-6
+    assert np.abs(np.diff(np.r_[0.0, w])).max() == pytest.approx(rho)

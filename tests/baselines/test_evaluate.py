@@ -53,3 +53,11 @@ def test_thesis_comparison_lists_saturated_lqr_smc_rows_only():
     lines = format_thesis_comparison(rows).strip().splitlines()[2:]
     assert [ln.split() for ln in lines] == [["LQR", "case", "1", "+5.0%", "-10.0%"],
                                             ["SMC", "case", "2", "+0.0%", "+0.0%"]]
+
+
+def test_evaluate_takes_any_registered_id(capsys):
+    from baselines.evaluate import main
+
+    assert main(["--env-id", "ACLDBeamHard-v1", "--quiet"]) == 0
+    out = capsys.readouterr().out
+    assert out.count("load case") == 3 and out.count("bound") >= 3

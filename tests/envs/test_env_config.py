@@ -119,3 +119,28 @@ def test_load_case_accepts_a_tip_load_everywhere():
     sb3.set_attr("load_case", pulse)
     sb3.reset()
     assert sb3.venv.loads == [pulse, pulse]
+
+
+@pytest.mark.parametrize("env_id", ["ACLDBeamLab-v1", "ACLDBeamHard-v1"])
+def test_presets_pass_check_env_and_work_through_make_and_make_vec(env_id):
+    from gymnasium.utils.env_checker import check_env
+
+    env = gym.make(env_id, render_mode="rgb_array")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the volts action box (README, chosen warnings)
+        check_env(env.unwrapped, skip_render_check=False)
+    vec = gym.make_vec(env_id, num_envs=3)
+    assert type(vec.unwrapped) is ACLDBeamVectorEnv and vec.unwrapped.config == preset(env_id)
+    obs, _ = vec.reset(seed=0)
+    obs, r, *_ = vec.step(np.full((3, 1), 50.0, np.float32))
+    assert obs.shape == (3, 9) and np.isfinite(r).all()
+
+
+def test_preset_values_are_their_sources():
+    from acld_gym.envs.presets import HARD, LAB
+    from acld_gym.physics.actuator import REFERENCE_SLEW_RATE
+
+    assert LAB["slew_rate"] == pytest.approx(REFERENCE_SLEW_RATE, rel=1e-3)
+    assert LAB["sensor_noise"] == pytest.approx(6.23167e-5 * 10e-3 / np.sqrt(12), rel=1e-2)
+    assert LAB["actuator_delay"] == 1 and HARD["obs_mode"] == "measurement"
+    assert {k: HARD[k] for k in LAB} == LAB  # the hard level is the lab rig and more

@@ -117,13 +117,12 @@ def reference_policies(env_id: str = DEFAULT_ENV_ID) -> dict:
     report the evaluation, never in training)."""
     from baselines.policies import LQRPolicy, MPCPolicy, PassivePolicy, SMCPolicy
 
-    env = _make_env(env_id, 1)
-    nom = env.nom
+    env = _make_env(env_id, 1)  # designed for its observation (measurement: own observer)
     return {
-        "passive": PassivePolicy(nom=nom),
-        "lqr": LQRPolicy(nom=nom),
-        "smc": SMCPolicy(nom=nom),
-        "mpc": MPCPolicy(nom=nom),
+        "passive": PassivePolicy.for_env(env),
+        "lqr": LQRPolicy.for_env(env),
+        "smc": SMCPolicy.for_env(env),
+        "mpc": MPCPolicy.for_env(env),
     }
 
 

@@ -5,12 +5,15 @@ registered id).
 [--plots DIR]`` prints a table per case (peak [mm], 5 % settling [s], ISE [m^2 s], max |V|
 [V], return) for passive, LQR, SMC, MPC and the clairvoyant bound, all with the +/-120 V
 limit, 1 ms control and the default Kalman observer, in the configuration of ``--env-id``
-(default ``ACLDBeam-v1``; ``--mesh`` replaces its mesh); on the thesis mesh it also prints
-the saturated LQR/SMC rows against thesis Table 2. The policies are designed on the env's
-nominal model (:meth:`baselines.policies.LQRPolicy.for_env`: through the measurement
-observation they run the nominal observer themselves) and the bound has the env's actuator
-inside. Any object with SB3's
-``predict`` can be evaluated with :func:`rollout`, so trained agents use the same
+(default ``ACLDBeam-v1``; ``--mesh`` replaces its mesh), with each policy's effort (RMS
+voltage, amplifier reactive power, chattering and time at the limit after the tip has
+settled: :mod:`baselines.analysis.effort`), and the score of each policy on the env's
+published test set (:mod:`baselines.analysis.score`, :data:`acld_gym.benchmark.TEST_SETS`;
+``--score-episodes``); on the thesis mesh it also prints the saturated LQR/SMC rows against
+thesis Table 2. The policies are designed on the env's nominal model
+(:meth:`baselines.policies.LQRPolicy.for_env`: through the measurement observation they run
+the nominal observer themselves) and the bound has the env's actuator inside. Any object
+with SB3's ``predict`` can be evaluated with :func:`rollout`, so trained agents use the same
 code; a policy that records an ``observation_fingerprint`` is checked against the
 env's before it acts.
 """
@@ -18,6 +21,7 @@ env's before it acts.
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
 from dataclasses import asdict, dataclass
@@ -40,7 +44,8 @@ from acld_gym.util.validate import arg_type
 
 __all__ = ["EvalRow", "Episode", "rollout", "check_compatible", "bound_episode", "episode_rows",
            "evaluate", "default_policies", "policies_for",
-           "mean_rows", "format_tables", "format_thesis_comparison", "plot_episodes"]
+           "mean_rows", "format_tables", "format_effort", "format_thesis_comparison",
+           "add_scores", "plot_episodes"]
 
 
 @dataclass(frozen=True)
@@ -65,11 +70,19 @@ class EvalRow:
     # ``return`` is a keyword; stored as ``ret`` and written as "return".
     ret: float
     ms_per_step: float
+    # Effort (baselines.analysis.effort); the settled-window ones are NaN without a
+    # settled window (random loads).
+    rms_voltage_V: float = math.nan
+    reactive_power_var: float = math.nan
+    total_variation_V_per_s: float = math.nan
+    limit_fraction: float = math.nan
+    residual_tip_rms_m: float = math.nan
 
     def as_dict(self) -> dict:
         d = asdict(self)
         d["return"] = d.pop("ret")
-        return d
+        return {k: (None if isinstance(v, float) and not math.isfinite(v) else v)
+                for k, v in d.items()}
 
 
 def check_compatible(policy, env) -> None:
@@ -138,11 +151,17 @@ def bound_episode(env: ACLDBeamEnv) -> Episode:
 
 
 def metrics_row(case, name: str, ep: Episode) -> EvalRow:
+    from .analysis.effort import effort, settled_from
+
     dt = float(ep.t[1] - ep.t[0]) if ep.t.size > 1 else float(ep.t[0])
+    e = effort(ep.voltage, ep.y, dt, settled_from(case))
     return EvalRow(case=case, policy=name, peak_mm=peak(ep.y) * 1e3,
                    settling_s=settling_time(ep.t, ep.y), ise=float(np.sum(ep.y**2) * dt),
                    max_voltage_V=max_abs(ep.voltage), ret=float(np.sum(ep.reward)),
-                   ms_per_step=1e3 * ep.seconds_per_step)
+                   ms_per_step=1e3 * ep.seconds_per_step, rms_voltage_V=e.rms_voltage_V,
+                   reactive_power_var=e.reactive_power_var,
+                   total_variation_V_per_s=e.total_variation_V_per_s,
+                   limit_fraction=e.limit_fraction, residual_tip_rms_m=e.residual_tip_rms_m)
 
 
 def default_policies(mesh: str = "converged", dt: float = 1e-3) -> dict:
@@ -224,7 +243,27 @@ def format_tables(rows: list[EvalRow]) -> str:
             out.append(f"{r.policy:>8} {r.peak_mm:10.3f} {r.settling_s:10.3f} {r.ise:12.3e} "
                        f"{rel_l} {rel_b} {r.max_voltage_V:7.1f} {r.ret:10.1f} "
                        f"{r.ms_per_step:8.3f}")
+        out.extend(format_effort(sub))
     return "\n".join(out)
+
+
+def format_effort(rows: list[EvalRow]) -> list[str]:
+    """The effort lines of one case's rows (:mod:`baselines.analysis.effort`)."""
+    from .analysis.effort import settled_from
+
+    def num(x: float, width: int, prec: int, scale: float = 1.0) -> str:
+        return f"{x * scale:{width}.{prec}f}" if math.isfinite(x) else "-".rjust(width)
+
+    start = settled_from(rows[0].case)
+    when = f"after {start:.3f} s:" if math.isfinite(start) else "(no settled window)"
+    out = [f"{'effort':>8} {'V rms [V]':>10} {'Q [mvar]':>9}  {when:>19} {'TV [kV/s]':>9} "
+           f"{'at limit':>8} {'tip rms [um]':>12}"]
+    for r in rows:
+        out.append(f"{r.policy:>8} {r.rms_voltage_V:10.1f} {num(r.reactive_power_var, 9, 2, 1e3)}"
+                   f"  {'':>19} {num(r.total_variation_V_per_s, 9, 2, 1e-3)} "
+                   f"{num(r.limit_fraction, 7, 1, 100)}% "
+                   f"{num(r.residual_tip_rms_m, 12, 2, 1e6)}")
+    return out
 
 
 def format_thesis_comparison(rows: list[EvalRow]) -> str:
@@ -240,6 +279,23 @@ def format_thesis_comparison(rows: list[EvalRow]) -> str:
                        f"{100 * (r.peak_mm / ref.peak_mm - 1):+7.1f}% "
                        f"{100 * (r.settling_s / ref.settling_s - 1):+8.1f}%")
     return "\n".join(out)
+
+
+def add_scores(policies: dict, n_episodes: int | None, env_kwargs: dict, quiet: bool = True,
+               labels: dict | None = None, env_id: str = "ACLDBeam-v1") -> dict:
+    """Score ``policies`` on the test set of ``env_id`` (the first ``n_episodes``; 0:
+    none), print the score table, and return ``{policy: score dict}`` for the JSON rows."""
+    from .analysis.score import format_scores, score_policies
+
+    if n_episodes == 0:
+        return {}
+    scores = score_policies(policies, env_id=env_id, n_episodes=n_episodes,
+                            env_kwargs=env_kwargs, quiet=quiet)
+    where = ", ".join(f"{k}={v!r}" for k, v in env_kwargs.items()
+                      if v and (k, v) != ("mesh", "converged"))
+    text = format_scores(scores, labels)
+    print(text.replace(" random loads", f" random loads, {where}", 1) if where else text)
+    return {name: s.as_dict() for name, s in scores.items()}
 
 
 def plot_episodes(episodes: dict, directory: Path) -> None:
@@ -280,6 +336,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--mesh", choices=MESHES, default=None,
                    help="truth plant: the mesh-converged beam or the thesis mesh (default: "
                         "the configuration's)")
+    p.add_argument("--score-episodes", type=arg_type(int, 0, 100_000), default=None,
+                   help="score on the first N episodes of the test set (0: no score; "
+                        "default: all of it)")
     p.add_argument("--quiet", action="store_true", help="no progress line")
     args = p.parse_args(argv)
     try:  # unusable output paths fail now, before any computing
@@ -292,13 +351,17 @@ def main(argv: list[str] | None = None) -> int:
     config = preset(args.env_id, **({} if args.mesh is None else {"mesh": args.mesh}))
     probe = ACLDBeamEnv(config=config)  # build the design once before timing anything
     episodes: dict = {}
-    rows = evaluate(policies_for(probe), seed=args.seed, env_kwargs={"config": config},
+    policies = policies_for(probe)
+    rows = evaluate(policies, seed=args.seed, env_kwargs={"config": config},
                     episodes=episodes, quiet=args.quiet)
     print(format_tables(rows))
     if config.mesh == "thesis":
         print(format_thesis_comparison(rows))
+    mesh = {} if args.mesh is None else {"mesh": args.mesh}  # (every id has a test set)
+    scores = add_scores(policies, args.score_episodes, mesh, args.quiet, env_id=args.env_id)
     if args.json:
-        write_json(args.json, [r.as_dict() for r in rows])
+        write_json(args.json, [dict(r.as_dict(), score=scores.get(r.policy))
+                               for r in rows])
         print(f"\nwrote {args.json}")
     if args.plots:
         plot_episodes(episodes, Path(args.plots))

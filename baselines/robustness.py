@@ -40,18 +40,17 @@ __all__ = ["closed_loop_matrix", "spectral_radius", "corner_plants", "corner_stu
 
 def closed_loop_matrix(plant: SampledSystem, output: np.ndarray, observer: DiscreteObserver,
                        gain: np.ndarray) -> np.ndarray:
-    """The loop's one-period map on ``[x, xhat]`` (module docstring)."""
-    n, k = plant.Ad.shape[0], observer.n
-    lc, lp, C = observer.Lc[:, 0], observer.Lp[:, 0], observer.C[0]
-    vx = -(gain @ lc) * output          # V = vx . x + vh . xhat
-    vh = -(gain - (gain @ lc) * C)
-    b, bo = plant.Bd[:, 0], observer.B[:, 0]
-    M = np.empty((n + k, n + k))
-    M[:n, :n] = plant.Ad + np.outer(b, vx)
-    M[:n, n:] = np.outer(b, vh)
-    M[n:, :n] = np.outer(bo, vx) + np.outer(lp, output)
-    M[n:, n:] = observer.A + np.outer(bo, vh) - np.outer(lp, C)
-    return M
+    """The loop's one-period map on ``[x, xhat]`` (module docstring): the observer loop of
+    :class:`baselines.analysis.linear.ObserverLoop` with the law written on the prior
+    estimate and the measurement, :math:`V = h_x^T \\hat x + h_y y`."""
+    from .analysis.linear import LinearLaw, ObserverLoop
+
+    k = observer.n
+    lc, C = observer.Lc[:, 0], observer.C[0]
+    h = np.append(-(gain - (gain @ lc) * C), -(gain @ lc))  # V = h . [xhat, y]
+    loop = ObserverLoop(plant=plant, output=output, observer=observer, obs_map=np.eye(k + 1),
+                        observer_load=np.zeros(k))
+    return loop.closed_loop(LinearLaw(gain=h, offset=0.0))
 
 
 def spectral_radius(plant: SampledSystem, nom: NominalDesign, gain: np.ndarray,

@@ -7,7 +7,7 @@ total. The outputs go to ``results/`` as with ``make run``; stdout is discarded 
 is not a terminal, so no progress line is drawn.
 
 Not a timed test: run ``python benchmarks/bench_run.py [--no-quiet-run]`` from the
-repository's top level after ``make install`` (about two minutes on two cores).
+repository's top level after ``make install`` (about two minutes on two cores: the run twice).
 """
 
 from __future__ import annotations

@@ -25,19 +25,40 @@ def test_python_blocks_run_and_claims_hold(page):
     assert failures == []
 
 
-def _rows(text: str) -> list[list[str]]:
-    """The policy rows of evaluation tables, without the ms/step column."""
-    return [line.split()[:-1] for line in text.splitlines()
+def _rows(text: str, score: bool = False) -> list[list[str]]:
+    """The policy rows of the evaluation tables (``score``: of the score table that follows
+    them), without the ms/step column of the case tables."""
+    cases, _, scores = text.partition("\nscore on ")
+    rows = [line.split() for line in (scores if score else cases).splitlines()
             if re.match(r"^\s+(passive|lqr|smc|mpc|bound)\s", line)]
+    return [r[:-1] if len(r) == 9 else r for r in rows]  # (9 columns: a row with ms/step)
 
 
-def test_variant_tables_are_what_their_commands_print(capsys):
-    from baselines.evaluate import main
-
+def _sections() -> list[tuple[str, str]]:
     text = (DOCS / "variants.md").read_text()
     sections = re.findall(r"`python -m baselines\.evaluate --env-id (\S+)`:\n\n```\n(.*?)```",
                           text, flags=re.S)
     assert {env_id for env_id, _ in sections} == {"ACLDBeamLab-v1", "ACLDBeamHard-v1"}
-    for env_id, table in sections:
-        assert main(["--env-id", env_id, "--quiet"]) == 0
+    return sections
+
+
+def test_variant_tables_are_what_their_commands_print(capsys):
+    """The case tables (with the effort lines); the score is the slow test's."""
+    from baselines.evaluate import main
+
+    for env_id, table in _sections():
+        assert "\nscore on " in table, env_id  # the page shows the score too
+        assert main(["--env-id", env_id, "--score-episodes", "0", "--quiet"]) == 0
         assert _rows(capsys.readouterr().out) == _rows(table), env_id
+
+
+@pytest.mark.slow
+def test_variant_scores_are_what_their_commands_print(capsys):
+    """The whole output of each command, the score on the 100 test episodes included."""
+    from baselines.evaluate import main
+
+    for env_id, table in _sections():
+        assert main(["--env-id", env_id, "--quiet"]) == 0
+        out = capsys.readouterr().out
+        assert _rows(out) == _rows(table), env_id
+        assert _rows(out, score=True) == _rows(table, score=True) != [], env_id

@@ -6,13 +6,18 @@ training), runs passive / LQR / SMC / MPC, every shipped agent (``train/agents/`
 labelled by how it was trained: "from scratch" or "DAgger from MPC + RL") and the
 clairvoyant bound through ``ACLDBeam-v1`` (+/-120 V, 1 ms, default Kalman observer) and prints
 peak [mm], 5 % settling [s], ISE [m^2 s], ISE relative to LQR and to the bound,
-max |V| [V], return, and compute time per step [ms].
+max |V| [V], return, compute time per step [ms], the effort (RMS voltage, amplifier
+reactive power, chattering and time at the limit after settling,
+:mod:`baselines.analysis.effort`), and every policy's score on the published test set
+(:mod:`baselines.analysis.score`: IQM of (ISE_LQR - ISE) / (ISE_LQR - ISE_bound) with a
+95 % bootstrap interval; ``--score-episodes``).
 
 ``--param-noise X`` repeats the comparison with per-episode parameter
 randomization (every policy sees the same randomized plants; the bound knows
 the plant). ``--json PATH`` writes the rows (as ``baselines.evaluate``'s, plus
-``ise_rel_lqr`` and ``ise_rel_bound``); ``--plots DIR`` writes one figure per
-thesis case and the learning curves.
+``ise_rel_lqr``, ``ise_rel_bound`` and the policy's ``score``); ``--markdown PATH`` the
+table and the score table; ``--plots DIR`` writes one figure per thesis case and the
+learning curves.
 """
 
 from __future__ import annotations
@@ -34,6 +39,7 @@ from acld_gym.util.progress import Progress
 from acld_gym.util.validate import arg_type
 from baselines.evaluate import (
     EvalRow,
+    add_scores,
     default_policies,
     episode_rows,
     format_tables,
@@ -42,7 +48,8 @@ from baselines.evaluate import (
 )
 
 __all__ = ["AGENTS_DIR", "HELDOUT_SEEDS", "agent_names", "load_agents", "training_labels",
-           "compare", "relative", "markdown_table", "plot_learning_curves", "main"]
+           "compare", "relative", "markdown_table", "markdown_scores", "plot_learning_curves",
+           "main"]
 
 AGENTS_DIR = Path(__file__).resolve().parent / "agents"
 #: Seeds of the held-out random-load episodes (training uses seeds < 1000 per sub-env).
@@ -122,15 +129,44 @@ def relative(rows: list[EvalRow], labels: dict | None = None) -> list[dict]:
 
 
 def markdown_table(rows: list[dict]) -> str:
-    """The comparison as one markdown table (rows from :func:`relative`)."""
+    """The comparison as one markdown table (rows from :func:`relative`); the effort after
+    settling is "-" where there is no settled window (random loads)."""
+    def num(x, fmt: str, scale: float = 1.0) -> str:
+        return "-" if x is None else format(x * scale, fmt)
+
     head = ("| case | policy | trained | peak [mm] | settling [s] | ISE [m^2 s] | ISE / LQR "
-            "| ISE / bound | max abs V [V] | ms / step |")
-    out = [head, "|---|---|---|---|---|---|---|---|---|---|"]
+            "| ISE / bound | max abs V [V] | V rms [V] | Q [mvar] | TV after settling [kV/s] "
+            "| at limit after settling | ms / step |")
+    out = [head, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for d in rows:
         out.append(f"| {d['case']} | {d['policy']} | {d.get('training', '')} "
                    f"| {d['peak_mm']:.3f} | {d['settling_s']:.3f} "
                    f"| {d['ise']:.3e} | {d['ise_rel_lqr']:.2f} | {d['ise_rel_bound']:.2f} "
-                   f"| {d['max_voltage_V']:.0f} | {d['ms_per_step']:.3f} |")
+                   f"| {d['max_voltage_V']:.0f} | {num(d.get('rms_voltage_V'), '.1f')} "
+                   f"| {num(d.get('reactive_power_var'), '.1f', 1e3)} "
+                   f"| {num(d.get('total_variation_V_per_s'), '.1f', 1e-3)} "
+                   f"| {num(d.get('limit_fraction'), '.0%')} | {d['ms_per_step']:.3f} |")
+    return "\n".join(out)
+
+
+def markdown_scores(rows: list[dict]) -> str:
+    """The score of each policy (one row per policy, from the ``score`` of :func:`relative`'s
+    rows) as a markdown table."""
+    seen: dict[str, dict] = {}
+    for d in rows:
+        if d.get("score") is not None:
+            seen.setdefault(d["policy"], d)
+    if not seen:
+        return ""
+    first = next(iter(seen.values()))["score"]
+    out = [f"Score on `{first['test_set']}` ({first['n_episodes']} random loads): IQM of "
+           "(ISE_LQR - ISE) / (ISE_LQR - ISE_bound) per episode, 95 % bootstrap CI "
+           "(LQR 0, clairvoyant bound 1).", "",
+           "| policy | trained | score (IQM) | 95 % CI |", "|---|---|---|---|"]
+    for name, d in seen.items():
+        sc = d["score"]
+        out.append(f"| {name} | {d.get('training', '')} | {sc['iqm']:.3f} "
+                   f"| [{sc['ci_low']:.3f}, {sc['ci_high']:.3f}] |")
     return "\n".join(out)
 
 
@@ -193,6 +229,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="seed of the thesis-case episodes")
     p.add_argument("--mesh", choices=MESHES, default="converged",
                    help="truth plant (default: the converged beam); the agents trained on it")
+    p.add_argument("--score-episodes", type=arg_type(int, 0, 100_000), default=None,
+                   help="score on the first N episodes of the test set (0: no score; "
+                        "default: all of it)")
     p.add_argument("--quiet", action="store_true", help="no progress line")
     return p
 
@@ -224,11 +263,16 @@ def main(argv: list[str] | None = None) -> int:
     print(f"Agents vs reference policies{title}; 'random' = mean over {len(seeds)} "
           "held-out random-load episodes")
     print(format_tables(rows))
+    env_kwargs = {"param_noise": args.param_noise, "mesh": args.mesh}
+    scores = add_scores(policies, args.score_episodes, env_kwargs, args.quiet, labels)
+    table = [dict(d, score=scores.get(d["policy"])) for d in relative(rows, labels)]
     if args.json:
-        write_json(args.json, relative(rows, labels))
+        write_json(args.json, table)
         print(f"\nwrote {args.json}")
     if args.markdown:
-        write_text(args.markdown, markdown_table(relative(rows, labels)) + "\n")
+        scored = markdown_scores(table)
+        write_text(args.markdown, markdown_table(table) + "\n" + (f"\n{scored}\n" if scored
+                                                                   else ""))
         print(f"wrote {args.markdown}")
     if args.plots:
         plot_episodes(episodes, Path(args.plots))

@@ -1,1 +1,2 @@
-"""Tools every layer uses: validation, atomic files, BLAS threads, progress lines."""
+"""Tools every layer uses: validation, atomic files, BLAS threads, progress lines,
+aggregate statistics (IQM and bootstrap intervals)."""

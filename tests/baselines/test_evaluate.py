@@ -9,6 +9,8 @@ from baselines.evaluate import evaluate, format_tables, main
 from baselines.policies import LQRPolicy, PassivePolicy
 
 KEYS = {"case", "policy", "peak_mm", "settling_s", "ise", "max_voltage_V", "return"}
+EFFORT = {"rms_voltage_V", "reactive_power_var", "total_variation_V_per_s", "limit_fraction",
+          "residual_tip_rms_m"}
 
 
 def test_rows_and_relative_figures():
@@ -24,16 +26,22 @@ def test_rows_and_relative_figures():
     assert " 1.00 " in bound_line
 
 
-def test_cli_writes_json_with_issue_keys(tmp_path):
+def test_cli_writes_json_with_issue_keys(tmp_path, capsys):
     path = tmp_path / "b.json"
-    assert main(["--json", str(path)]) == 0
+    assert main(["--json", str(path), "--score-episodes", "3"]) == 0
     rows = json.loads(path.read_text())
     assert len(rows) == 15  # 3 cases x (passive, lqr, smc, mpc, bound)
     for r in rows:
-        assert KEYS <= set(r)
+        assert KEYS | EFFORT <= set(r)
         assert r["policy"] in {"passive", "lqr", "smc", "mpc", "bound"}
         assert r["case"] in (1, 2, 3)
         assert np.isfinite(r["ise"]) and r["max_voltage_V"] <= 120.0 + 1e-9
+        assert 0 <= r["limit_fraction"] <= 1 and r["rms_voltage_V"] <= 120.0
+        assert r["score"]["n_episodes"] == 3
+    score = {r["policy"]: r["score"]["iqm"] for r in rows}
+    assert score["lqr"] == 0.0 and score["bound"] == 1.0 and score["passive"] < 0
+    out = capsys.readouterr().out
+    assert "score on ACLDBeam-v1/test-v1 (3 random loads" in out and "TV [kV/s]" in out
 
 
 def test_cli_bad_argument_exits_2(capsys):

@@ -8,17 +8,8 @@ import pytest
 
 from acld_gym.design.discrete import discretize
 from acld_gym.envs.beam_env import COMPILED_STEP, ACLDBeamEnv
-from acld_gym.physics.actuator import (
-    EPSILON_0,
-    PZT_PERMITTIVITY,
-    REFERENCE_SLEW_RATE,
-    V_LIMIT,
-    patch_capacitance,
-    slew_rate,
-    with_amplifier,
-)
+from acld_gym.physics.actuator import V_LIMIT, with_amplifier
 from acld_gym.physics.loads import TipLoad
-from acld_gym.physics.params import BeamParameters
 
 PATHS = [True, False] if COMPILED_STEP else [False]
 QUIET = TipLoad(())  # no load: the response is the voltage's alone
@@ -132,17 +123,6 @@ def test_options_are_off_by_default_and_v1_is_unchanged():
         assert _run(u, **kw).tobytes() == ref.tobytes()
     env = ACLDBeamEnv()
     assert env.batch.layout.z_size == 67 and env.batch.layout.out_voltage is None
-
-
-def test_patch_capacitance_and_the_reference_slew_rate():
-    p = BeamParameters()
-    c = patch_capacitance(p)
-    assert c == pytest.approx(EPSILON_0 * PZT_PERMITTIVITY * 0.09 * 0.015 / 0.001)
-    assert c == pytest.approx(22.7e-9, rel=1e-3)
-    assert REFERENCE_SLEW_RATE == pytest.approx(0.095 / c) == slew_rate(0.095, c)
-    # thinner patch, more capacitance, slower voltage for the same current
-    thin = patch_capacitance(BeamParameters(pzt_thickness=0.5e-3))
-    assert thin == pytest.approx(2 * c)
 
 
 @pytest.mark.parametrize("kw, name", [

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from stepping import single_rollout
 
 from acld_gym.envs.beam_env import COMPILED_STEP, ACLDBeamEnv
 from acld_gym.envs.presets import PRESETS
@@ -63,29 +64,6 @@ def _actions(seed=0):
     return np.random.default_rng(seed).uniform(-150, 150, (STEPS, N, 1)).astype(np.float32)
 
 
-def _single(kw, compiled, acts, seed=11):
-    """N single envs driven as a NEXT_STEP vector env would be."""
-    envs = [ACLDBeamEnv(**kw) for _ in range(N)]
-    for e in envs:
-        e.compiled_step = compiled
-    out = [e.reset(seed=seed + i) for i, e in enumerate(envs)]
-    steps = [(np.array([o for o, _ in out]), None, None, None, [i for _, i in out])]
-    done = [False] * N
-    for a in acts:
-        rows = []
-        for i, e in enumerate(envs):
-            if done[i]:
-                o, info = e.reset()
-                r, te, tr = 0.0, False, False
-            else:
-                o, r, te, tr, info = e.step(a[i])
-            done[i] = te or tr
-            rows.append((o, r, te, tr, info))
-        o, r, te, tr, info = zip(*rows, strict=True)
-        steps.append((np.array(o), np.array(r), np.array(te), np.array(tr), list(info)))
-    return steps
-
-
 def _vector(kw, compiled, acts, seed=11):
     env = ACLDBeamVectorEnv(num_envs=N, **kw)
     env.compiled_step = compiled
@@ -129,10 +107,10 @@ def test_single_vector_and_compiled_steps_agree_on_every_option(name):
     kw["episode_length"] = 50 * kw.get("dt", 1e-3)  # 50 steps
     acts = _actions()
     paths = [True, False] if COMPILED_STEP else [False]
-    ref = [_as_vector(s) for s in _single(kw, False, acts)]  # single env, numpy
+    ref = [_as_vector(s) for s in single_rollout(kw, N, acts, compiled=False)]  # single env, numpy
     for compiled in paths:
         if compiled:
-            got = [_as_vector(s) for s in _single(kw, True, acts)]
+            got = [_as_vector(s) for s in single_rollout(kw, N, acts, compiled=True)]
             _assert_same(got, ref, f"{name}: single compiled vs numpy")
         vec = _vector(kw, compiled, acts)
         done = _assert_same(vec, ref, f"{name}: vector (compiled={compiled}) vs single")

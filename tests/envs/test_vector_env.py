@@ -6,36 +6,15 @@ import gymnasium as gym
 import numpy as np
 import pytest
 from gymnasium.vector import AutoresetMode
+from stepping import single_rollout
 
 import acld_gym  # noqa: F401  (registers ACLDBeam-v1)
-from acld_gym.envs.beam_env import ACLDBeamEnv
 from acld_gym.envs.sb3 import SB3VecEnv
 from acld_gym.envs.step import INFO_KEYS
 from acld_gym.envs.vector_env import ACLDBeamVectorEnv
 
 N = 3
 SHORT = 0.05  # 50-step episodes: 120 steps cross two autoresets
-
-
-def _single_rollout(kw, seed, acts):
-    """N single envs driven as a NEXT_STEP vector env would be."""
-    envs = [ACLDBeamEnv(**kw) for _ in range(N)]
-    out = [e.reset(seed=seed + i) for i, e in enumerate(envs)]
-    steps = [(np.array([o for o, _ in out]), None, None, None, [i for _, i in out])]
-    done = [False] * N
-    for a in acts:
-        rows = []
-        for i, e in enumerate(envs):
-            if done[i]:
-                o, info = e.reset()
-                r, te, tr = 0.0, False, False
-            else:
-                o, r, te, tr, info = e.step(a[i])
-            done[i] = te or tr
-            rows.append((o, r, te, tr, info))
-        o, r, te, tr, info = zip(*rows, strict=True)
-        steps.append((np.array(o), np.array(r), np.array(te), np.array(tr), list(info)))
-    return steps
 
 
 def _vector_rollout(kw, seed, acts):
@@ -59,7 +38,7 @@ def _vector_rollout(kw, seed, acts):
 def test_equal_trajectories_with_single_env_across_autoresets(kw):
     kw = dict(kw, episode_length=SHORT)
     acts = np.random.default_rng(0).uniform(-150, 150, (120, N, 1)).astype(np.float32)
-    single = _single_rollout(kw, 11, acts)
+    single = single_rollout(kw, N, acts, seed=11)
     vec = _vector_rollout(kw, 11, acts)
     n_done = 0
     for (so, sr, ste, str_, sinfo), (vo, vr, vte, vtr, vinfo) in zip(single, vec, strict=True):

@@ -1,0 +1,154 @@
+r"""The score's references on a test set: LQR's and the clairvoyant bound's ISE per episode,
+computed once per test set and cached.
+
+For each episode of an :class:`acld_gym.benchmark.EvaluationSet` (its seed, through the env
+as :func:`baselines.evaluate.rollout` runs it) the reference is LQR's ISE
+(:class:`baselines.policies.LQRPolicy` on the env's nominal design) and the bound's
+(:func:`baselines.evaluate.bound_episode`, 20-120 ms an episode on one BLAS thread). A
+hundred episodes take about 7 s, so they are cached in the user cache
+(:func:`acld_gym.physics.plant_cache.user_cache_dir`), in a JSON file whose name carries a
+key: the SHA-256 of the test set, the env arguments, the env's whole configuration
+(:class:`acld_gym.envs.config.EnvConfig`: the actuator, temperature and parameter-noise
+settings of a preset too), its observation fingerprint (its design and observer) and the
+package version.
+
+A cached file is validated before use: its format, key, seeds and lengths, every ISE
+finite and positive, the bound's below LQR's, and a spot check -- the first episode is run
+again and must give the same two ISE to :data:`SPOT_RTOL`. A file that fails is recomputed
+and rewritten (atomically), with a note on stderr; an unwritable cache only costs the time.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+
+import acld_gym
+from acld_gym.benchmark import EvaluationSet
+from acld_gym.envs.fingerprint import observation_fingerprint
+from acld_gym.physics.plant_cache import user_cache_dir
+from acld_gym.util.atomic import write_json
+from acld_gym.util.progress import Progress
+
+__all__ = ["References", "references", "reference_episode", "make_env", "cache_path",
+           "FORMAT", "SPOT_RTOL"]
+
+#: Version of the cache files' layout and of the way references are computed.
+FORMAT = 1
+#: Relative agreement of the spot check's re-run with the cached first episode.
+SPOT_RTOL = 1e-6
+
+
+@dataclass(frozen=True)
+class References:
+    """LQR's and the bound's ISE [m^2 s] on each episode of the test set ``name``."""
+
+    name: str
+    seeds: tuple[int, ...]
+    lqr_ise: np.ndarray
+    bound_ise: np.ndarray
+
+
+def make_env(test: EvaluationSet, env_kwargs: dict | None = None):
+    """The env of the test set's episodes (``gym.make``, its load case)."""
+    return gym.make(test.env_id, load_case=test.load_case, **(env_kwargs or {}))
+
+
+def reference_episode(env, seed: int) -> tuple[float, float]:
+    """``(LQR's ISE, the bound's ISE)`` of the episode ``seed`` of ``env``."""
+    from baselines.evaluate import bound_episode, metrics_row, rollout
+    from baselines.policies import LQRPolicy
+
+    lqr = metrics_row("test", "lqr", rollout(LQRPolicy.for_env(env), env, seed=seed)).ise
+    env.reset(seed=seed)
+    bound = metrics_row("test", "bound", bound_episode(env)).ise
+    return lqr, bound
+
+
+def _key(test: EvaluationSet, env_kwargs: dict, env) -> str:
+    blob = json.dumps({"format": FORMAT, "test_set": test.name, "env_id": test.env_id,
+                       "seeds": list(test.seeds), "load_case": test.load_case,
+                       "env_kwargs": env_kwargs, "acld_gym": acld_gym.__version__,
+                       "config": repr(env.unwrapped.config),  # actuator, temperature, ...
+                       "observation": observation_fingerprint(env)}, sort_keys=True)
+    return hashlib.sha256(blob.encode()).hexdigest()[:16]
+
+
+def cache_path(test: EvaluationSet, key: str) -> Path:
+    safe = test.name.replace("/", "_")
+    return user_cache_dir() / f"references-{safe}-{len(test.seeds)}-{key}.json"
+
+
+def _validated(path: Path, test: EvaluationSet, key: str, env) -> References | None:
+    """The file's references if every check of the module docstring passes, else None
+    (with the reason on stderr)."""
+    def reject(why: str) -> None:
+        print(f"baselines: recomputing the references of {test.name} ({path}: {why})",
+              file=sys.stderr)
+
+    try:
+        rec = json.loads(path.read_text())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        reject(f"unreadable: {exc}")
+        return None
+    if not isinstance(rec, dict) or rec.get("format") != FORMAT or rec.get("key") != key:
+        reject("another format or key")
+        return None
+    if rec.get("seeds") != list(test.seeds):
+        reject("other seeds")
+        return None
+    try:
+        lqr = np.asarray(rec["lqr_ise"], dtype=float)
+        bound = np.asarray(rec["bound_ise"], dtype=float)
+    except (KeyError, TypeError, ValueError):
+        reject("no ISE arrays")
+        return None
+    n = len(test.seeds)
+    if lqr.shape != (n,) or bound.shape != (n,):
+        reject("wrong lengths")
+        return None
+    if not (np.all(np.isfinite(lqr)) and np.all(np.isfinite(bound)) and np.all(bound > 0)):
+        reject("non-finite or non-positive ISE")
+        return None
+    if np.any(bound > lqr * (1 + 1e-9)):
+        reject("a bound above LQR")
+        return None
+    spot = reference_episode(env, test.seeds[0])
+    if not np.allclose(spot, (lqr[0], bound[0]), rtol=SPOT_RTOL, atol=0.0):
+        reject(f"the first episode gives {spot}, the file {lqr[0], bound[0]}")
+        return None
+    return References(test.name, test.seeds, lqr, bound)
+
+
+def references(test: EvaluationSet, env_kwargs: dict | None = None, cache: bool = True,
+               quiet: bool = True) -> References:
+    """The references of ``test`` (from the validated cache, else computed and cached);
+    a progress line on a terminal unless ``quiet``."""
+    kwargs = dict(env_kwargs or {})
+    env = make_env(test, kwargs)
+    key = _key(test, kwargs, env)
+    path = cache_path(test, key)
+    if cache and path.is_file():
+        refs = _validated(path, test, key, env)
+        if refs is not None:
+            return refs
+    n = len(test.seeds)
+    lqr, bound = np.empty(n), np.empty(n)
+    with Progress(n, f"references {test.name}", quiet) as progress:
+        for i, s in enumerate(test.seeds):
+            progress.stage(f"episode {i + 1}/{n}")
+            lqr[i], bound[i] = reference_episode(env, s)
+    if cache:
+        try:
+            write_json(path, {"format": FORMAT, "key": key, "test_set": test.name,
+                              "seeds": list(test.seeds), "lqr_ise": lqr.tolist(),
+                              "bound_ise": bound.tolist()})
+        except OSError:
+            pass  # a read-only cache: computed again next time
+    return References(test.name, test.seeds, lqr, bound)

@@ -1,0 +1,72 @@
+"""train.compare's effort columns and score table, and the shipped comparison's scores: they
+order the policies as their mean ISE on the same test episodes wherever the intervals
+separate them (train/agents/compare.json, written by python -m train.compare)."""
+
+import itertools
+import json
+
+import pytest
+
+from train.compare import AGENTS_DIR, main, markdown_scores, markdown_table
+
+ROWS = json.loads((AGENTS_DIR / "compare.json").read_text())
+
+
+def _scores():
+    out = {}
+    for r in ROWS:
+        out.setdefault(r["policy"], r["score"])
+    return out
+
+
+def test_every_policy_of_the_shipped_table_has_a_full_score():
+    scores = _scores()
+    assert {"passive", "lqr", "smc", "mpc", "bound"} <= set(scores)
+    for name, s in scores.items():
+        assert s["n_episodes"] >= 100 and s["test_set"] == "ACLDBeam-v1/test-v1", name
+        assert s["ci_low"] <= s["iqm"] <= s["ci_high"]
+    assert scores["lqr"]["iqm"] == 0.0 and scores["bound"]["iqm"] == 1.0
+    assert scores["passive"]["iqm"] < 0
+
+
+def test_scores_order_the_policies_as_their_mean_ise_where_the_intervals_separate():
+    scores = _scores()
+    separated = 0
+    for (a, sa), (b, sb) in itertools.combinations(scores.items(), 2):
+        if sa["ci_low"] > sb["ci_high"]:
+            assert sa["mean_ise"] < sb["mean_ise"], (a, b)
+            separated += 1
+        elif sb["ci_low"] > sa["ci_high"]:
+            assert sb["mean_ise"] < sa["mean_ise"], (a, b)
+            separated += 1
+    assert separated >= len(scores)  # most pairs are separated
+
+
+def test_effort_columns_in_the_shipped_table():
+    for r in ROWS:
+        assert r["rms_voltage_V"] is not None and r["rms_voltage_V"] <= 120.0
+        if r["case"] == "random":
+            assert r["total_variation_V_per_s"] is None  # no settled window
+        else:
+            assert 0.0 <= r["limit_fraction"] <= 1.0
+
+
+def test_the_markdown_has_the_effort_and_the_score(tmp_path, capsys):
+    md, js = tmp_path / "c.md", tmp_path / "c.json"
+    argv = ["--only", "vrs", "--random-episodes", "1", "--score-episodes", "2", "--quiet",
+            "--markdown", str(md), "--json", str(js)]
+    assert main(argv) == 0
+    text = md.read_text()
+    assert "| V rms [V] | Q [mvar] | TV after settling [kV/s] |" in text
+    assert "| vrs | from scratch |" in text and "95 % CI" in text
+    rows = json.loads(js.read_text())
+    assert markdown_table(rows) in text and markdown_scores(rows) in text
+    assert {r["score"]["n_episodes"] for r in rows} == {2}
+    assert "score on ACLDBeam-v1/test-v1 (2 random loads" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("argv, word", [(["--score-episodes", "-1"], "--score-episodes")])
+def test_bad_score_episodes_exit_2(argv, word, capsys):
+    with pytest.raises(SystemExit) as e:
+        main(argv)
+    assert e.value.code == 2 and word in capsys.readouterr().err

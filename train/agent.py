@@ -129,6 +129,7 @@ def export_sb3(model, obs_norm=None) -> ActorProgram:
     import torch.nn as nn
     from stable_baselines3.common.torch_layers import FlattenExtractor
 
+    from .bench.sb3_policies import DropLast
     from .features import DirectionFeatures
 
     ops: list[dict] = []
@@ -141,6 +142,8 @@ def export_sb3(model, obs_norm=None) -> ActorProgram:
     extractor, layers, squash = actor_parts(model)
     if isinstance(extractor, DirectionFeatures):
         ops.append({"op": "direction"})
+    elif isinstance(extractor, DropLast):  # an asymmetric agent: the actor never read the
+        pass  # appended log(reward scale), and the deployed env does not append it
     elif not isinstance(extractor, FlattenExtractor):
         raise TypeError(f"export_sb3 supports the flatten or direction features only, got "
                         f"{type(extractor).__name__}")

@@ -24,8 +24,9 @@ import numpy as np
 from acld_gym.design.discrete import SampledSystem
 from acld_gym.envs.checks import check_actions
 from acld_gym.envs.config import EnvConfig
-from acld_gym.envs.episode import fixed_plant
+from acld_gym.envs.episode import fixed_plant, passive_plant
 from acld_gym.envs.loadcode import LoadCodes
+from acld_gym.envs.scale import PassiveCost
 from acld_gym.envs.step import (
     INFO_KEYS,
     OBS_HIST,
@@ -108,7 +109,14 @@ class BatchStep:
         self.observer = obs = nom.observer(c.observer)
         self.est = estimate_map(obs, nom.xr_scale)
         self.layout = lay = StepLayout.of(c, nom, obs)
-        self.n_obs = observation_size(nom, c.obs_mode)
+        #: The observation's size: the design's (:func:`acld_gym.envs.step.observation_size`),
+        #: plus log(reward scale) last with ``observe_reward_scale``.
+        self.n_obs = observation_size(nom, c.obs_mode) + int(c.observe_reward_scale)
+        #: The reward scale c of each env's episode (:mod:`acld_gym.envs.scale`; ones
+        #: unless ``reward_scale``): every reward is divided by it.
+        self.reward_scale = np.ones(N)
+        self.passive_cost = (PassiveCost(passive_plant(nom, c), nom.output, self.steps, c.y_ref)
+                             if c.reward_scale == "passive" else None)
         #: The configuration's plant (the nominal one, shifted to its temperature, with its
         #: amplifier); an episode's own when drawn (param_noise, temperature_range).
         self.base_plant = fixed_plant(nom, c)
@@ -148,7 +156,8 @@ class BatchStep:
             GT=self.GT if self.GT_env is None else self.GT_env, Z=self.Z, OUT=self.OUT, k=self.k,
             noise=self.noise, y_hist=self.y_hist, comp=self.codes.comp, ncomp=self.codes.ncomp,
             pool=self.codes.pool, times=self.times, **self.layout.core_kwargs(),
-            obs_mode=("estimate", "measurement", "full").index(c.obs_mode), n_obs=self.n_obs,
+            obs_mode=("estimate", "measurement", "full").index(c.obs_mode),
+            n_obs=self.n_obs - int(c.observe_reward_scale),
             dt=c.dt, y_ref=c.y_ref, lam=c.lam, v_max=V_LIMIT, limit=c.deflection_limit,
             y_scale=Y_SCALE, slew_step=c.slew_step or 0.0, dgemm=_dgemm())
 
@@ -182,6 +191,8 @@ class BatchStep:
                 self.GT_env[i] = self.fused_matrix(plant).T if plant is not self.base_plant \
                     else self.GT
             self.plants[i] = plant
+        if self.passive_cost is not None:
+            self.reward_scale[rows] = self.passive_cost([loads[j] for j in range(len(rows))])
         if self.compiled and self.codes.version != self._codes_version:
             self.core.set_loads(self.codes.comp, self.codes.ncomp, self.codes.pool)
             self._codes_version = self.codes.version
@@ -205,13 +216,13 @@ class BatchStep:
         if core is not None:
             res = core.step(actions)  # None unless finite float32/float64 of the right shape
             if res is not None:
-                return res
+                return self.scaled(res)
         requested, v = check_actions(actions, self.num_envs, V_LIMIT, vector=True)
         if core is not None:  # the checked, clipped voltages step compiled
             res = core.step(v)
             res[4]["requested_voltage"] = requested
             res[4]["clipped"] = requested != v
-            return res
+            return self.scaled(res)
         r = self.advance(v)
         values = (r.y, r.voltage, requested, requested != v, r.tip_load, self.k * self.config.dt,
                   r.xr,
@@ -221,7 +232,44 @@ class BatchStep:
         for key, val in zip(INFO_KEYS, values, strict=True):
             info[key] = val
             info["_" + key] = ones
+        self.scale_info(info)
         return r.obs, r.reward, r.code != 0, r.truncated, info
+
+    # --- the reward scale (acld_gym.envs.scale) ----------------------------------------------
+    def scaled(self, res):
+        """A compiled vector step's 5-tuple with the reward scale applied (the reward divided
+        by :attr:`reward_scale`, ``info["reward_scale"]``, log c appended to the
+        observation): ``res`` itself without ``reward_scale``."""
+        if self.passive_cost is None:
+            return res
+        obs, reward, terminated, truncated, info = res
+        self.scale_info(info)
+        return self._append_scale(obs), reward / self.reward_scale, terminated, truncated, info
+
+    def scaled_one(self, res):
+        """:meth:`scaled` for the compiled ``step_one`` of env 0 (None stays None)."""
+        if res is None or self.passive_cost is None:
+            return res
+        obs, reward, terminated, truncated, info = res
+        s = float(self.reward_scale[0])
+        info["reward_scale"] = s
+        if self.config.observe_reward_scale:
+            obs = np.append(obs, np.float32(np.log(s)))
+        return obs, reward / s, terminated, truncated, info
+
+    def scale_info(self, info: dict, rows=None) -> None:
+        """Add ``info["reward_scale"]`` (and its mask) of ``rows`` (default all) to a vector
+        info, with ``reward_scale`` set."""
+        if self.passive_cost is not None:
+            s = self.reward_scale if rows is None else self.reward_scale[rows]
+            info["reward_scale"] = s.copy()
+            info["_reward_scale"] = np.ones(s.shape, dtype=bool)
+
+    def _append_scale(self, obs: np.ndarray, rows=None) -> np.ndarray:
+        if not self.config.observe_reward_scale:
+            return obs
+        s = self.reward_scale if rows is None else self.reward_scale[rows]
+        return np.concatenate([obs, np.log(s).astype(np.float32)[:, None]], axis=-1)
 
     def advance(self, v: np.ndarray, inputs: np.ndarray | None = None) -> StepResult:
         """The step in numpy (the reference of the compiled one): voltages ``v`` (N,) [V]
@@ -246,6 +294,8 @@ class BatchStep:
         y = self.OUT[:, lay.out_y].copy()
         volts = v if lay.out_voltage is None else self.OUT[:, lay.out_voltage].copy()
         reward, r_y, r_v = reward_terms(y, volts, c.y_ref, c.lam, V_LIMIT)
+        if self.passive_cost is not None:
+            reward = reward / self.reward_scale
         return StepResult(obs=self.observations(), reward=reward, reward_deflection=r_y,
                           reward_voltage=r_v,
                           code=termination_codes(y, reward, self.OUT, c.deflection_limit),
@@ -277,7 +327,7 @@ class BatchStep:
                                   self.Z[rows, lay.voltage, None] / V_LIMIT], axis=-1)
         else:
             out = self.Z[rows, lay.x]
-        return out.astype(np.float32)
+        return self._append_scale(out.astype(np.float32), rows)
 
     def tip_loads(self, rows=None) -> np.ndarray:
         """The tip load [N] of ``rows`` (default all) at their current time ``k dt``."""

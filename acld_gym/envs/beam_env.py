@@ -278,9 +278,7 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
 
     def __setstate__(self, state):
         self.__dict__.update(state)
-        core = self._batch.core
-        self._fast = _not_reset if not self._started else (
-            core.step_one if core is not None else _no_fast_path)
+        self._fast = _not_reset if not self._started else self._fast_step()
 
     # --- Gymnasium API --------------------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict | None = None):
@@ -296,14 +294,26 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
         self.load = load
         self.history = []
         self._started = True
-        core = self._batch.core
-        self._fast = core.step_one if core is not None else _no_fast_path
+        self._fast = self._fast_step()
         b = self._batch
         info = {"tip_deflection": 0.0, "voltage": 0.0, "requested_voltage": 0.0,
                 "clipped": False, "tip_load": float(b.tip_loads()[0]), "time": 0.0,
                 "xr_true": np.zeros(self.nom.design.reduced.order), "terminated_by": None,
                 "reward_deflection": 0.0, "reward_voltage": 0.0}
+        if b.passive_cost is not None:
+            info["reward_scale"] = float(b.reward_scale[0])
         return b.observations()[0], info
+
+    def _fast_step(self):
+        """The compiled step of this env (with the reward scale applied, if set), or
+        :func:`_no_fast_path`."""
+        b = self._batch
+        if b.core is None:
+            return _no_fast_path
+        if b.passive_cost is None:
+            return b.core.step_one
+        step_one, scaled_one = b.core.step_one, b.scaled_one
+        return lambda action: scaled_one(step_one(action))
 
     def step(self, action):
         result = self._fast(action)  # the compiled step; None where it does not apply
@@ -329,7 +339,10 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
             f = load_schedule(self.nom.plant, self.load, k, k + 1)[0]
             w = self.np_random.normal(0.0, self.sensor_noise) if self.sensor_noise else 0.0
             inputs = np.append(f[0], w)[None]
-        return _single(b.advance(v, inputs), float(requested[0]), float(v[0]), k + 1, self.dt)
+        out = _single(b.advance(v, inputs), float(requested[0]), float(v[0]), k + 1, self.dt)
+        if b.passive_cost is not None:
+            out[4]["reward_scale"] = float(b.reward_scale[0])
+        return out
 
     def render(self):
         if self.render_mode is None:

@@ -18,8 +18,11 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from acld_gym.design.nominal import SENSOR_NOISE_M
 from acld_gym.design.observer import MODEL_STD
+from acld_gym.envs.scale import REWARD_SCALES
 from acld_gym.envs.step import OBS_HIST
 from acld_gym.physics.actuator import V_LIMIT
 from acld_gym.physics.loads import TipLoad, check_load_case
@@ -109,6 +112,13 @@ class EnvConfig:
     temperature_range: tuple[float, float] | None = _f(
         None, "°C", "draw the temperature per episode, uniform in (low, high); None: "
                     "always temperature")
+    reward_scale: str | None = _f(
+        None, "-", "None (the reward as defined) or 'passive': each reward of an episode "
+                   "divided by the passive beam's mean step cost on its load "
+                   "(acld_gym.envs.scale; info['reward_scale'])")
+    observe_reward_scale: bool = _f(
+        False, "-", "append log(reward scale) to the observation as its last entry: "
+                    "privileged, for a critic only; needs reward_scale")
     env_id: str = _f("ACLDBeam-v1", "-", "the registered id this configuration belongs to "
                                          "(recorded in the observation fingerprint)")
 
@@ -151,6 +161,14 @@ class EnvConfig:
             if not lo < hi:
                 raise ValueError(f"temperature_range must have low < high [°C], got {rng!r}")
             set_(self, "temperature_range", (lo, hi))
+        check_choice("reward_scale", self.reward_scale, REWARD_SCALES)
+        if not isinstance(self.observe_reward_scale, (bool, np.bool_)):
+            raise ValueError(f"observe_reward_scale must be True or False, got "
+                             f"{self.observe_reward_scale!r}")
+        set_(self, "observe_reward_scale", bool(self.observe_reward_scale))
+        if self.observe_reward_scale and self.reward_scale is None:
+            raise ValueError("observe_reward_scale=True needs a reward_scale (e.g. "
+                             "reward_scale='passive'), got reward_scale=None")
         if not isinstance(self.env_id, str) or not self.env_id:
             raise ValueError(f"env_id must be a non-empty string, got {self.env_id!r}")
         check_episode_size(self.episode_length, self.dt)

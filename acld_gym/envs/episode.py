@@ -15,7 +15,7 @@ from acld_gym.physics.temperature import shifted_parameters
 from acld_gym.physics.uncertainty import randomized_parameters
 
 __all__ = ["reset_options", "draw_episode", "draw_noise", "fixed_plant", "sampled_plant",
-           "randomized_plant", "RESET_OPTIONS"]
+           "randomized_plant", "passive_plant", "RESET_OPTIONS"]
 
 #: The keys of ``reset(options=...)``: a named case or a TipLoad (``"load_case"``), or a
 #: TipLoad (``"load"``), for this episode only.
@@ -71,6 +71,14 @@ def fixed_plant(nom: NominalDesign, config) -> SampledSystem:
     params = shifted_parameters(nom.truth.params, config.temperature)
     return sampled_plant(nom, None if params is nom.truth.params else params,
                          config.amplifier_bandwidth)
+
+
+def passive_plant(nom: NominalDesign, config) -> SampledSystem:
+    """The configuration's plant as the load alone drives it (the reward scale's,
+    :mod:`acld_gym.envs.scale`): the nominal beam at ``config.temperature``, without the
+    amplifier (at zero voltage it does not act)."""
+    params = shifted_parameters(nom.truth.params, config.temperature)
+    return sampled_plant(nom, None if params is nom.truth.params else params, None)
 
 
 def sampled_plant(nom: NominalDesign, params, bandwidth: float | None) -> SampledSystem:

@@ -83,8 +83,9 @@ class SB3VecEnv(VecEnv):
         obs, rewards, terminated, truncated, info = v.step(self._actions)
         self._actions = None
         done = terminated | truncated
+        keys = INFO_KEYS + (("reward_scale",) if "reward_scale" in info else ())
         infos: list[dict[str, Any]] = [
-            {key: _scalar(info[key][i]) for key in INFO_KEYS} for i in range(self.num_envs)]
+            {key: _scalar(info[key][i]) for key in keys} for i in range(self.num_envs)]
         if done.any():
             ended = np.flatnonzero(done)
             for i in ended:

@@ -164,6 +164,7 @@ class ACLDBeamVectorEnv(ConfigAttributes, FigureOwner, VectorEnv):
         for key, val in zip(INFO_KEYS, vals, strict=True):
             info[key] = val
             info["_" + key] = ones
+        b.scale_info(info)
         return info
 
     # --- Gymnasium API --------------------------------------------------------------------
@@ -213,6 +214,8 @@ class ACLDBeamVectorEnv(ConfigAttributes, FigureOwner, VectorEnv):
             info[key][rows] = 0
         info["tip_load"][rows] = b.tip_loads(rows)
         info["terminated_by"][rows] = None
+        if "reward_scale" in info:  # the new episode's scale
+            info["reward_scale"][rows] = b.reward_scale[rows]
 
     def reset_done(self, indices) -> np.ndarray:
         """Reset the sub-envs ``indices`` now (each from its own generator, with the env's

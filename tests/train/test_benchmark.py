@@ -51,7 +51,7 @@ def _tiny_configs(tmp_path):
     vrs.update(timesteps=8000, loads={1: 1, "random": 1}, eval_points=2)
     vrs["model"] = {**vrs["model"], "n_directions": 2, "top_directions": 1}
     ppo = yaml.safe_load(open("train/benchmark/ppo.yaml"))
-    ppo.update(timesteps=2048, n_envs=4, eval_points=2)
+    ppo.update(timesteps=2048, n_envs=4, eval_points=2, whiten_steps=256)
     ppo["model"] = {**ppo["model"], "n_steps": 256, "batch_size": 256, "n_epochs": 1}
     paths = []
     for name, data in (("tiny_vrs", vrs), ("tiny_ppo", ppo)):
@@ -149,8 +149,8 @@ def test_fold_whitening_and_quadratic_features():
 
     feats = QuadraticFeatures(gym.spaces.Box(-1, 1, (3,)))
     x = torch.tensor([[1.0, 2.0, 3.0]])
-    assert feats.features_dim == 9
-    assert feats(x).tolist() == [[1, 2, 3, 1, 2, 3, 4, 6, 9]]
+    assert feats.features_dim == 12  # u and the flattened outer product u u^T
+    assert feats(x).tolist() == [[1, 2, 3, 1, 2, 3, 2, 4, 6, 3, 6, 9]]
     env = gym.make("Pendulum-v1")
     T = np.random.default_rng(0).normal(size=(3, 3))
     z = np.random.default_rng(1).normal(size=(5, 3)).astype(np.float32)
@@ -186,7 +186,8 @@ def torch_zeros(n):
 
 
 def test_whitening_and_actor():
-    from train.bench.search import LinearDirectionActor, whitening
+    from acld_gym.wrappers import whitening
+    from train.bench.search import LinearDirectionActor
 
     rng = np.random.default_rng(0)
     u = rng.normal(size=(5000, 3)) @ np.array([[1.0, 0.99, 0.0], [0.0, 0.1, 0.0], [0, 0, 2.0]])

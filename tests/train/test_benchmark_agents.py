@@ -10,8 +10,9 @@ import pytest
 import yaml
 
 import acld_gym  # noqa: F401  (registers the env ids)
+from acld_gym.wrappers import whitening
 from train.agent import TrainedAgent, linear_program
-from train.bench.search import LinearDirectionActor, whitening
+from train.bench.search import LinearDirectionActor
 
 
 def _observations(n=64, seed=0):

@@ -68,6 +68,13 @@ class AlgoConfig:
         root mean square (:class:`EpisodeScaledRolloutBuffer`; the critic's targets
         are unchanged): episodes whose returns differ by decades weigh alike in the
         policy gradient (normalisation per load). Use ``n_steps`` = the episode length.
+    env_kwargs : dict
+        SB3 algorithms: options of the *training* env (fields of
+        :class:`acld_gym.envs.config.EnvConfig`, e.g. ``reward_scale: passive`` and
+        ``observe_reward_scale: true``); the evaluation is always on the env id as
+        registered. With ``observe_reward_scale`` the whitening leaves the last entry
+        (log c) alone and the policy must drop it from its actor
+        (:class:`train.bench.sb3_policies.AsymmetricCriticPolicy`).
     """
 
     algo: str
@@ -80,6 +87,7 @@ class AlgoConfig:
     eval_points: int = 10
     whiten_steps: int = 0
     episode_scale: bool = False
+    env_kwargs: dict = field(default_factory=dict)
 
     def __post_init__(self):
         if self.algo not in ALGOS:
@@ -115,6 +123,18 @@ class AlgoConfig:
                 "whiten_steps needs features: null and norm_obs: false (the "
                 "trained actor takes the whitening into its first layer)"
             )
+        if not isinstance(self.env_kwargs, dict):
+            raise ValueError(f"env_kwargs must be a mapping of env options, got "
+                             f"{self.env_kwargs!r}")
+        if self.env_kwargs:
+            from acld_gym.envs.config import make_config
+
+            try:  # the training env's options, validated by the env's own config
+                make_config(**self.env_kwargs)
+            except (TypeError, ValueError) as exc:
+                raise ValueError(f"env_kwargs: {exc}") from None
+            if self.algo == "vrs":
+                raise ValueError("env_kwargs are for the SB3 algorithms (vrs has its own env)")
         if self.episode_scale and self.algo != "ppo":
             raise ValueError("episode_scale is for ppo only")
 

@@ -47,20 +47,24 @@ class VecWhiten(VecEnvWrapper):
     ``z/|z|`` seen (every sub-env, every step) are appended to it, from which
     :func:`whitening` estimates T (:func:`train_sb3` with ``whiten_steps``)."""
 
-    def __init__(self, venv: VecEnv):
+    def __init__(self, venv: VecEnv, passthrough: int = 0):
         super().__init__(venv)
-        self.transform = np.eye(venv.observation_space.shape[0])
+        self.passthrough = int(passthrough)
+        self.transform = np.eye(venv.observation_space.shape[0] - self.passthrough)
         self.collect: list | None = None
 
     def set_transform(self, transform: np.ndarray) -> None:
         self.transform = np.asarray(transform, dtype=np.float64)
 
     def _u(self, obs: np.ndarray) -> np.ndarray:
-        z = np.asarray(obs, dtype=np.float64)
+        """``[T^T z, rest]``: the last ``passthrough`` entries are not whitened."""
+        obs = np.asarray(obs, dtype=np.float64)
+        d = obs.shape[-1] - self.passthrough
+        z = obs[..., :d]
         if self.collect is not None:
             r = np.linalg.norm(z, axis=-1, keepdims=True)
             self.collect.append((z / np.maximum(r, 1e-12))[r[:, 0] > 0])
-        return (z @ self.transform).astype(np.float32)
+        return np.concatenate([z @ self.transform, obs[..., d:]], axis=-1).astype(np.float32)
 
     def reset(self) -> np.ndarray:
         return self._u(self.venv.reset())
@@ -68,8 +72,10 @@ class VecWhiten(VecEnvWrapper):
     def step_wait(self):
         obs, rewards, dones, infos = self.venv.step_wait()
         for i in np.flatnonzero(dones):
-            z = np.asarray(infos[i]["terminal_observation"], dtype=np.float64)
-            infos[i]["terminal_observation"] = (z @ self.transform).astype(np.float32)
+            terminal = np.asarray(infos[i]["terminal_observation"], dtype=np.float64)
+            d = terminal.shape[-1] - self.passthrough
+            infos[i]["terminal_observation"] = np.concatenate(
+                [terminal[:d] @ self.transform, terminal[d:]]).astype(np.float32)
         return self._u(obs), rewards, dones, infos
 
 
@@ -167,12 +173,13 @@ def make_sb3_env(cfg: AlgoConfig, seed: int, env_id: str, gamma: float = 0.99) -
 
     parts = []
     for case, n in _split_envs(cfg.load_weights, cfg.n_envs).items():
-        parts.append(SB3VecEnv(venv=gym.make_vec(env_id, num_envs=n, load_case=case).unwrapped))
+        parts.append(SB3VecEnv(venv=gym.make_vec(env_id, num_envs=n, load_case=case,
+                                                 **cfg.env_kwargs).unwrapped))
     venv: VecEnv = parts[0] if len(parts) == 1 else ConcatVecEnv(parts)
     venv.seed(seed)
     venv = VecAgentEnv(venv, residual=None, gamma=gamma, shaping=None)
-    if cfg.whiten_steps:
-        venv = VecWhiten(venv)
+    if cfg.whiten_steps:  # log c, if observed, stays as it is (the critic's scale)
+        venv = VecWhiten(venv, passthrough=int(bool(cfg.env_kwargs.get("observe_reward_scale"))))
     if cfg.features == "direction":
         venv = VecDirectionFeatures(venv)
     return VecNormalize(venv, gamma=gamma, **cfg.normalize)

@@ -10,13 +10,14 @@ import torch
 import torch.nn as nn
 from gymnasium import spaces
 from stable_baselines3.common.buffers import RolloutBuffer
-from stable_baselines3.common.policies import ActorCriticPolicy
+from stable_baselines3.common.policies import ActorCriticPolicy, ContinuousCritic
 from stable_baselines3.common.torch_layers import (
     BaseFeaturesExtractor,
     FlattenExtractor,
     MlpExtractor,
 )
 from stable_baselines3.common.vec_env import VecNormalize
+from stable_baselines3.sac.policies import SACPolicy
 
 import acld_gym  # noqa: F401  (registers the env ids)
 
@@ -26,32 +27,67 @@ __all__ = [
     "QuadraticFeatures",
     "CRITIC_FEATURES",
     "SplitCriticPolicy",
+    "AsymmetricCriticPolicy",
+    "AsymmetricSACPolicy",
+    "ScaledQuadraticCritic",
+    "DropLast",
+    "ScaledQuadraticFeatures",
     "EpisodeScaledRolloutBuffer",
     "SB3Policy",
 ]
 
 
 class QuadraticFeatures(BaseFeaturesExtractor):
-    r"""Features :math:`[u,\ u_i u_j\ (i \le j)]` of the observation u (d + d(d+1)/2
-    values): a linear value on them is a quadratic form plus a linear term, the
-    shape of a linear-quadratic problem's value function."""
+    r"""Features :math:`[u,\ u u^T]` of the observation u (d + d^2 values, the outer
+    product flattened): a linear value on them is a quadratic form plus a linear term, the
+    shape of a linear-quadratic problem's value function. (The outer product holds each
+    :math:`u_i u_j` twice, which a linear layer does not mind; it costs one broadcast
+    product, where gathering the :math:`i \le j` entries costs an indexed gather and its
+    scatter in the backward pass, 10x slower on a CPU.)"""
 
     def __init__(self, observation_space: spaces.Box):
         d = int(observation_space.shape[0])
-        super().__init__(observation_space, features_dim=d + d * (d + 1) // 2)
-        i, j = np.triu_indices(d)
-        self.register_buffer("_i", torch.as_tensor(i), persistent=False)
-        self.register_buffer("_j", torch.as_tensor(j), persistent=False)
+        super().__init__(observation_space, features_dim=d + d * d)
 
     def forward(self, observations: torch.Tensor) -> torch.Tensor:
-        return torch.cat(
-            [observations, observations[:, self._i] * observations[:, self._j]], dim=-1
-        )
+        outer = observations.unsqueeze(2) * observations.unsqueeze(1)
+        return torch.cat([observations, outer.flatten(1)], dim=-1)
+
+
+class DropLast(BaseFeaturesExtractor):
+    """The observation without its last entry: the actor of an asymmetric actor-critic,
+    which must not read the privileged log(reward scale) the env appends
+    (``observe_reward_scale``, :mod:`acld_gym.envs.scale`)."""
+
+    def __init__(self, observation_space: spaces.Box):
+        super().__init__(observation_space, features_dim=int(observation_space.shape[0]) - 1)
+
+    def forward(self, observations: torch.Tensor) -> torch.Tensor:
+        return observations[:, :-1]
+
+
+class ScaledQuadraticFeatures(QuadraticFeatures):
+    r"""Quadratic features (:class:`QuadraticFeatures`) of :math:`u / \sqrt{c}`, where the
+    observation is :math:`[u, \log c]` (``observe_reward_scale``). With the reward divided
+    by the episode's passive cost c (``reward_scale: passive``), the value of a linear
+    policy on a linear plant is :math:`V(u)/c` with V quadratic in u, hence exactly a
+    quadratic form of :math:`u/\sqrt{c}`: one set of critic weights fits every load, where
+    a quadratic form of u alone would have to span the six decades of c."""
+
+    def __init__(self, observation_space: spaces.Box):
+        d = int(observation_space.shape[0]) - 1
+        super().__init__(spaces.Box(-np.inf, np.inf, (d,), np.float32))
+        self._observation_space = observation_space
+
+    def forward(self, observations: torch.Tensor) -> torch.Tensor:
+        u = observations[:, :-1] * torch.exp(-0.5 * observations[:, -1:])
+        return super().forward(u)
 
 
 #: ``critic_features`` of :class:`SplitCriticPolicy` and their extractor classes.
 CRITIC_FEATURES = {
     "quadratic": QuadraticFeatures,
+    "scaled_quadratic": ScaledQuadraticFeatures,
     "direction": DirectionFeatures,
     "flatten": FlattenExtractor,
 }
@@ -109,6 +145,18 @@ class SplitCriticPolicy(ActorCriticPolicy):
         return data
 
 
+class AsymmetricCriticPolicy(SplitCriticPolicy):
+    r"""An asymmetric actor-critic on the observation ``[u, log c]`` of an env with
+    ``reward_scale: passive`` and ``observe_reward_scale: true``: the actor reads u only
+    (:class:`DropLast`; with ``net_arch: {pi: []}`` a linear law, deployable on the plain
+    env), the critic the quadratic features of :math:`u/\sqrt{c}`
+    (:class:`ScaledQuadraticFeatures`)."""
+
+    def __init__(self, *args, critic_features: str = "scaled_quadratic", **kwargs):
+        kwargs.setdefault("features_extractor_class", DropLast)
+        super().__init__(*args, critic_features=critic_features, **kwargs)
+
+
 class EpisodeScaledRolloutBuffer(RolloutBuffer):
     """A ``RolloutBuffer`` that divides the GAE advantages of each episode segment (per
     sub-env, split at episode starts) by their root mean square, after the returns
@@ -155,6 +203,9 @@ class SB3Policy:
             x = direction_features(x).astype(np.float32)
         if self.obs_norm is not None:
             x = self.obs_norm.normalize_obs(x)
+        if self.model.policy.features_extractor_class is DropLast:  # an asymmetric agent: its
+            # actor drops the last entry (log c) the plain env does not have
+            x = np.concatenate([x, np.zeros((len(x), 1), np.float32)], axis=1)
         import torch
 
         with torch.no_grad():  # the deterministic action of model.predict, without its checks
@@ -162,3 +213,47 @@ class SB3Policy:
         v = self.v_max * np.clip(np.asarray(a, dtype=np.float64).reshape(-1, 1), -1, 1)
         v = v.astype(np.float32)
         return (v if batched else v[0]), state
+
+
+class ScaledQuadraticCritic(ContinuousCritic):
+    r"""SAC's twin critic as quadratic forms (plus linear terms and a constant) of
+    :math:`w = [u, a] / \sqrt{c}` on the observation ``[u, log c]`` of an env with
+    ``reward_scale: passive`` and ``observe_reward_scale: true``: the shape of the
+    state-action value of a linear policy on a linear plant with a quadratic reward, divided
+    by the episode's passive cost c (:class:`ScaledQuadraticFeatures` for the state value)."""
+
+    def __init__(self, observation_space, action_space, *args, n_critics: int = 2, **kwargs):
+        super().__init__(observation_space, action_space, *args, n_critics=n_critics, **kwargs)
+        d = int(observation_space.shape[0]) - 1 + int(np.prod(action_space.shape))
+        self.quadratic = QuadraticFeatures(spaces.Box(-np.inf, np.inf, (d,), np.float32))
+        self.q_networks = []
+        for idx in range(n_critics):
+            q_net = nn.Linear(self.quadratic.features_dim, 1)
+            self.add_module(f"qf{idx}", q_net)  # replaces the MLP of the same name
+            self.q_networks.append(q_net)
+
+    def _features(self, obs: torch.Tensor, actions: torch.Tensor) -> torch.Tensor:
+        w = torch.cat([obs[:, :-1], actions], dim=1) * torch.exp(-0.5 * obs[:, -1:])
+        return self.quadratic(w)
+
+    def forward(self, obs: torch.Tensor, actions: torch.Tensor) -> tuple[torch.Tensor, ...]:
+        f = self._features(obs, actions)
+        return tuple(q(f) for q in self.q_networks)
+
+    def q1_forward(self, obs: torch.Tensor, actions: torch.Tensor) -> torch.Tensor:
+        return self.q_networks[0](self._features(obs, actions))
+
+
+class AsymmetricSACPolicy(SACPolicy):
+    """SAC's policy on the observation ``[u, log c]``: the (squashed Gaussian) actor reads u
+    only (:class:`DropLast`; ``net_arch: {pi: []}`` a linear law, deployable on the plain
+    env), the twin critic is :class:`ScaledQuadraticCritic`."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("features_extractor_class", DropLast)
+        kwargs["share_features_extractor"] = False
+        super().__init__(*args, **kwargs)
+
+    def make_critic(self, features_extractor=None) -> ScaledQuadraticCritic:
+        critic_kwargs = self._update_features_extractor(self.critic_kwargs, features_extractor)
+        return ScaledQuadraticCritic(**critic_kwargs).to(self.device)

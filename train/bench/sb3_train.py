@@ -8,12 +8,18 @@ import torch
 import torch.nn as nn
 
 import acld_gym  # noqa: F401  (registers the env ids)
+from acld_gym.wrappers import whitening
 
 from ..agent import actor_parts
 from .config import SB3_ALGOS, AlgoConfig, CurveCallback, eval_schedule
 from .sb3_envs import VecWhiten, make_sb3_env
-from .sb3_policies import EpisodeScaledRolloutBuffer, SB3Policy, SplitCriticPolicy
-from .search import whitening
+from .sb3_policies import (
+    AsymmetricCriticPolicy,
+    AsymmetricSACPolicy,
+    EpisodeScaledRolloutBuffer,
+    SB3Policy,
+    SplitCriticPolicy,
+)
 
 __all__ = ["fold_whitening", "train_sb3"]
 
@@ -45,8 +51,11 @@ def _resolve_policy_kwargs(kwargs: dict) -> dict:
                 raise ValueError(f"{key}: a number or {{linear: [start, end]}}, got {value!r}")
             kwargs = {**kwargs, key: _linear_schedule(*map(float, value["linear"]))}
 
-    if kwargs.get("policy") == "SplitCriticPolicy":
-        kwargs = {**kwargs, "policy": SplitCriticPolicy}
+    named = {"SplitCriticPolicy": SplitCriticPolicy,
+             "AsymmetricCriticPolicy": AsymmetricCriticPolicy,
+             "AsymmetricSACPolicy": AsymmetricSACPolicy}
+    if kwargs.get("policy") in named:
+        kwargs = {**kwargs, "policy": named[kwargs["policy"]]}
     pk = dict(kwargs.get("policy_kwargs") or {})
     if isinstance(pk.get("activation_fn"), str):
         pk["activation_fn"] = {"tanh": nn.Tanh, "relu": nn.ReLU}[pk["activation_fn"].lower()]

@@ -10,6 +10,7 @@ import gymnasium as gym
 import numpy as np
 
 import acld_gym  # noqa: F401  (registers the env ids)
+from acld_gym.wrappers import whitening
 
 from ..features import direction_features
 from .config import AlgoConfig, CurveCallback, eval_schedule
@@ -78,17 +79,6 @@ class LinearDirectionActor:
         }
 
 
-def whitening(directions: np.ndarray, ridge: float = 1e-3) -> np.ndarray:
-    r"""ZCA whitening matrix :math:`T = \Sigma^{-1/2}` (ridge-regularised, relative to the
-    largest eigenvalue) of the second moment of the observation directions ``z/|z|``
-    (rows), so that the direction features of ``z @ T`` are isotropic on average."""
-    u = np.asarray(directions, dtype=np.float64)
-    sigma = u.T @ u / max(u.shape[0], 1)
-    lam, vec = np.linalg.eigh(sigma)
-    lam = np.maximum(lam, 0.0) + ridge * lam.max()
-    return (vec / np.sqrt(lam)) @ vec.T
-
-
 @dataclass(frozen=True)
 class RandomSearch:
     """Settings of ``vrs`` (the ``model:`` mapping of its YAML file).
@@ -115,10 +105,10 @@ class RandomSearch:
         Step size and noise fall linearly over the budget to this fraction of their
         initial values (1: constant), so the final actor jitters less.
     whiten : bool
-        Estimate a whitening matrix (:func:`whitening`) from the observations of a first
-        round of candidate episodes (counted in the budget) and search the actor on the
-        whitened observation. The scaled observation's components are strongly
-        correlated (up to 0.999), which makes an isotropic search in w ill-conditioned.
+        Estimate a whitening matrix (:func:`acld_gym.wrappers.whitening`) from the
+        observations of a first round of candidate episodes (counted in the budget) and
+        search the actor on the whitened observation. The scaled observation's components
+        are strongly correlated (up to 0.999), which makes an isotropic search in w ill-conditioned.
     common_episodes : bool
         Every candidate of an iteration runs on the same episodes (loads and sensor
         noise; common random numbers), so a direction's +/- scores differ by the

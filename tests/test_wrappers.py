@@ -1,0 +1,64 @@
+"""acld_gym.wrappers: Gymnasium's checker passes, and the maps are exact."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import acld_gym  # noqa: F401
+from acld_gym.envs.beam_env import ACLDBeamEnv
+from acld_gym.wrappers import UnitAction, WhitenObservation, whitening
+
+
+def test_unit_action_round_trip_is_exact():
+    env = UnitAction(ACLDBeamEnv(load_case=1))
+    assert env.action_space == gym.spaces.Box(-1.0, 1.0, (1,), np.float32)
+    rng = np.random.default_rng(0)
+    a = np.concatenate([rng.uniform(-1, 1, 100_000), [-1.0, 1.0, 0.0, 1e-30, -2.0**-24]])
+    a = a.astype(np.float32)
+    volts = env.action(a)
+    assert volts.dtype == np.float64 and np.abs(volts).max() <= 120.0
+    assert np.array_equal(env.reverse_action(volts), a)
+    assert np.array_equal(volts, 120.0 * a.astype(np.float64))
+
+
+def test_unit_action_steps_like_volts():
+    plain, unit = ACLDBeamEnv(load_case=2), UnitAction(ACLDBeamEnv(load_case=2))
+    plain.reset(seed=1)
+    unit.reset(seed=1)
+    for a in (0.25, -1.0, 0.7):
+        a32 = np.array([a], np.float32)
+        o1, r1, *_, i1 = plain.step(120.0 * a32.astype(np.float64))  # volts, in float64
+        o2, r2, *_, i2 = unit.step(a32)
+        assert np.array_equal(o1, o2) and r1 == r2 and i1["voltage"] == i2["voltage"]
+    _, _, _, _, info = unit.step(np.array([1.5], np.float32))  # beyond: clipped, reported
+    assert info["clipped"] and info["voltage"] == 120.0
+
+
+def test_whiten_observation_keeps_passthrough_and_checks():
+    env = ACLDBeamEnv(load_case="random", episode_length=0.05, reward_scale="passive",
+                      observe_reward_scale=True)
+    rng = np.random.default_rng(2)
+    T = whitening(rng.normal(size=(500, 9)))
+    w = WhitenObservation(env, T, passthrough=1)
+    check_env(UnitAction(w), skip_render_check=True)
+    z, _ = env.reset(seed=3)
+    u, _ = w.reset(seed=3)
+    assert np.allclose(u[:9], z[:9].astype(np.float64) @ T, rtol=1e-6) and u[9] == z[9]
+    with pytest.raises(ValueError, match=r"transform must be a finite \(9, 9\)"):
+        WhitenObservation(env, np.eye(10), passthrough=1)
+    with pytest.raises(ValueError, match="passthrough must be an integer"):
+        WhitenObservation(env, T, passthrough=10)
+
+
+def test_whitening_makes_the_second_moment_isotropic():
+    rng = np.random.default_rng(4)
+    A = rng.normal(size=(6, 6))
+    u = rng.normal(size=(20000, 6)) @ A
+    T = whitening(u, ridge=0.0)
+    m = (u @ T).T @ (u @ T) / len(u)
+    assert np.allclose(m, np.eye(6), atol=1e-9)
+    with pytest.raises(ValueError, match="directions must be a finite"):
+        whitening(np.array([np.nan, 1.0])[None])

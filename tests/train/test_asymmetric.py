@@ -1,0 +1,74 @@
+"""The asymmetric actor-critic of the PPO recipe (train.bench.sb3_policies): the actor never
+reads the privileged log(reward scale), the critic is exactly invariant to the scaling that
+leaves V/c unchanged, the trained actor exports onto the plain env's observation, and the
+recipe runs end to end on a tiny budget."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import torch
+import yaml
+
+from train.bench.sb3_policies import AsymmetricCriticPolicy
+
+
+def _model():
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.env_util import make_vec_env
+
+    venv = make_vec_env("ACLDBeam-v1", n_envs=1, env_kwargs={
+        "reward_scale": "passive", "observe_reward_scale": True, "episode_length": 0.05})
+    return PPO(AsymmetricCriticPolicy, venv, n_steps=64, batch_size=64, seed=0, device="cpu",
+               policy_kwargs={"net_arch": {"pi": [], "vf": []}})
+
+
+def test_actor_ignores_log_scale_and_critic_is_scale_invariant():
+    model = _model()
+    pol = model.policy
+    with torch.no_grad():  # make the critic's weights generic
+        for p in pol.value_net.parameters():
+            p.copy_(torch.randn_like(p))
+    rng = np.random.default_rng(0)
+    u = torch.as_tensor(rng.normal(size=(5, 9)), dtype=torch.float32)
+    log_c = torch.as_tensor(rng.normal(size=(5, 1)), dtype=torch.float32)
+    obs = torch.cat([u, log_c], dim=1)
+    with torch.no_grad():
+        a1 = pol._predict(obs, deterministic=True)
+        a2 = pol._predict(torch.cat([u, log_c + 3.0], dim=1), deterministic=True)
+        assert torch.equal(a1, a2)  # the actor never reads log c
+        k = 7.0  # u -> sqrt(k) u with c -> k c: u / sqrt(c) and so the value are unchanged
+        v1 = pol.predict_values(obs)
+        v2 = pol.predict_values(torch.cat([u * np.sqrt(k), log_c + np.log(k)], dim=1))
+        v3 = pol.predict_values(torch.cat([u * np.sqrt(k), log_c], dim=1))
+    assert torch.allclose(v1, v2, rtol=1e-4, atol=1e-5)
+    assert not torch.allclose(v1, v3, rtol=1e-2)
+
+
+def test_recipe_trains_and_exports_onto_the_plain_observation():
+    from train.bench.algos import train_algo
+    from train.bench.config import AlgoConfig
+    from train.benchmark import policy_program
+
+    data = yaml.safe_load(open("train/benchmark/ppo.yaml"))
+    assert data["env_kwargs"] == {"reward_scale": "passive", "observe_reward_scale": True}
+    data.update(timesteps=2048, n_envs=4, whiten_steps=256, eval_points=1)
+    data["model"] = {**data["model"], "n_steps": 128, "batch_size": 256, "n_epochs": 1}
+    policy, record = train_algo(AlgoConfig.from_dict(data), 0, "ACLDBeam-v1",
+                                lambda steps, pol: None)
+    assert np.asarray(record["transform"]).shape == (9, 9)  # log c is not whitened
+    assert policy.model.observation_space.shape == (10,)
+    prog = policy_program(policy)
+    z = np.random.default_rng(1).normal(size=(6, 9)).astype(np.float32)
+    v, _ = policy.predict(z)  # on the plain env's 9 entries
+    assert np.allclose(120 * prog(z.astype(np.float64)), v, atol=1e-3)
+
+
+def test_env_kwargs_are_validated_by_the_env_config():
+    from train.bench.config import AlgoConfig
+
+    base = {"algo": "ppo", "timesteps": 10, "model": {"policy": "MlpPolicy"}}
+    with pytest.raises(ValueError, match="env_kwargs: .*observe_reward_scale=True needs"):
+        AlgoConfig.from_dict({**base, "env_kwargs": {"observe_reward_scale": True}})
+    with pytest.raises(ValueError, match="env_kwargs: unexpected keyword"):
+        AlgoConfig.from_dict({**base, "env_kwargs": {"reward_scael": "passive"}})

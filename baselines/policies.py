@@ -1,8 +1,9 @@
-"""Reference policies for ``ACLDBeam-v0`` with stable-baselines3's ``predict`` protocol.
+"""Reference policies for ``ACLDBeam-v1`` (and every registered id) with stable-baselines3's ``predict`` protocol.
 
 They are designed on the nominal reduced model sampled at the env's control
 period (:func:`acld_gym.design.nominal.nominal_design`) and read the reduced-state estimate
-from the ``"estimate"`` observation (``obs[:6] * xr_scale``), so
+from the ``"estimate"`` observation (``obs[:k] * xr_scale``, k the design order: 8 on the
+converged plant, 6 on the thesis mesh), so
 ``evaluate_policy`` and :mod:`baselines.evaluate` treat them like agents.
 
 A policy is designed for one plant (``mesh``) and one observation basis: build it
@@ -179,7 +180,7 @@ class MPCPolicy(_Policy):
     small-amplitude (unconstrained, linear) law the robust LQR instead of a cheap-control
     output inversion, which the observer cannot support on a perturbed plant: with
     :math:`\beta = 0` a 10 % stiffer or softer beam makes that linear loop unstable
-    (tests/test_robustness.py). Without it (``state_weight=0``) the MPC is 1.02 x the
+    (tests/baselines/test_robustness.py). Without it (``state_weight=0``) the MPC is 1.02 x the
     clairvoyant bound on thesis case 1 instead of 1.18 x, but only on the nominal plant.
     """
 

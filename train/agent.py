@@ -125,7 +125,7 @@ def actor_parts(model) -> tuple[Any, list, bool]:
 def export_sb3(model, obs_norm=None) -> ActorProgram:
     """The deterministic actor of an SB3 ``MlpPolicy`` (PPO, SAC, TD3, TQC, ARS, ...) and its
     ``VecNormalize`` observation statistics as an :class:`ActorProgram` (equal to SB3's
-    ``predict`` to float32 round-off; tests/test_train_agents.py)."""
+    ``predict`` to float32 round-off; tests/train/test_distill.py)."""
     import torch.nn as nn
     from stable_baselines3.common.torch_layers import FlattenExtractor
 

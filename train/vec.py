@@ -1,4 +1,4 @@
-"""The training env: the native batched ``ACLDBeam-v0`` through SB3's ``VecEnv``
+"""The training env: the native batched ``ACLDBeam-v1`` through SB3's ``VecEnv``
 adapter, with the action mapped to [-1, 1] (optionally as a residual on the
 discrete LQR), optional potential-based reward shaping, and ``VecNormalize``.
 
@@ -126,7 +126,7 @@ def make_vec_env(cfg, seed: int, n_envs: int | None = None, backend: str = "nati
                  load_case=None) -> VecNormalize:
     """The wrapped training env of a :class:`train.config.TrainConfig` (seeded).
 
-    ``backend="native"``: :class:`acld_gym.sb3.SB3VecEnv` (one batched env);
+    ``backend="native"``: :class:`acld_gym.envs.sb3.SB3VecEnv` (one batched env);
     ``"subproc"``: SB3's ``SubprocVecEnv`` over single envs (for comparison).
     """
     n = cfg.n_envs if n_envs is None else n_envs

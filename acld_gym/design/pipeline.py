@@ -2,7 +2,8 @@
 
 Everything downstream (the reproduction, the environment's reference
 policies) starts from a :class:`Design`, so the pipeline is written once. The
-design model (the 6-state reduced model and everything designed on it) is kept
+design model (the reduced model -- 8 states on the converged plant, 6 on the thesis
+mesh -- and everything designed on it) is kept
 apart from the truth model it was reduced from (:class:`acld_gym.physics.plant.Plant`):
 the environment simulates the truth, possibly with randomized parameters, while
 observers and baselines keep the nominal design.

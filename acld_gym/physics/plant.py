@@ -140,7 +140,7 @@ class Plant:
         return first_order(M, C, K, Pc, self.Fd, self.c)
 
     def to_statespace(self, params: BeamParameters | None = None):
-        """The plant as a ``control.StateSpace`` (:mod:`acld_gym.design.interop`)."""
+        """The plant as a ``control.StateSpace`` (:mod:`acld_gym.physics.interop`)."""
         from acld_gym.physics.interop import statespace
 
         A, B, E, C = self.state_space(params)

@@ -4,7 +4,7 @@ VENV    := .venv
 BIN     := $(VENV)/bin
 STAMP   := $(VENV)/.installed-stamp
 
-.PHONY: install run studies test test-slow docs lint format bench agents clean
+.PHONY: install run studies test test-slow docs wheel-check lint format bench agents clean
 
 $(STAMP): pyproject.toml constraints.txt setup.py acld_gym/envs/_stepcore.c
 	$(PY) -m venv $(VENV)
@@ -56,6 +56,19 @@ test: $(STAMP)
 	$(BIN)/ruff check acld_gym baselines train tests benchmarks
 	$(BIN)/python -m pytest -q
 	$(MAKE) docs
+
+## The core install: the wheel (compiled step, shipped agents as package data) in a clean
+## venv without extras (no torch, no osqp), checked from outside the checkout.
+WHEEL_VENV ?= /tmp/acld-gym-core-venv
+wheel-check: $(STAMP)
+	rm -rf dist $(WHEEL_VENV)
+	$(BIN)/pip wheel --quiet --no-deps --no-build-isolation -w dist .
+	$(PY) -m venv $(WHEEL_VENV)
+	$(WHEEL_VENV)/bin/pip install --quiet -c constraints.txt dist/acld_gym-*.whl
+	! $(WHEEL_VENV)/bin/python -c "import torch" 2>/dev/null
+	! $(WHEEL_VENV)/bin/python -c "import osqp" 2>/dev/null
+	cp .ci/core_install_check.py $(WHEEL_VENV)/
+	cd $(WHEEL_VENV) && bin/python core_install_check.py --compiled
 
 ## The documentation site (mkdocs.yml, docs/) into site/, strict: any warning fails.
 docs: $(STAMP)

@@ -1,4 +1,5 @@
-"""Reference policies for ``ACLDBeam-v1`` (and every registered id) with stable-baselines3's ``predict`` protocol.
+"""Reference policies for ``ACLDBeam-v1`` (and every registered id) with
+stable-baselines3's ``predict`` protocol.
 
 They are designed on the nominal reduced model sampled at the env's control
 period (:func:`acld_gym.design.nominal.nominal_design`) and read the reduced-state estimate
@@ -28,7 +29,7 @@ from acld_gym.envs.fingerprint import design_fingerprint
 from acld_gym.physics.actuator import V_LIMIT
 
 __all__ = ["PassivePolicy", "LQRPolicy", "SMCPolicy", "MPCPolicy", "MeasurementFeedback",
-           "discrete_lqr_gain"]
+           "MPC_MISSING", "mpc_available", "discrete_lqr_gain"]
 
 
 class _Policy:
@@ -160,6 +161,19 @@ class SMCPolicy(_Policy):
 STATE_WEIGHT = 1e-9
 
 
+#: What to say where the MPC's QP solver is not installed (a core install).
+MPC_MISSING = "MPC needs the QP solver osqp: pip install 'acld-gym[baselines]'"
+
+
+def mpc_available() -> bool:
+    """Whether the MPC's QP solver (osqp, the extra ``acld-gym[baselines]``) is installed."""
+    try:
+        import osqp  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
 class MPCPolicy(_Policy):
     r"""Box-constrained MPC on the sampled reduced model (OSQP).
 
@@ -189,6 +203,8 @@ class MPCPolicy(_Policy):
     def __init__(self, dt: float = 1e-3, horizon: int = 60, rho: float = 1e-4,
                  state_weight: float = STATE_WEIGHT, nom=None, mesh: str = "converged"):
         super().__init__(dt, nom, mesh)
+        if not mpc_available():
+            raise ImportError(MPC_MISSING)
         import osqp
         import scipy.sparse as sp
 

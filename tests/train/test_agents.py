@@ -132,6 +132,31 @@ def test_bad_metadata_is_named(agent_dir):
         TrainedAgent.load(agent_dir)
 
 
+def _damage(agent_dir: Path, key: str, change) -> None:
+    """Rewrite one array of the agent's policy file with ``change(array)``."""
+    with np.load(agent_dir / POLICY_FILE) as z:
+        arrays = {k: z[k] for k in z.files}
+    arrays[key] = change(arrays[key])
+    np.savez(agent_dir / POLICY_FILE, **arrays)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_every_array_is_checked_against_the_program(name, tmp_path):
+    """Wrong shapes (one input too few, a second action, a matrix for a vector) and
+    non-finite weights are refused at load, naming the file and the array."""
+    cases = [("W0", lambda w: w[:-1], "shape"), ("b0", lambda b: np.concatenate([b, b]), "shape"),
+             ("b0", lambda b: np.atleast_2d(b), "shape"),
+             ("W0", lambda w: np.where(np.arange(w.size).reshape(w.shape) == 0, np.nan, w),
+              "non-finite"),
+             ("b0", lambda b: b + np.inf, "non-finite")]
+    for i, (key, change, what) in enumerate(cases):
+        d = tmp_path / f"{name}-{i}"
+        shutil.copytree(AGENTS_DIR / name, d)
+        _damage(d, key, change)
+        with pytest.raises(AgentFileError, match=rf"{POLICY_FILE}: array '{key}' has {what}"):
+            TrainedAgent.load(d, check=False)
+
+
 def test_fingerprint_mismatch_is_refused_and_says_what_differs(agent_dir):
     meta = json.loads((agent_dir / META_FILE).read_text())
     meta["observation"]["xr_scale"] = [2 * x for x in meta["observation"]["xr_scale"]]

@@ -130,7 +130,7 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
 
     | field | default | meaning |
     |---|---|---|
-    | ``load_case`` | 1 | 1, 2, 3 (thesis ch. 5), ``"random"`` (:func:`random_load`) or a |
+    | ``load_case`` | 1 | 1, 2, 3 (thesis ch. 5), ``"random"`` (new random load per episode) or a |
     | | | ``TipLoad`` (pulses, harmonics, ``Samples``; :mod:`acld_gym.physics.loads`) |
     | ``mesh`` | ``"converged"`` | truth plant: ``"converged"`` or ``"thesis"`` (38 states) |
     | ``dt`` | 1e-3 | control period [s], in [1e-4, 1e-2] |

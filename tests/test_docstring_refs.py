@@ -11,8 +11,6 @@ import importlib
 import re
 from pathlib import Path
 
-import pytest
-
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGES = ("acld_gym", "baselines", "train", "tests")
 ROLE = re.compile(r":(mod|func|class|meth|data|attr|exc):`~?([A-Za-z_][\w.]*)(?:\(\))?`")

@@ -72,7 +72,7 @@ wheel-check: $(STAMP)
 
 ## The documentation site (mkdocs.yml, docs/) into site/, strict: any warning fails.
 docs: $(STAMP)
-	$(BIN)/mkdocs build --strict --quiet
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict
 
 test-slow: $(STAMP)
 	$(BIN)/python -m pytest -q -m slow

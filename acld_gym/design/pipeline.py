@@ -110,6 +110,8 @@ def design(model: Plant | BeamModel | None = None, order: int = REDUCED_ORDER,
     smc_eps : the continuous SMC's boundary layer.
     basis : coordinates of the reduced model (:data:`acld_gym.design.reduction.BASES`).
 
+    Notes
+    -----
     The laws are designed on first use.
     """
     if isinstance(model, Plant):

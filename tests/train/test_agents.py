@@ -1,12 +1,13 @@
 """The shipped agents (train/agents/) and the agent format.
 
 The agents load without executing anything, refuse observations they were not trained
-on, act in volts, and reproduce the rows of ``train/agents/compare.json`` -- the README's
-table, written by ``python -m train.compare --json train/agents/compare.json`` -- on the
-three thesis cases and the held-out random set. Tolerance 1e-2 relative on ISE and
-peak: the evaluation is deterministic, and the observation is the same on every machine
-(canonical basis, shipped plant); the slack covers BLAS round-off in the agents'
-switching decisions, which a near-tie can amplify.
+on, act in volts, and reproduce the rows of ``train/agents/compare.json`` -- the table of
+``docs/training.md`` and the README's score table, written by
+``python -m train.compare --json train/agents/compare.json`` -- on the three thesis cases
+and the held-out random set. Tolerance 1e-2 relative on ISE and peak: the evaluation is
+deterministic, and the observation is the same on every machine (canonical basis, shipped
+plant); the slack covers BLAS round-off in the agents' switching decisions, which a
+near-tie can amplify.
 """
 
 from __future__ import annotations
@@ -26,7 +27,8 @@ from train.compare import AGENTS_DIR, HELDOUT_SEEDS, agent_names, load_agents
 
 RTOL = 1e-2
 ROWS = json.loads((AGENTS_DIR / "compare.json").read_text())
-README = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+#: The page with the comparison tables (``python -m train.compare --markdown``).
+PAGE = (Path(__file__).resolve().parents[2] / "docs" / "training.md").read_text()
 NAMES = agent_names()
 
 
@@ -68,7 +70,19 @@ def test_thesis_cases_reproduce_the_table(agents, name, case):
     assert row.ise == pytest.approx(ref["ise"], rel=RTOL)
     assert row.peak_mm == pytest.approx(ref["peak_mm"], rel=RTOL)
     assert np.abs(ep.voltage).max() <= 120.0
-    assert f"{ref['ise']:.3e}" in README
+    assert f"{ref['ise']:.3e}" in PAGE
+
+
+def test_the_pages_show_the_generated_tables():
+    """Every row of ``train/agents/compare.md`` (written by ``python -m train.compare``) is
+    on the training page, and the README's score table is its score table."""
+    root = Path(__file__).resolve().parents[2]
+    rows = [line for line in (AGENTS_DIR / "compare.md").read_text().splitlines()
+            if line.startswith("| ")]
+    assert rows and [r for r in rows if r not in PAGE.splitlines()] == []
+    readme = (root / "README.md").read_text().splitlines()
+    scores = rows[rows.index(next(r for r in rows if "score (IQM)" in r)):]
+    assert [r for r in scores if r not in readme] == []
 
 
 @pytest.mark.parametrize("name", NAMES)

@@ -17,7 +17,7 @@ and the policy is stable on that plant when the spectral radius of this map is b
 :func:`corner_study` evaluates it at every corner of the env's parameter box (each
 randomized parameter at :math:`e^{\pm 3\sigma}`, 1024 plants), the worst case of a
 multiplicative perturbation; ``python -m baselines.robustness`` prints the table quoted
-in the README.
+in ``docs/baselines.md``.
 """
 
 from __future__ import annotations

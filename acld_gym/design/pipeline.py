@@ -31,8 +31,8 @@ REDUCED_ORDER = 6
 #: 5330 rad/s, below twice the 1 kHz control's Nyquist frequency (it aliases to 953 rad/s,
 #: next to mode 2): 6 states give sigma_6 / sigma_7 = 4.2 and LQR/SMC loops with the
 #: observer that are unstable at small amplitude (spectral radius 1.011); 8 states (modes
-#: 1-4) give sigma_8 / sigma_9 = 10.4 and stable loops (README, "Thesis mesh vs converged
-#: plant").
+#: 1-4) give sigma_8 / sigma_9 = 10.4 and stable loops (the mesh study,
+#: docs/mesh.md).
 DESIGN_ORDER = {"thesis": 6, "converged": 8}
 
 

@@ -174,7 +174,7 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
     on every mesh: the thesis tuned it to its model's first resonance (178.6 rad/s);
     the converged beam's is 177.4 rad/s, and over the 0.193 s of the load the 1.6 rad/s
     detuning adds up to 0.31 rad of phase, so the load still pumps the first mode
-    (README, "Thesis mesh vs converged plant"). Random loads aim their harmonics at
+    (the mesh study, ``docs/mesh.md``). Random loads aim their harmonics at
     the plant's own modes.
 
     ## Version History

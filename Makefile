@@ -61,7 +61,7 @@ test: $(STAMP)
 ## venv without extras (no torch, no osqp), checked from outside the checkout.
 WHEEL_VENV ?= /tmp/acld-gym-core-venv
 wheel-check: $(STAMP)
-	rm -rf dist $(WHEEL_VENV)
+	rm -rf build dist $(WHEEL_VENV)
 	$(BIN)/pip wheel --quiet --no-deps --no-build-isolation -w dist .
 	$(PY) -m venv $(WHEEL_VENV)
 	$(WHEEL_VENV)/bin/pip install --quiet -c constraints.txt dist/acld_gym-*.whl

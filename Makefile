@@ -4,7 +4,7 @@ VENV    := .venv
 BIN     := $(VENV)/bin
 STAMP   := $(VENV)/.installed-stamp
 
-.PHONY: install run studies test test-slow lint format bench agents clean
+.PHONY: install run studies test test-slow docs wheel-check lint format bench agents clean
 
 $(STAMP): pyproject.toml constraints.txt setup.py acld_gym/envs/_stepcore.c
 	$(PY) -m venv $(VENV)
@@ -13,7 +13,7 @@ $(STAMP): pyproject.toml constraints.txt setup.py acld_gym/envs/_stepcore.c
 	# constraints too, so the package is built without an isolated build environment.
 	$(BIN)/pip install --quiet -c constraints.txt setuptools numpy
 	# torch is pinned (constraints.txt) to the CPU build; an unpinned torch pulls CUDA.
-	$(BIN)/pip install --quiet --no-build-isolation -c constraints.txt -e ".[all,dev]"
+	$(BIN)/pip install --quiet --no-build-isolation -c constraints.txt -e ".[all,dev,docs]"
 	touch $(STAMP)
 
 install: $(STAMP)
@@ -51,10 +51,28 @@ agents: $(STAMP)
 	$(BIN)/python -m train sac --config train/sac_dagger.yaml --seed 0 --out runs/sac_dagger --no-progress
 	for a in ppo_dagger sac_dagger; do $(BIN)/python -m train.ship runs/$$a $$a; done
 
-## Lint + the test suite (slow tests excluded; see test-slow).
+## Lint + the test suite (slow tests excluded; see test-slow) + the documentation site.
 test: $(STAMP)
 	$(BIN)/ruff check acld_gym baselines train tests benchmarks
 	$(BIN)/python -m pytest -q
+	$(MAKE) docs
+
+## The core install: the wheel (compiled step, shipped agents as package data) in a clean
+## venv without extras (no torch, no osqp), checked from outside the checkout.
+WHEEL_VENV ?= /tmp/acld-gym-core-venv
+wheel-check: $(STAMP)
+	rm -rf build dist $(WHEEL_VENV)
+	$(BIN)/pip wheel --quiet --no-deps --no-build-isolation -w dist .
+	$(PY) -m venv $(WHEEL_VENV)
+	$(WHEEL_VENV)/bin/pip install --quiet -c constraints.txt dist/acld_gym-*.whl
+	! $(WHEEL_VENV)/bin/python -c "import torch" 2>/dev/null
+	! $(WHEEL_VENV)/bin/python -c "import osqp" 2>/dev/null
+	cp .ci/core_install_check.py $(WHEEL_VENV)/
+	cd $(WHEEL_VENV) && bin/python core_install_check.py --compiled
+
+## The documentation site (mkdocs.yml, docs/) into site/, strict: any warning fails.
+docs: $(STAMP)
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict
 
 test-slow: $(STAMP)
 	$(BIN)/python -m pytest -q -m slow
@@ -71,4 +89,4 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_run.py
 
 clean:
-	rm -rf $(VENV) results .pytest_cache
+	rm -rf $(VENV) results .pytest_cache site build dist

@@ -43,7 +43,7 @@ from acld_gym.util.progress import Progress
 from acld_gym.util.validate import arg_type
 
 __all__ = ["EvalRow", "Episode", "rollout", "check_compatible", "bound_episode", "episode_rows",
-           "evaluate", "default_policies", "policies_for",
+           "evaluate", "policy_classes", "default_policies", "policies_for",
            "mean_rows", "format_tables", "format_effort", "format_thesis_comparison",
            "add_scores", "plot_episodes"]
 
@@ -164,20 +164,24 @@ def metrics_row(case, name: str, ep: Episode) -> EvalRow:
                    limit_fraction=e.limit_fraction, residual_tip_rms_m=e.residual_tip_rms_m)
 
 
-def default_policies(mesh: str = "converged", dt: float = 1e-3) -> dict:
-    """Passive, LQR, SMC and MPC designed on the nominal ``mesh`` plant."""
-    from .policies import LQRPolicy, MPCPolicy, PassivePolicy, SMCPolicy
+def policy_classes() -> tuple:
+    """Passive, LQR, SMC and MPC; without MPC where its QP solver is not installed (a
+    core install: :data:`baselines.policies.MPC_MISSING`)."""
+    from .policies import LQRPolicy, MPCPolicy, PassivePolicy, SMCPolicy, mpc_available
 
-    return {cls.name: cls(dt=dt, mesh=mesh)
-            for cls in (PassivePolicy, LQRPolicy, SMCPolicy, MPCPolicy)}
+    return (PassivePolicy, LQRPolicy, SMCPolicy) + ((MPCPolicy,) if mpc_available() else ())
+
+
+def default_policies(mesh: str = "converged", dt: float = 1e-3) -> dict:
+    """Passive, LQR, SMC and MPC (:func:`policy_classes`) designed on the nominal ``mesh``
+    plant."""
+    return {cls.name: cls(dt=dt, mesh=mesh) for cls in policy_classes()}
 
 
 def policies_for(env) -> dict:
-    """Passive, LQR, SMC and MPC designed for ``env`` (its nominal model and observation)."""
-    from .policies import LQRPolicy, MPCPolicy, PassivePolicy, SMCPolicy
-
-    return {cls.name: cls.for_env(env) for cls in (PassivePolicy, LQRPolicy, SMCPolicy,
-                                                   MPCPolicy)}
+    """Passive, LQR, SMC and MPC (:func:`policy_classes`) designed for ``env`` (its nominal
+    model and observation)."""
+    return {cls.name: cls.for_env(env) for cls in policy_classes()}
 
 
 def episode_rows(policies: dict, case, seed: int = 0, env_kwargs: dict | None = None,
@@ -352,6 +356,10 @@ def main(argv: list[str] | None = None) -> int:
     probe = ACLDBeamEnv(config=config)  # build the design once before timing anything
     episodes: dict = {}
     policies = policies_for(probe)
+    if "mpc" not in policies:
+        from .policies import MPC_MISSING
+
+        print(f"mpc skipped: {MPC_MISSING}")
     rows = evaluate(policies, seed=args.seed, env_kwargs={"config": config},
                     episodes=episodes, quiet=args.quiet)
     print(format_tables(rows))

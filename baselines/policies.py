@@ -1,8 +1,10 @@
-"""Reference policies for ``ACLDBeam-v0`` with stable-baselines3's ``predict`` protocol.
+"""Reference policies for ``ACLDBeam-v1`` (and every registered id) with
+stable-baselines3's ``predict`` protocol.
 
 They are designed on the nominal reduced model sampled at the env's control
 period (:func:`acld_gym.design.nominal.nominal_design`) and read the reduced-state estimate
-from the ``"estimate"`` observation (``obs[:6] * xr_scale``), so
+from the ``"estimate"`` observation (``obs[:k] * xr_scale``, k the design order: 8 on the
+converged plant, 6 on the thesis mesh), so
 ``evaluate_policy`` and :mod:`baselines.evaluate` treat them like agents.
 
 A policy is designed for one plant (``mesh``) and one observation basis: build it
@@ -27,7 +29,7 @@ from acld_gym.envs.fingerprint import design_fingerprint
 from acld_gym.physics.actuator import V_LIMIT
 
 __all__ = ["PassivePolicy", "LQRPolicy", "SMCPolicy", "MPCPolicy", "MeasurementFeedback",
-           "discrete_lqr_gain"]
+           "MPC_MISSING", "mpc_available", "discrete_lqr_gain"]
 
 
 class _Policy:
@@ -159,6 +161,19 @@ class SMCPolicy(_Policy):
 STATE_WEIGHT = 1e-9
 
 
+#: What to say where the MPC's QP solver is not installed (a core install).
+MPC_MISSING = "MPC needs the QP solver osqp: pip install 'acld-gym[baselines]'"
+
+
+def mpc_available() -> bool:
+    """Whether the MPC's QP solver (osqp, the extra ``acld-gym[baselines]``) is installed."""
+    try:
+        import osqp  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
 class MPCPolicy(_Policy):
     r"""Box-constrained MPC on the sampled reduced model (OSQP).
 
@@ -179,7 +194,7 @@ class MPCPolicy(_Policy):
     small-amplitude (unconstrained, linear) law the robust LQR instead of a cheap-control
     output inversion, which the observer cannot support on a perturbed plant: with
     :math:`\beta = 0` a 10 % stiffer or softer beam makes that linear loop unstable
-    (tests/test_robustness.py). Without it (``state_weight=0``) the MPC is 1.02 x the
+    (tests/baselines/test_robustness.py). Without it (``state_weight=0``) the MPC is 1.02 x the
     clairvoyant bound on thesis case 1 instead of 1.18 x, but only on the nominal plant.
     """
 
@@ -188,6 +203,8 @@ class MPCPolicy(_Policy):
     def __init__(self, dt: float = 1e-3, horizon: int = 60, rho: float = 1e-4,
                  state_weight: float = STATE_WEIGHT, nom=None, mesh: str = "converged"):
         super().__init__(dt, nom, mesh)
+        if not mpc_available():
+            raise ImportError(MPC_MISSING)
         import osqp
         import scipy.sparse as sp
 

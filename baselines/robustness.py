@@ -1,7 +1,8 @@
 r"""Small-signal stability of the reference policies on randomized plants.
 
 About rest no voltage limit or switching is active, and every reference policy is a
-linear law :math:`V = -K \hat x_r` (:meth:`small_signal_gain`). With the env's observer
+linear law :math:`V = -K \hat x_r`
+(:meth:`baselines.policies.LQRPolicy.small_signal_gain`). With the env's observer
 (:class:`acld_gym.design.observer.DiscreteObserver`: measurement update :math:`L_c`,
 prediction gain :math:`L_p`) and a sampled plant :math:`(A_d, B_d, c)`, one period of
 the loop is linear in :math:`(x, \hat x)`:
@@ -16,7 +17,7 @@ and the policy is stable on that plant when the spectral radius of this map is b
 :func:`corner_study` evaluates it at every corner of the env's parameter box (each
 randomized parameter at :math:`e^{\pm 3\sigma}`, 1024 plants), the worst case of a
 multiplicative perturbation; ``python -m baselines.robustness`` prints the table quoted
-in the README.
+in ``docs/baselines.md``.
 """
 
 from __future__ import annotations

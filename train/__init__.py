@@ -1,4 +1,4 @@
-"""Training, sweeping and comparing RL agents on ``ACLDBeam-v0``.
+"""Training, sweeping and comparing RL agents on ``ACLDBeam-v1``.
 
 * ``python -m train ppo|sac ...`` trains one agent (:mod:`train.cli`), with the
   hyperparameters of ``train/ppo.yaml`` / ``train/sac.yaml``.

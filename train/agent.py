@@ -31,11 +31,12 @@ import numpy as np
 
 from acld_gym.util.atomic import write_atomic, write_json
 
-from .features import direction_features
-from .vec import VoltageMap
+from .direction import direction_features
+from .voltage import VoltageMap
 
 __all__ = ["TrainedAgent", "ActorProgram", "AgentFileError", "export_sb3", "actor_parts",
-           "linear_program", "POLICY_FILE", "META_FILE", "MODEL_FILE", "STATS_FILE"]
+           "linear_program", "observation_width", "POLICY_FILE", "META_FILE", "MODEL_FILE",
+           "STATS_FILE"]
 
 POLICY_FILE = "policy.npz"
 META_FILE = "metadata.json"
@@ -57,18 +58,23 @@ class ActorProgram:
     ``mean``, ``var``), ``{"op": "direction"}`` (:func:`train.features.direction_features`),
     ``{"op": "linear"}`` (arrays ``W{i}``, ``b{i}``), ``{"op": "tanh" | "relu"}``,
     ``{"op": "clip", "low": l, "high": h}``. The output is the action in [-1, 1].
+
+    Every array must be finite and of the shape its operation needs, the first layer's
+    input ``n_obs`` wide if given (the observation's width) and the last layer's output
+    one action; otherwise :class:`AgentFileError` names the array.
     """
 
     _KINDS = ("normalize", "direction", "linear", "tanh", "relu", "clip")
 
-    def __init__(self, ops: list[dict], arrays: dict[str, np.ndarray]):
+    def __init__(self, ops: list[dict], arrays: dict[str, np.ndarray],
+                 n_obs: int | None = None):
         self.ops = [dict(op) for op in ops]
         self.arrays = {k: np.asarray(v, dtype=np.float64) for k, v in arrays.items()}
         layer = 0
         for op in self.ops:
             kind = op.get("op")
             if kind not in self._KINDS:
-                raise AgentFileError(f"actor: unknown operation {kind!r}")
+                raise AgentFileError(f"{META_FILE}: actor: unknown operation {kind!r}")
             if kind == "linear":
                 op.setdefault("layer", layer)
                 layer += 1
@@ -77,6 +83,43 @@ class ActorProgram:
                         raise AgentFileError(f"{POLICY_FILE}: missing array {key!r}")
             if kind == "normalize" and not {"mean", "var"} <= set(self.arrays):
                 raise AgentFileError(f"{POLICY_FILE}: normalize needs 'mean' and 'var'")
+        self._check_arrays(n_obs)
+
+    def _check_arrays(self, n_obs: int | None) -> None:
+        """Every array the operations use is finite and of the shape its place in the
+        program fixes: ``mean``, ``var`` (d,), ``W{i}`` (width in, width out), ``b{i}``
+        (width out,), the output one action; d is ``n_obs`` (or the first array's width)."""
+        for key, value in self.arrays.items():
+            if not np.all(np.isfinite(value)):
+                raise AgentFileError(f"{POLICY_FILE}: array {key!r} has non-finite values")
+        width = n_obs
+        for op in self.ops:
+            kind = op["op"]
+            if kind == "normalize":
+                width = self._expect("mean", (width,), width)[0]
+                self._expect("var", (width,), width)
+                if np.any(self.arrays["var"] < 0):
+                    raise AgentFileError(f"{POLICY_FILE}: array 'var' has negative values")
+            elif kind == "direction" and width is not None:
+                width += 1
+            elif kind == "linear":
+                w, b = f"W{op['layer']}", f"b{op['layer']}"
+                width_in, width = self._expect(w, (width, None), width, ndim=2)
+                self._expect(b, (width,), width)
+        if width is not None and width != 1:
+            raise AgentFileError(f"{POLICY_FILE}: the actor's last layer gives {width} "
+                                 "values, expected one action")
+
+    def _expect(self, key: str, shape: tuple, width: int | None, ndim: int = 1) -> tuple:
+        """The shape of array ``key``, checked against ``shape`` (None: any size)."""
+        got = self.arrays[key].shape
+        if len(got) != ndim or any(w is not None and g != w
+                                   for g, w in zip(got, shape, strict=True)):
+            want = ", ".join("n" if w is None else str(w) for w in shape)
+            raise AgentFileError(f"{POLICY_FILE}: array {key!r} has shape {got}, expected "
+                                 f"({want}{',' if ndim == 1 else ''}) (the actor's width "
+                                 f"there: {width})")
+        return got
 
     def __call__(self, obs: np.ndarray) -> np.ndarray:
         """Actions in [-1, 1], shape (n, 1), for raw observations (n, d)."""
@@ -125,7 +168,7 @@ def actor_parts(model) -> tuple[Any, list, bool]:
 def export_sb3(model, obs_norm=None) -> ActorProgram:
     """The deterministic actor of an SB3 ``MlpPolicy`` (PPO, SAC, TD3, TQC, ARS, ...) and its
     ``VecNormalize`` observation statistics as an :class:`ActorProgram` (equal to SB3's
-    ``predict`` to float32 round-off; tests/test_train_agents.py)."""
+    ``predict`` to float32 round-off; tests/train/test_distill.py)."""
     import torch.nn as nn
     from stable_baselines3.common.torch_layers import FlattenExtractor
 
@@ -195,11 +238,21 @@ def linear_program(theta: np.ndarray, transform: np.ndarray | None = None,
     return ActorProgram(ops, arrays)
 
 
+def observation_width(metadata: dict) -> int | None:
+    """The width of the observation an agent's metadata records (the ``"estimate"``
+    observation: the design order + 1), or None when it does not say."""
+    obs = metadata.get("observation")
+    if isinstance(obs, dict) and obs.get("obs_mode") == "estimate" and \
+            isinstance(obs.get("xr_scale"), list):
+        return len(obs["xr_scale"]) + 1
+    return None
+
+
 class TrainedAgent:
     """An agent directory (module docstring) as a policy on the env's raw observation.
 
     ``predict`` runs the :class:`ActorProgram` and maps its action to volts with the
-    same :class:`train.vec.VoltageMap` as in training.
+    same :class:`train.voltage.VoltageMap` as in training.
     """
 
     def __init__(self, actor: ActorProgram, metadata: dict, name: str = "agent",
@@ -260,9 +313,9 @@ class TrainedAgent:
         except (OSError, ValueError, zipfile.BadZipFile, EOFError) as exc:
             raise AgentFileError(f"{pol_path}: not a readable numpy archive ({exc})") from None
         try:
-            actor = ActorProgram(meta["actor"], arrays)
+            actor = ActorProgram(meta["actor"], arrays, observation_width(meta))
         except AgentFileError as exc:
-            raise AgentFileError(f"{d}: {exc}") from None
+            raise AgentFileError(f"{d}/{exc}") from None
         agent = cls(actor, meta, name or meta.get("algo", "agent"), d)
         if check:
             agent.check_current()

@@ -51,7 +51,8 @@ class TrainConfig:
         (:class:`train.distill.DistillConfig`'s fields); None: from scratch.
     shaping : float or None
         Voltage weight of the LQ potential used for reward shaping during training
-        (:class:`train.vec.VecLQShaping`); None: the env's reward as is.
+        (:class:`train.vec.VecAgentEnv`, :func:`train.vec.lq_potential`); None: the env's
+        reward as is.
     normalize : dict
         Keyword arguments of ``VecNormalize``.
     eval_freq, checkpoint_freq : int

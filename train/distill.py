@@ -2,7 +2,7 @@ r"""Initialise an agent's actor by imitating a reference policy (DAgger).
 
 The constrained MPC is within a few percent of the clairvoyant bound but solves a
 QP every millisecond; PPO and SAC from scratch stayed near LQR on this beam
-(README, "What was tried"). Distillation gives the actor MPC-class control to
+(docs/training.md). Distillation gives the actor MPC-class control to
 start from; reinforcement learning then fine-tunes it on the env's reward.
 
 This is DAgger (Ross, Gordon & Bagnell 2011): in iteration i the training env is

@@ -10,23 +10,13 @@ episode; a network on the raw observation must resolve it at every amplitude.
 
 from __future__ import annotations
 
-import numpy as np
 import torch
 from gymnasium import spaces
 from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 
+from .direction import EPS, direction_features
+
 __all__ = ["DirectionFeatures", "direction_features", "FEATURES"]
-
-#: Amplitude floor of the norm (the observation's scales are of order one).
-EPS = 1e-12
-
-
-def direction_features(obs: np.ndarray) -> np.ndarray:
-    r"""numpy twin of :class:`DirectionFeatures`: ``[z / |z|, log |z|]``, shape (n, d + 1)."""
-    z = np.asarray(obs, dtype=np.float64)
-    r = np.sqrt(np.sum(z * z, axis=-1, keepdims=True) + EPS**2)
-    return np.concatenate([z / r, np.log(r)], axis=-1)
-
 
 class DirectionFeatures(BaseFeaturesExtractor):
     r"""Features :math:`[z / |z|,\ \log |z|]` of the observation z (d + 1 values).

@@ -1,4 +1,4 @@
-"""The training env: the native batched ``ACLDBeam-v0`` through SB3's ``VecEnv``
+"""The training env: the native batched ``ACLDBeam-v1`` through SB3's ``VecEnv``
 adapter, with the action mapped to [-1, 1] (optionally as a residual on the
 discrete LQR), optional potential-based reward shaping, and ``VecNormalize``.
 
@@ -17,38 +17,10 @@ from acld_gym.design.feedback import discrete_lqr_gain
 from acld_gym.design.nominal import nominal_design
 from acld_gym.envs.sb3 import SB3VecEnv
 from acld_gym.physics.actuator import V_LIMIT
-from baselines.policies import LQRPolicy
+
+from .voltage import VoltageMap
 
 __all__ = ["VoltageMap", "VecAgentEnv", "lq_potential", "make_vec_env"]
-
-
-class VoltageMap:
-    r"""Agent action :math:`a \in [-1, 1]` to piezo voltage [V].
-
-    Plain: :math:`V = 120\,a`. Residual on LQR:
-    :math:`V = 120\,\mathrm{clip}(u_\mathrm{LQR}/120 + 2a, -1, 1)` with
-    :math:`u_\mathrm{LQR}` the discrete LQR voltage of
-    :class:`baselines.policies.LQRPolicy` for the same ``"estimate"`` observation
-    (the unsaturated LQR voltage: the residual moves it by at most 240 V, so it
-    refines LQR where LQR is unsure and cannot overrule it where LQR is far in
-    saturation -- with the LQR voltage clipped first, training was unstable).
-    The same map serves training (:class:`VecAgentEnv`) and the trained
-    agent (:class:`train.agent.TrainedAgent`).
-    """
-
-    def __init__(self, residual: str | None = None, mesh: str = "converged"):
-        if residual not in (None, "lqr"):
-            raise ValueError(f"residual must be None or 'lqr', got {residual!r}")
-        self.residual = residual
-        self._lqr = LQRPolicy(mesh=mesh) if residual == "lqr" else None
-
-    def __call__(self, action: np.ndarray, obs: np.ndarray) -> np.ndarray:
-        """Volts, shape (n, 1), for actions (n, 1) and raw observations (n, 7)."""
-        a = np.clip(np.asarray(action, dtype=np.float64).reshape(-1, 1), -1.0, 1.0)
-        if self._lqr is not None:
-            u0 = self._lqr.voltage(self._lqr.reduced_state(np.atleast_2d(obs)))[:, None]
-            a = np.clip(u0 / V_LIMIT + 2.0 * a, -1.0, 1.0)
-        return (V_LIMIT * a).astype(np.float32)
 
 
 def lq_potential(gamma: float, lam: float, y_ref: float = 1e-3, dt: float = 1e-3,
@@ -126,7 +98,7 @@ def make_vec_env(cfg, seed: int, n_envs: int | None = None, backend: str = "nati
                  load_case=None) -> VecNormalize:
     """The wrapped training env of a :class:`train.config.TrainConfig` (seeded).
 
-    ``backend="native"``: :class:`acld_gym.sb3.SB3VecEnv` (one batched env);
+    ``backend="native"``: :class:`acld_gym.envs.sb3.SB3VecEnv` (one batched env);
     ``"subproc"``: SB3's ``SubprocVecEnv`` over single envs (for comparison).
     """
     n = cfg.n_envs if n_envs is None else n_envs

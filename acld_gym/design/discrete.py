@@ -22,7 +22,8 @@ grid) and second-order accurate for harmonics (relative error about
 where :math:`H^0_i, H^1_i` are the hold weights of sub-interval i. Every
 matrix comes from one matrix exponential of an augmented (Van Loan) matrix,
 computed in balanced coordinates, so the sampled model is exact for any
-stiffness; :func:`load_weights` is tested against a much finer reference.
+stiffness; :func:`discretize` is tested against a much finer reference
+(tests/design/test_discrete.py).
 """
 
 from __future__ import annotations

@@ -147,7 +147,7 @@ def discrete_kalman(Ad: np.ndarray, Bd: np.ndarray, Ed: np.ndarray, Cr: np.ndarr
     ACLDBeam-v0) the filter trusts the lightly damped model so much that a 10 % change
     of the beam's stiffness destabilizes LQR + observer; with :math:`\mu = 0.1` the
     loop stays stable on every plant the env's ``param_noise`` accepts
-    (tests/test_robustness.py).
+    (tests/baselines/test_robustness.py).
     """
     if not (isinstance(model_std, (int, float)) and np.isfinite(model_std) and model_std >= 0):
         raise ValueError(f"model_std must be a non-negative number, got {model_std!r}")

@@ -2,7 +2,8 @@
 
 Everything downstream (the reproduction, the environment's reference
 policies) starts from a :class:`Design`, so the pipeline is written once. The
-design model (the 6-state reduced model and everything designed on it) is kept
+design model (the reduced model -- 8 states on the converged plant, 6 on the thesis
+mesh -- and everything designed on it) is kept
 apart from the truth model it was reduced from (:class:`acld_gym.physics.plant.Plant`):
 the environment simulates the truth, possibly with randomized parameters, while
 observers and baselines keep the nominal design.
@@ -30,8 +31,8 @@ REDUCED_ORDER = 6
 #: 5330 rad/s, below twice the 1 kHz control's Nyquist frequency (it aliases to 953 rad/s,
 #: next to mode 2): 6 states give sigma_6 / sigma_7 = 4.2 and LQR/SMC loops with the
 #: observer that are unstable at small amplitude (spectral radius 1.011); 8 states (modes
-#: 1-4) give sigma_8 / sigma_9 = 10.4 and stable loops (README, "Thesis mesh vs converged
-#: plant").
+#: 1-4) give sigma_8 / sigma_9 = 10.4 and stable loops (the mesh study,
+#: docs/mesh.md).
 DESIGN_ORDER = {"thesis": 6, "converged": 8}
 
 
@@ -109,6 +110,8 @@ def design(model: Plant | BeamModel | None = None, order: int = REDUCED_ORDER,
     smc_eps : the continuous SMC's boundary layer.
     basis : coordinates of the reduced model (:data:`acld_gym.design.reduction.BASES`).
 
+    Notes
+    -----
     The laws are designed on first use.
     """
     if isinstance(model, Plant):

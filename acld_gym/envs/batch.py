@@ -4,9 +4,9 @@
 :class:`acld_gym.envs.step.StepLayout`) and advances them all with one product by the
 fused matrix (:func:`acld_gym.envs.step.output_matrix`): the single env is its N = 1 case,
 the vector env its N = num_envs case. :meth:`BatchStep.advance` is the step in numpy (the
-reference); the compiled step (``acld_gym.envs._stepcore.BatchCore``, :attr:`core`) runs the
-same step on the same arrays, with the reward and the termination mirrored from
-:mod:`acld_gym.envs.step`. Both return the same :class:`StepResult`.
+reference); the compiled step (``acld_gym.envs._stepcore.BatchCore``,
+:attr:`BatchStep.core`) runs the same step on the same arrays, with the reward and the
+termination mirrored from :mod:`acld_gym.envs.step`. Both return the same :class:`StepResult`.
 
 Loads: the compiled step evaluates each env's encoded load (:mod:`acld_gym.envs.loadcode`)
 at every step; the numpy step reads the episode's load samples from a table filled at reset

@@ -130,7 +130,7 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
 
     | field | default | meaning |
     |---|---|---|
-    | ``load_case`` | 1 | 1, 2, 3 (thesis ch. 5), ``"random"`` (:func:`random_load`) or a |
+    | ``load_case`` | 1 | 1, 2, 3 (thesis ch. 5), ``"random"`` (new random load per episode) or a |
     | | | ``TipLoad`` (pulses, harmonics, ``Samples``; :mod:`acld_gym.physics.loads`) |
     | ``mesh`` | ``"converged"`` | truth plant: ``"converged"`` or ``"thesis"`` (38 states) |
     | ``dt`` | 1e-3 | control period [s], in [1e-4, 1e-2] |
@@ -174,7 +174,7 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
     on every mesh: the thesis tuned it to its model's first resonance (178.6 rad/s);
     the converged beam's is 177.4 rad/s, and over the 0.193 s of the load the 1.6 rad/s
     detuning adds up to 0.31 rad of phase, so the load still pumps the first mode
-    (README, "Thesis mesh vs converged plant"). Random loads aim their harmonics at
+    (the mesh study, ``docs/mesh.md``). Random loads aim their harmonics at
     the plant's own modes.
 
     ## Version History

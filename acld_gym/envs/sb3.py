@@ -10,7 +10,7 @@ final observation is in ``infos[i]["terminal_observation"]``;
 Example::
 
     from stable_baselines3 import PPO
-    from acld_gym.sb3 import SB3VecEnv
+    from acld_gym.envs import SB3VecEnv
 
     venv = SB3VecEnv(num_envs=16, load_case="random")
     PPO("MlpPolicy", venv).learn(100_000)

@@ -78,7 +78,8 @@ def _mode_guesses(params: BeamParameters, band: float) -> np.ndarray:
 
 
 def build_converged_plant(dt: float, params: BeamParameters, refinement: int) -> Plant:
-    """Build the converged plant from the fine mesh (no cache; see :func:`converged_plant`)."""
+    """Build the converged plant from the fine mesh (no cache; see
+    :func:`acld_gym.physics.truth.converged_plant`)."""
     band = band_of(dt)
     fine = parametric_model(params, Mesh().refined(refinement))
     lam = damped_modes(fine, _mode_guesses(params, band))

@@ -132,7 +132,7 @@ class BeamModel:
 
     def to_statespace(self):
         """The model as a ``control.StateSpace`` (inputs voltage [V] and tip load [N],
-        output tip deflection [m]; :mod:`acld_gym.design.interop`)."""
+        output tip deflection [m]; :mod:`acld_gym.physics.interop`)."""
         from acld_gym.physics.interop import statespace
 
         A, B, E, C = self.state_space()

@@ -6,7 +6,8 @@ Two meshes (``mesh=``):
   finite-element model itself. The thesis chose it "so as to limit the time of
   numerical simulation" (sec. 2.6); its modes 2 and 3 are 14 % and 50 % too high.
   Table 2 and ``ACLDBeam-v0`` use it.
-* ``"converged"``: the same beam on a mesh refined :data:`REFINEMENT` = 128 times
+* ``"converged"``: the same beam on a mesh refined
+  :data:`acld_gym.physics.krylov.REFINEMENT` = 128 times
   (2305 DOFs; modes 1-4 within 0.005 % of their Richardson limits, see
   :mod:`acld_gym.physics.convergence`), projected by Galerkin onto a rational Krylov
   subspace: the responses to the voltage and to the tip load at
@@ -140,7 +141,7 @@ class Plant:
         return first_order(M, C, K, Pc, self.Fd, self.c)
 
     def to_statespace(self, params: BeamParameters | None = None):
-        """The plant as a ``control.StateSpace`` (:mod:`acld_gym.design.interop`)."""
+        """The plant as a ``control.StateSpace`` (:mod:`acld_gym.physics.interop`)."""
         from acld_gym.physics.interop import statespace
 
         A, B, E, C = self.state_space(params)

@@ -33,7 +33,8 @@ def converged_plant(dt: float = 1e-3, params: BeamParameters | None = None,
 
     Parameters
     ----------
-    dt : control period [s]; the plant is accurate up to :func:`band_of` (dt).
+    dt : control period [s]; the plant is accurate up to
+        :func:`acld_gym.physics.plant.band_of` (dt).
     params : nominal parameters (default: the thesis's MATLAB values).
     refinement : refinement factor of the thesis mesh (default :data:`REFINEMENT`).
     """

@@ -137,7 +137,7 @@ def build_parser() -> argparse.ArgumentParser:
     m.add_argument("--preset", choices=sorted(PRESETS), default="matlab")
     m.set_defaults(func=cmd_model)
     me = sub.add_parser("mesh", help="mesh convergence; the thesis mesh against the converged "
-                                     "plant (README tables)")
+                                     "plant (the tables of docs/mesh.md)")
     me.add_argument("--json", metavar="PATH", help="write the numbers as JSON")
     me.set_defaults(func=cmd_mesh)
     pa = sub.add_parser("params", help="print the parameter table (Markdown)")

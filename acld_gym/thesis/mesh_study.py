@@ -1,5 +1,5 @@
-"""The thesis mesh against the mesh-converged plant: the numbers of the README section
-"Thesis mesh vs converged plant" (``acld-gym mesh``), from the mode study of
+"""The thesis mesh against the mesh-converged plant: the numbers of the documentation's
+mesh study, ``docs/mesh.md`` (``acld-gym mesh``), from the mode study of
 :mod:`acld_gym.physics.convergence`, the two truth plants, their design models and the
 thesis's passive and LQR responses."""
 
@@ -26,7 +26,7 @@ __all__ = ["mesh_report", "format_mesh_report"]
 
 
 def mesh_report(dt: float = 1e-3) -> dict:
-    """The README's "Thesis mesh vs converged plant" numbers (``acld-gym mesh``).
+    """The numbers of ``docs/mesh.md`` (``acld-gym mesh``).
 
     Returns a JSON-able dict: the mode study, both plants' modes against the Richardson
     limits, their responses against the converged model, the design models, and the

@@ -133,6 +133,8 @@ def analyze(policy, env_id: str = acld_gym.ENV_ID, name: str | None = None,
     quiet : bool
         No progress line.
 
+    Notes
+    -----
     Everything runs on one BLAS thread (:mod:`acld_gym.util.blas`).
     """
     kwargs = dict(env_kwargs or {})

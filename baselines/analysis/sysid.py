@@ -83,7 +83,8 @@ class EraRealization:
         self._P = U[:, :m].T @ H1 @ Vt[:m].T
 
     def model(self, order: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(A, B, C)`` of the realization of ``order`` (at most :attr:`max_order`)."""
+        """``(A, B, C)`` of the realization of ``order`` (at most the ``max_order`` given
+        at construction)."""
         if not isinstance(order, int) or not 1 <= order <= self.max_order:
             raise ValueError(f"order must be an integer in [1, {self.max_order}], got "
                              f"{order!r}")

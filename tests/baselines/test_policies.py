@@ -68,7 +68,7 @@ def test_bound_is_below_every_policy(results, case):
 
 @pytest.mark.parametrize("case, lqr_ratio", [(1, 1.25), (2, 1.35), (3, 1.02)])
 def test_mpc_within_1p25_of_bound_and_lqr_ratios(results, case, lqr_ratio):
-    # Measured on ACLDBeam-v1 (python -m baselines.evaluate, README): MPC 1.18x, 1.24x,
+    # Measured on ACLDBeam-v1 (python -m baselines.evaluate, docs/baselines.md): MPC 1.18x, 1.24x,
     # 1.01x of the bound; LQR 1.25x, 1.35x, 1.02x. 8 % tolerance: the switching
     # controllers make the ratios move with the noise realization by a few percent.
     b = ise(results[case, "bound"][0])
@@ -81,7 +81,7 @@ def test_mpc_within_1p25_of_bound_and_lqr_ratios(results, case, lqr_ratio):
 @pytest.mark.parametrize("name", ["lqr", "smc"])
 def test_through_env_matches_thesis_saturated_rows(thesis_results, case, name):
     # Thesis Table 2, saturated rows, on the thesis's mesh: peak within 7 %, settling
-    # within 10 % (discrete LQR/SMC at 1 kHz with the Kalman observer, README).
+    # within 10 % (discrete LQR/SMC at 1 kHz with the Kalman observer, docs/baselines.md).
     y, v = thesis_results[case, name]
     t = np.arange(1, y.size + 1) * 1e-3
     ref = thesis_row(case, name, True)

@@ -1,7 +1,7 @@
 """Small-signal stability of the reference policies on randomized plants (issue 13:
 "the baselines must stay stable on every param_noise plant that the env accepts").
 
-Provenance: ``python -m baselines.robustness`` (README) evaluates all 1024 corners of the
+Provenance: ``python -m baselines.robustness`` (docs/baselines.md) evaluates all 1024 corners of the
 box of +/-3 std of each randomized parameter at the env's bound (converged: 0.1, thesis
 mesh: 0.05); the slow test below repeats it. The fast tests take the corners that matter
 most (beam stiffness and piezo constant at their extremes) and the two counterexamples

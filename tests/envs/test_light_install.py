@@ -1,22 +1,13 @@
 """The env without the training stack (issue 11, light extras): ``import acld_gym`` and
 ``gym.make`` work in an environment without torch, SB3, osqp, yaml or tqdm. The imports
-are blocked in a subprocess, the way a core-only install lacks them."""
+are blocked in a subprocess, the way a core-only install lacks them
+(:func:`tests.core_only.run_core_only`)."""
 
 from __future__ import annotations
 
-import subprocess
-import sys
-
-BLOCKED = ("torch", "stable_baselines3", "sb3_contrib", "osqp", "tensorboard", "yaml", "tqdm",
-           "ray")
+from tests.core_only import BLOCKED, run_core_only
 
 CODE = f"""
-import sys
-class Block:
-    def find_spec(self, name, path=None, target=None):
-        if name.split('.')[0] in {BLOCKED!r}:
-            raise ImportError(f'blocked: {{name}} (not in a core install)')
-sys.meta_path.insert(0, Block())
 import numpy as np, gymnasium as gym
 import acld_gym
 for env_id in ("ACLDBeam-v1", "ACLDBeam-v0"):
@@ -28,12 +19,12 @@ vec = gym.make_vec("ACLDBeam-v1", num_envs=4)
 vec.reset(seed=0)
 vec.step(np.zeros((4, 1)))
 from acld_gym.thesis.reproduce import run_cases
-loaded = sorted(m for m in sys.modules if m.split('.')[0] in {BLOCKED!r})
+loaded = sorted(m for m in sys.modules if m.split('.')[0] in {BLOCKED + ("tqdm",)!r})
 print("ok", loaded)
 """
 
 
 def test_env_works_without_the_training_stack():
-    out = subprocess.run([sys.executable, "-c", CODE], capture_output=True, text=True)
+    out = run_core_only(CODE, blocked_extra=("tqdm",))
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "ok []"

@@ -1,7 +1,7 @@
 """Independent verification of the finite-element model against closed-form results
 (GitHub issue 13, item 2).
 
-Provenance: every reference number is computed by ``tests/closed_form.py`` (no code
+Provenance: every reference number is computed by ``tests/physics/closed_form.py`` (no code
 shared with acld_gym; its docstrings give author, year and equation of each formula)
 from the parameters of :class:`acld_gym.physics.params.BeamParameters` (the thesis's MATLAB
 values): aluminium beam 300 x 15 x 3 mm, E = 70 GPa, G = 26 GPa, rho = 2700 kg/m^3,

@@ -102,7 +102,7 @@ def test_bad_arguments(argv, word, capsys):
 
 @pytest.mark.slow
 def test_mesh_report_json(tmp_path):
-    # The README's "Thesis mesh vs converged plant" tables come from this command.
+    # The tables of docs/mesh.md come from this command.
     import json
 
     p = tmp_path / "mesh.json"

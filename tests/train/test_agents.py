@@ -1,12 +1,13 @@
 """The shipped agents (train/agents/) and the agent format.
 
 The agents load without executing anything, refuse observations they were not trained
-on, act in volts, and reproduce the rows of ``train/agents/compare.json`` -- the README's
-table, written by ``python -m train.compare --json train/agents/compare.json`` -- on the
-three thesis cases and the held-out random set. Tolerance 1e-2 relative on ISE and
-peak: the evaluation is deterministic, and the observation is the same on every machine
-(canonical basis, shipped plant); the slack covers BLAS round-off in the agents'
-switching decisions, which a near-tie can amplify.
+on, act in volts, and reproduce the rows of ``train/agents/compare.json`` -- the table of
+``docs/training.md`` and the README's score table, written by
+``python -m train.compare --json train/agents/compare.json`` -- on the three thesis cases
+and the held-out random set. Tolerance 1e-2 relative on ISE and peak: the evaluation is
+deterministic, and the observation is the same on every machine (canonical basis, shipped
+plant); the slack covers BLAS round-off in the agents' switching decisions, which a
+near-tie can amplify.
 """
 
 from __future__ import annotations
@@ -26,7 +27,8 @@ from train.compare import AGENTS_DIR, HELDOUT_SEEDS, agent_names, load_agents
 
 RTOL = 1e-2
 ROWS = json.loads((AGENTS_DIR / "compare.json").read_text())
-README = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+#: The page with the comparison tables (``python -m train.compare --markdown``).
+PAGE = (Path(__file__).resolve().parents[2] / "docs" / "training.md").read_text()
 NAMES = agent_names()
 
 
@@ -68,7 +70,19 @@ def test_thesis_cases_reproduce_the_table(agents, name, case):
     assert row.ise == pytest.approx(ref["ise"], rel=RTOL)
     assert row.peak_mm == pytest.approx(ref["peak_mm"], rel=RTOL)
     assert np.abs(ep.voltage).max() <= 120.0
-    assert f"{ref['ise']:.3e}" in README
+    assert f"{ref['ise']:.3e}" in PAGE
+
+
+def test_the_pages_show_the_generated_tables():
+    """Every row of ``train/agents/compare.md`` (written by ``python -m train.compare``) is
+    on the training page, and the README's score table is its score table."""
+    root = Path(__file__).resolve().parents[2]
+    rows = [line for line in (AGENTS_DIR / "compare.md").read_text().splitlines()
+            if line.startswith("| ")]
+    assert rows and [r for r in rows if r not in PAGE.splitlines()] == []
+    readme = (root / "README.md").read_text().splitlines()
+    scores = rows[rows.index(next(r for r in rows if "score (IQM)" in r)):]
+    assert [r for r in scores if r not in readme] == []
 
 
 @pytest.mark.parametrize("name", NAMES)
@@ -130,6 +144,31 @@ def test_bad_metadata_is_named(agent_dir):
     (agent_dir / META_FILE).write_text("[1, 2]")
     with pytest.raises(AgentFileError, match=META_FILE):
         TrainedAgent.load(agent_dir)
+
+
+def _damage(agent_dir: Path, key: str, change) -> None:
+    """Rewrite one array of the agent's policy file with ``change(array)``."""
+    with np.load(agent_dir / POLICY_FILE) as z:
+        arrays = {k: z[k] for k in z.files}
+    arrays[key] = change(arrays[key])
+    np.savez(agent_dir / POLICY_FILE, **arrays)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_every_array_is_checked_against_the_program(name, tmp_path):
+    """Wrong shapes (one input too few, a second action, a matrix for a vector) and
+    non-finite weights are refused at load, naming the file and the array."""
+    cases = [("W0", lambda w: w[:-1], "shape"), ("b0", lambda b: np.concatenate([b, b]), "shape"),
+             ("b0", lambda b: np.atleast_2d(b), "shape"),
+             ("W0", lambda w: np.where(np.arange(w.size).reshape(w.shape) == 0, np.nan, w),
+              "non-finite"),
+             ("b0", lambda b: b + np.inf, "non-finite")]
+    for i, (key, change, what) in enumerate(cases):
+        d = tmp_path / f"{name}-{i}"
+        shutil.copytree(AGENTS_DIR / name, d)
+        _damage(d, key, change)
+        with pytest.raises(AgentFileError, match=rf"{POLICY_FILE}: array '{key}' has {what}"):
+            TrainedAgent.load(d, check=False)
 
 
 def test_fingerprint_mismatch_is_refused_and_says_what_differs(agent_dir):

@@ -18,15 +18,7 @@ TEST_PATH = re.compile(r"(?<![\w/])tests/[\w/]+(?:\.py)?")
 #: Broken references in ``train/bench/`` (names of sibling modules, unqualified), left to
 #: the change that owns that folder (issue 23's RL recipe). Strict both ways: a new broken
 #: reference fails, and so does one of these once it is mended and still listed here.
-PENDING = {
-    "train/bench/__init__.py": {"LinearDirectionActor", "whitening", "make_sb3_env",
-                                "VecDirectionFeatures", "AlgoConfig", "VecWhiten",
-                                "SplitCriticPolicy", "EpisodeScaledRolloutBuffer"},
-    "train/bench/config.py": {"ConcatVecEnv", "RandomSearch", "whitening", "VecWhiten",
-                              "EpisodeScaledRolloutBuffer"},
-    "train/bench/sb3_envs.py": {"whitening", "train_sb3"},
-    "train/bench/sb3_policies.py": {"VecWhiten"},
-}
+PENDING: dict[str, set[str]] = {}
 
 
 def sources() -> list[Path]:

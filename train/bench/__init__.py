@@ -8,25 +8,28 @@ reports learning-curve points through a callback, and returns a policy with SB3'
 ``predict`` in volts.
 
 * ``vrs`` (the recipe): vectorised random search (ARS, Mania et al. 2018, "V1-t") on
-  the linear direction actor :class:`LinearDirectionActor`,
-  :math:`V = 120\,\mathrm{clip}(w \cdot [u/|u|, \log|u|] + b, -1, 1)` (9 parameters
-  for the 7-value observation z), :math:`u = T^T z` with T a whitening matrix the
-  agent estimates from its own first round of episodes (:func:`whitening`). All
+  the linear direction actor :class:`train.bench.search.LinearDirectionActor`,
+  :math:`V = 120\,\mathrm{clip}(w \cdot [u/|u|, \log|u|] + b, -1, 1)` (11 parameters
+  for the 9-value observation z: 10 weights and a bias), :math:`u = T^T z` with T a whitening matrix the
+  agent estimates from its own first round of episodes (:func:`acld_gym.wrappers.whitening`). All
   2 x ``n_directions`` perturbed actors run side by side in the native batched env
   on the same episodes (common random numbers), and each episode's return R is
   scored as :math:`-\log(-R)` (``objective: log``), which makes loads whose returns
   differ by three decades weigh alike (reward normalisation per load).
 * ``ars``: sb3-contrib's ``ARS`` (linear policy, clipped) on the direction features.
 * ``ppo``, ``sac``, ``td3``, ``tqc``, ``crossq``: stable-baselines3 / sb3-contrib
-  through :func:`make_sb3_env`: the native batched env (``SB3VecEnv``), actions in
+  through :func:`train.bench.sb3_envs.make_sb3_env`: the native batched env (``SB3VecEnv``),
+  actions in
   [-1, 1] (``train.vec.VecAgentEnv``, no residual, no shaping), optionally the
-  direction features as the observation (:class:`VecDirectionFeatures`), and
-  ``VecNormalize``. Options for them (fields of :class:`AlgoConfig`): ``whiten_steps``,
+  direction features as the observation (:class:`train.bench.sb3_envs.VecDirectionFeatures`), and
+  ``VecNormalize``. Options for them (fields of :class:`train.bench.config.AlgoConfig`):
+  ``whiten_steps``,
   a ZCA whitening of the observation estimated from the agent's own first rollouts
-  (:class:`VecWhiten`, the steps counted in the budget); for PPO the policy
+  (:class:`train.bench.sb3_envs.VecWhiten`, the steps counted in the budget); for PPO the policy
   ``SplitCriticPolicy`` (the critic on its own features, e.g. quadratic ones,
-  :class:`SplitCriticPolicy`) and ``episode_scale``, advantages normalised per episode
-  (:class:`EpisodeScaledRolloutBuffer`).
+  :class:`train.bench.sb3_policies.SplitCriticPolicy`) and ``episode_scale``, advantages normalised
+  per episode
+  (:class:`train.bench.sb3_policies.EpisodeScaledRolloutBuffer`).
 
 Modules, in the order of a run: ``config`` (an algorithm's YAML settings), ``search``
 (``vrs``), ``sb3_envs``, ``sb3_policies`` and ``sb3_train`` (the SB3 algorithms),

@@ -45,27 +45,29 @@ class AlgoConfig:
     loads : dict
         Training loads, ``{case: weight}`` with cases 1, 2, 3, ``random``. For ``vrs``
         the weights are episodes per candidate per iteration; for SB3 algorithms the
-        sub-envs are split in proportion (:class:`ConcatVecEnv`).
+        sub-envs are split in proportion (:class:`train.bench.sb3_envs.ConcatVecEnv`).
     features : str or None
         ``"direction"``: the agent sees ``[z/|z|, log|z|]``; None: the raw observation.
     normalize : dict
         ``VecNormalize`` keyword arguments (SB3 algorithms).
     model : dict
         The algorithm's keyword arguments (SB3: ``policy`` included; ``vrs``: the
-        fields of :class:`RandomSearch`).
+        fields of :class:`train.bench.search.RandomSearch`).
     eval_points : int
         Learning-curve points (evaluations) over the budget, besides the one at step 0
         (log-spaced, :class:`eval_schedule`).
     whiten_steps : int
         SB3 algorithms: 0 (default) for none; else the agent first acts with its own
         initial (stochastic) policy for about this many env steps (whole vector steps,
-        counted in the budget), and :func:`whitening` of the observation directions it
+        counted in the budget), and :func:`acld_gym.wrappers.whitening` of the observation
+        directions it
         saw becomes a fixed linear map of the observation, ``u = T^T z``
-        (:class:`VecWhiten`), the network's input. Needs ``features: null`` and
+        (:class:`train.bench.sb3_envs.VecWhiten`), the network's input. Needs ``features: null`` and
         ``norm_obs: false``; the final actor takes T into its first layer.
     episode_scale : bool
         PPO only: the advantages of each episode in a rollout are divided by their
-        root mean square (:class:`EpisodeScaledRolloutBuffer`; the critic's targets
+        root mean square (:class:`train.bench.sb3_policies.EpisodeScaledRolloutBuffer`; the
+        critic's targets
         are unchanged): episodes whose returns differ by decades weigh alike in the
         policy gradient (normalisation per load). Use ``n_steps`` = the episode length.
     env_kwargs : dict

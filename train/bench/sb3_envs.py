@@ -1,7 +1,10 @@
-"""The SB3 algorithms' training env (:func:`make_sb3_env`): the native batched env
+"""The SB3 algorithms' training env (:func:`train.bench.sb3_envs.make_sb3_env`): the native batched
+env
 (``SB3VecEnv``) with actions in [-1, 1], no residual and no shaping, split over the
-training loads (:class:`ConcatVecEnv`), optionally whitened (:class:`VecWhiten`) or
-as direction features (:class:`VecDirectionFeatures`), under ``VecNormalize``."""
+training loads (:class:`train.bench.sb3_envs.ConcatVecEnv`), optionally whitened
+(:class:`train.bench.sb3_envs.VecWhiten`) or
+as direction features (:class:`train.bench.sb3_envs.VecDirectionFeatures`), under
+``VecNormalize``."""
 
 from __future__ import annotations
 
@@ -45,7 +48,8 @@ class VecWhiten(VecEnvWrapper):
     r"""Observation ``z`` -> ``u = T^T z`` with a fixed matrix T (identity until
     :meth:`set_transform`). While ``collect`` is a list, the raw observation directions
     ``z/|z|`` seen (every sub-env, every step) are appended to it, from which
-    :func:`whitening` estimates T (:func:`train_sb3` with ``whiten_steps``)."""
+    :func:`acld_gym.wrappers.whitening` estimates T (:func:`train.bench.sb3_train.train_sb3` with
+    ``whiten_steps``)."""
 
     def __init__(self, venv: VecEnv, passthrough: int = 0):
         super().__init__(venv)
@@ -163,8 +167,9 @@ def _split_envs(weights: dict, n_envs: int) -> dict:
 def make_sb3_env(cfg: AlgoConfig, seed: int, env_id: str, gamma: float = 0.99) -> VecNormalize:
     """The SB3 training env: per training load case a native batched env
     (``SB3VecEnv`` over ``gym.make_vec(env_id)``) side by side, actions in [-1, 1]
-    (``VecAgentEnv``: no residual, no shaping), :class:`VecWhiten` if
-    ``cfg.whiten_steps`` (identity until :func:`train_sb3` sets it), optional direction
+    (``VecAgentEnv``: no residual, no shaping), :class:`train.bench.sb3_envs.VecWhiten` if
+    ``cfg.whiten_steps`` (identity until :func:`train.bench.sb3_train.train_sb3` sets it), optional
+    direction
     features, and
     ``VecNormalize`` with ``cfg.normalize`` (seeded: sub-env i gets ``seed + i``)."""
     from acld_gym.envs.sb3 import SB3VecEnv

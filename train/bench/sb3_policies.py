@@ -1,6 +1,7 @@
 """Policy pieces for the SB3 algorithms: a critic on its own (e.g. quadratic) features
-(:class:`SplitCriticPolicy`), advantages normalised per episode
-(:class:`EpisodeScaledRolloutBuffer`), and a trained model as a ``predict`` policy in
+(:class:`train.bench.sb3_policies.SplitCriticPolicy`), advantages normalised per episode
+(:class:`train.bench.sb3_policies.EpisodeScaledRolloutBuffer`), and a trained model as a
+``predict`` policy in
 volts (:class:`SB3Policy`)."""
 
 from __future__ import annotations
@@ -84,7 +85,8 @@ class ScaledQuadraticFeatures(QuadraticFeatures):
         return super().forward(u)
 
 
-#: ``critic_features`` of :class:`SplitCriticPolicy` and their extractor classes.
+#: ``critic_features`` of :class:`train.bench.sb3_policies.SplitCriticPolicy` and their extractor
+#: classes.
 CRITIC_FEATURES = {
     "quadratic": QuadraticFeatures,
     "scaled_quadratic": ScaledQuadraticFeatures,
@@ -177,7 +179,8 @@ class EpisodeScaledRolloutBuffer(RolloutBuffer):
 class SB3Policy:
     """A trained SB3 model with its frozen ``VecNormalize`` statistics as a policy on the
     env's raw observation, ``predict`` in volts (``V = v_max * clip(a, -1, 1)``);
-    ``transform``: the agent's whitening matrix (:class:`VecWhiten`), or None."""
+    ``transform``: the agent's whitening matrix (:class:`train.bench.sb3_envs.VecWhiten`), or
+    None."""
 
     def __init__(
         self,

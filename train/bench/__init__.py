@@ -9,8 +9,9 @@ reports learning-curve points through a callback, and returns a policy with SB3'
 
 * ``vrs`` (the recipe): vectorised random search (ARS, Mania et al. 2018, "V1-t") on
   the linear direction actor :class:`train.bench.search.LinearDirectionActor`,
-  :math:`V = 120\,\mathrm{clip}(w \cdot [u/|u|, \log|u|] + b, -1, 1)` (11 parameters
-  for the 9-value observation z: 10 weights and a bias), :math:`u = T^T z` with T a whitening matrix the
+  :math:`V = 120\,\mathrm{clip}(w \cdot [u/|u|, \log|u|] + b, -1, 1)` (11
+  parameters for the 9-value observation z: 10 weights and a bias), :math:`u = T^T z`
+  with T a whitening matrix the
   agent estimates from its own first round of episodes (:func:`acld_gym.wrappers.whitening`). All
   2 x ``n_directions`` perturbed actors run side by side in the native batched env
   on the same episodes (common random numbers), and each episode's return R is

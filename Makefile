@@ -38,18 +38,14 @@ studies: $(STAMP)
 	$(BIN)/python -m baselines.robustness
 	$(BIN)/python -m baselines.analyze passive lqr smc mpc $(wildcard train/agents/*/) --json results/analysis.json --markdown results/analysis.md --plots results/figures
 
-## Retrain the shipped agents. From scratch (no teacher): the benchmark's runs of vrs, ppo
-## and sac (5 seeds each, resumable), then ship vrs seed 0 and the ppo / sac seed that is
-## best on the thesis cases (README, "Reinforcement learning from scratch"). With the
-## opt-in MPC teacher: the DAgger agents, each run's best checkpoint.
+## Retrain the shipped agents, from scratch (no teacher): the benchmark's runs of vrs, ppo and
+## sac (5 seeds each, resumable), then ship vrs seed 0 and the ppo and sac seeds that are best
+## on the thesis cases (docs/training.md, "Reinforcement learning from scratch").
 agents: $(STAMP)
 	$(BIN)/python -m train.benchmark --algos vrs ppo sac --seeds 0 1 2 3 4 --resume --out runs/benchmark/v1
 	$(BIN)/python -m train.ship runs/benchmark/v1/agents/vrs-s0 vrs
-	$(BIN)/python -m train.ship runs/benchmark/v1/agents/ppo-s0 ppo
-	$(BIN)/python -m train.ship runs/benchmark/v1/agents/sac-s2 sac
-	$(BIN)/python -m train ppo --config train/ppo_dagger.yaml --seed 0 --out runs/ppo_dagger --no-progress
-	$(BIN)/python -m train sac --config train/sac_dagger.yaml --seed 0 --out runs/sac_dagger --no-progress
-	for a in ppo_dagger sac_dagger; do $(BIN)/python -m train.ship runs/$$a $$a; done
+	$(BIN)/python -m train.ship runs/benchmark/v1/agents/ppo-s3 ppo
+	$(BIN)/python -m train.ship runs/benchmark/v1/agents/sac-s0 sac
 
 ## Lint + the test suite (slow tests excluded; see test-slow) + the documentation site.
 test: $(STAMP)

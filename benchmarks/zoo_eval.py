@@ -7,7 +7,7 @@ cases 1, 2, 3 (seed 0) and the held-out random set, divided by LQR's ISE
 (:mod:`train.bench.evaluate`). Not a test::
 
     python -m rl_zoo3.train --algo ppo --env ACLDBeam-v1 --gym-packages acld_gym \\
-        --conf-file train/zoo/ppo.yml -f logs --seed 0
+        --conf-file train/zoo/ppo.yml -f logs --seed 0 --eval-freq -1
     python benchmarks/zoo_eval.py ppo logs/ppo/ACLDBeam-v1_1
 """
 

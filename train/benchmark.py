@@ -83,6 +83,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="skip the clairvoyant bound's reference (about 30 s)")
     p.add_argument("--resume", action="store_true",
                    help="reuse trials already in OUT/trials with the same config and env id")
+    p.add_argument("--no-train", action="store_true",
+                   help="with --resume: train nothing, report the reused trials only and "
+                        "name the missing ones")
     return p
 
 
@@ -126,6 +129,14 @@ def main(argv: list[str] | None = None) -> int:
                     continue
             trials.append({"name": name, "config": data, "seed": seed, "env_id": args.env_id,
                            "random_episodes": args.random_episodes})
+    if args.no_train:
+        if not args.resume:
+            parser.error("--no-train needs --resume")
+        for t in trials:
+            print(f"  missing: {t['name']} seed {t['seed']} (not trained: --no-train)")
+        trials = []
+        if not records:
+            parser.error(f"--no-train: no trials to report in {out / 'trials'}")
     from .bench.evaluate import references
 
     t0 = time.perf_counter()

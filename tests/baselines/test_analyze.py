@@ -2,6 +2,7 @@
 the env, with the JSON schema of issue 22; the library function takes any predict."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -9,6 +10,9 @@ import pytest
 from baselines.analyze import BASELINES, analyze, main
 from baselines.policies import LQRPolicy
 from train.compare import AGENTS_DIR, agent_names
+
+#: Agents with known faults (tests/data/agents/README.md).
+FIXTURES = Path(__file__).resolve().parents[1] / "data" / "agents"
 
 
 def _run(tmp_path, policy, *extra):
@@ -48,7 +52,7 @@ def test_lqr_in_control_terms(tmp_path):
 
 
 def test_an_agent_at_the_limit_is_reported_not_refused(tmp_path):
-    rec = _run(tmp_path, str(AGENTS_DIR / "ppo_dagger"), "--score-episodes", "0")
+    rec = _run(tmp_path, str(FIXTURES / "ppo_dagger"), "--score-episodes", "0")
     _check_schema(rec)
     assert rec["closed_loop_modes"] == [{"frequency_rad_s": None, "damping_ratio": None}] * 3
     assert rec["peak_reduction_db"] == [None] * 3
@@ -106,7 +110,7 @@ def test_the_command_runs_on_every_baseline_and_agent(tmp_path, policy):
 
 def test_several_policies_give_a_list_and_the_comparison_tables(tmp_path):
     js, md = tmp_path / "all.json", tmp_path / "all.md"
-    assert main(["passive", str(AGENTS_DIR / "ppo_dagger") + "/", "--score-episodes", "0",
+    assert main(["passive", str(FIXTURES / "ppo_dagger") + "/", "--score-episodes", "0",
                  "--quiet", "--json", str(js), "--markdown", str(md)]) == 0
     recs = json.loads(js.read_text())
     assert [r["policy"] for r in recs] == ["passive", "ppo_dagger"]

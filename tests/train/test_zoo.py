@@ -44,7 +44,7 @@ def test_rl_zoo3_trains_and_replays(tmp_path, algo, extra):
     common = ["--algo", algo, "--env", "ACLDBeam-v1", "--gym-packages", "acld_gym",
               "-f", str(tmp_path)]
     subprocess.run([sys.executable, "-m", "rl_zoo3.train", *common, "--conf-file",
-                    f"train/zoo/{algo}.yml", "-n", "1024", "--seed", "0",
+                    f"train/zoo/{algo}.yml", "-n", "1024", "--seed", "0", "--eval-freq", "-1",
                     "--hyperparams", *extra], check=True, capture_output=True)
     assert (tmp_path / algo / "ACLDBeam-v1_1" / "ACLDBeam-v1.zip").is_file()
     out = subprocess.run([sys.executable, "-m", "rl_zoo3.enjoy", *common, "--no-render",

@@ -2,6 +2,7 @@
 against the env's own response, invariance to the plant's coordinates, and the margins."""
 
 from dataclasses import replace
+from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
@@ -17,7 +18,9 @@ from baselines.analysis.linear import (
 from baselines.policies import LQRPolicy, SMCPolicy
 from baselines.robustness import closed_loop_matrix
 from train.agent import TrainedAgent
-from train.compare import AGENTS_DIR
+
+#: Agents with known faults (tests/data/agents/README.md).
+FIXTURES = Path(__file__).resolve().parents[2] / "data" / "agents"
 
 
 class PredictOnly:
@@ -60,10 +63,10 @@ def test_differences_of_predict_give_the_declared_gain(cls):
 
 
 def test_nonlinear_and_saturated_policies_are_refused():
-    sac = TrainedAgent.load(AGENTS_DIR / "sac")  # [z/|z|, log|z|] features, tanh
+    sac = TrainedAgent.load(FIXTURES / "sac_0.2")  # [z/|z|, log|z|] features, tanh
     law, why = small_signal_law(sac, 9, 120.0)
     assert law is None and "linear" in why
-    stuck = TrainedAgent.load(AGENTS_DIR / "ppo_dagger")  # -120 V at rest
+    stuck = TrainedAgent.load(FIXTURES / "ppo_dagger")  # -120 V at rest
     law, why = small_signal_law(stuck, 9, 120.0)
     assert law is None and "limit at rest" in why
 

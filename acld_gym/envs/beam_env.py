@@ -100,6 +100,8 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
     tip deflection [m] at the end of the step and ``V`` the patch voltage at the end of
     the step (``info["voltage"]``: the clipped action unless the actuator options are set).
     The two terms are ``info["reward_deflection"]`` and ``info["reward_voltage"]``.
+    With ``reward_scale="passive"`` (a training aid, off by default) the reward is divided
+    by the episode's passive cost c, ``info["reward_scale"]``; the terms stay unscaled.
 
     ## Starting State
 
@@ -161,6 +163,11 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
     | | | time-temperature superposition (WLF, ``acld_gym.physics.temperature``); 20 °C is |
     | | | where the thesis's GHM parameters hold, so the default plant is v1's |
     | ``temperature_range`` | None | (low, high) [°C]: a temperature per episode, uniform |
+    | ``reward_scale`` | None | ``"passive"``: each reward of an episode divided by c, the |
+    | | | passive beam's mean step cost on the episode's load (``info["reward_scale"]``; |
+    | | | ``acld_gym.envs.scale``); the passive policy's return is then exactly -T |
+    | ``observe_reward_scale`` | False | append log c to the observation as its last entry |
+    | | | (privileged, for a critic; n + 1 entries); needs ``reward_scale`` |
     | ``env_id`` | ``"ACLDBeam-v1"`` | the registered id of the configuration (fingerprint) |
 
     The actuator chain, per period: the action is clipped (the command, which the
@@ -196,8 +203,9 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
       truncated at 3 std. Since acld-gym 0.3.0 the info also has ``requested_voltage``
       and the reward's terms in the vector env too, custom loads (``TipLoad``) are
       accepted, and the actuator (``actuator_delay``, ``amplifier_bandwidth``,
-      ``slew_rate``) and temperature (``temperature``, ``temperature_range``) options
-      exist, all off by default: v1's dynamics, rewards and observations are unchanged.
+      ``slew_rate``), temperature (``temperature``, ``temperature_range``) and reward
+      scale (``reward_scale``, ``observe_reward_scale``) options exist, all off by
+      default: v1's dynamics, rewards and observations are unchanged.
     * v0: the thesis configuration (``acld_gym.envs.presets.PRESETS["ACLDBeam-v0"]``):
       the thesis's 38-state mesh, its 6-state design model and observers, the same
       dynamics, reward, spaces and episode. It differs from v1 with ``mesh="thesis"`` in

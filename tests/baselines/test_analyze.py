@@ -11,7 +11,7 @@ from baselines.analyze import BASELINES, analyze, main
 from baselines.policies import LQRPolicy
 from train.compare import AGENTS_DIR, agent_names
 
-#: Agents with known faults (tests/data/agents/README.md).
+#: Agents with known faults (described in the README of tests/data/agents).
 FIXTURES = Path(__file__).resolve().parents[1] / "data" / "agents"
 
 

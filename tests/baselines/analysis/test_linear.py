@@ -19,7 +19,7 @@ from baselines.policies import LQRPolicy, SMCPolicy
 from baselines.robustness import closed_loop_matrix
 from train.agent import TrainedAgent
 
-#: Agents with known faults (tests/data/agents/README.md).
+#: Agents with known faults (described in the README of tests/data/agents).
 FIXTURES = Path(__file__).resolve().parents[2] / "data" / "agents"
 
 

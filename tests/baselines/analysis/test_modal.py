@@ -13,7 +13,7 @@ from baselines.policies import LQRPolicy, MPCPolicy, PassivePolicy, SMCPolicy
 from train.agent import TrainedAgent
 from train.compare import AGENTS_DIR
 
-#: Agents with known faults (tests/data/agents/README.md).
+#: Agents with known faults (described in the README of tests/data/agents).
 FIXTURES = Path(__file__).resolve().parents[2] / "data" / "agents"
 
 

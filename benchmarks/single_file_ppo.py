@@ -92,12 +92,7 @@ def main(argv=None) -> int:
     p.add_argument("--total-timesteps", type=int, default=1_000_000)
     p.add_argument("--json", type=Path, default=None, help="write the figures here")
     args = p.parse_args(argv)
-    from train.bench.evaluate import (
-        eval_episodes,
-        reference_policies,
-        relative_ise,
-        rollout_ise,
-    )
+    from train.bench.evaluate import ise_rel_lqr
 
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
@@ -113,10 +108,7 @@ def main(argv=None) -> int:
         import pickle
 
         actor = _Actor(pickle.loads(saved.read_bytes()))
-    episodes = eval_episodes()
-    ise = rollout_ise(actor, "ACLDBeam-v1", episodes)
-    lqr = rollout_ise(reference_policies("ACLDBeam-v1")["lqr"], "ACLDBeam-v1", episodes)
-    rel = relative_ise(ise, {"lqr": lqr})
+    rel = ise_rel_lqr(actor, "ACLDBeam-v1")
     out = {"seed": args.seed, "total_timesteps": args.total_timesteps, "wall_seconds": wall,
            "ise_rel_lqr": {str(k): float(v) for k, v in rel.items()}}
     print(json.dumps(out, indent=1))

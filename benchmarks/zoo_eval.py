@@ -26,7 +26,7 @@ def main(argv=None) -> int:
     args = p.parse_args(argv)
     from stable_baselines3 import PPO, SAC
 
-    from train.bench.evaluate import eval_episodes, reference_policies, relative_ise, rollout_ise
+    from train.bench.evaluate import ise_rel_lqr
     from train.bench.sb3_policies import SB3Policy
 
     path = args.run / "ACLDBeam-v1.zip"
@@ -34,10 +34,7 @@ def main(argv=None) -> int:
         p.error(f"run: no {path}")
     model = {"ppo": PPO, "sac": SAC}[args.algo].load(path, device="cpu")
     policy = SB3Policy(model, None, None)
-    episodes = eval_episodes()
-    ise = rollout_ise(policy, "ACLDBeam-v1", episodes)
-    lqr = rollout_ise(reference_policies("ACLDBeam-v1")["lqr"], "ACLDBeam-v1", episodes)
-    rel = {str(k): round(float(v), 4) for k, v in relative_ise(ise, {"lqr": lqr}).items()}
+    rel = {str(k): round(float(v), 4) for k, v in ise_rel_lqr(policy, "ACLDBeam-v1").items()}
     print(json.dumps({"run": str(args.run), "algo": args.algo, "ise_rel_lqr": rel}, indent=1))
     return 0
 

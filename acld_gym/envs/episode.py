@@ -68,17 +68,21 @@ def draw_episode(rng: np.random.Generator, case, nom: NominalDesign, config,
 def fixed_plant(nom: NominalDesign, config) -> SampledSystem:
     """The sampled plant of a configuration without per-episode draws: the nominal one (the
     same object), at ``config.temperature``, driven through its amplifier."""
-    params = shifted_parameters(nom.truth.params, config.temperature)
-    return sampled_plant(nom, None if params is nom.truth.params else params,
-                         config.amplifier_bandwidth)
+    return sampled_plant(nom, _shifted(nom, config), config.amplifier_bandwidth)
 
 
 def passive_plant(nom: NominalDesign, config) -> SampledSystem:
     """The configuration's plant as the load alone drives it (the reward scale's,
     :mod:`acld_gym.envs.scale`): the nominal beam at ``config.temperature``, without the
     amplifier (at zero voltage it does not act)."""
+    return sampled_plant(nom, _shifted(nom, config), None)
+
+
+def _shifted(nom: NominalDesign, config):
+    """The nominal parameters at ``config.temperature``, or None where they are the nominal
+    ones (20 °C)."""
     params = shifted_parameters(nom.truth.params, config.temperature)
-    return sampled_plant(nom, None if params is nom.truth.params else params, None)
+    return None if params is nom.truth.params else params
 
 
 def sampled_plant(nom: NominalDesign, params, bandwidth: float | None) -> SampledSystem:

@@ -36,6 +36,7 @@ __all__ = [
     "rollout_ise",
     "batched_ise",
     "relative_ise",
+    "ise_rel_lqr",
     "reference_policies",
     "references",
 ]
@@ -110,6 +111,17 @@ def relative_ise(ise: dict, refs: dict, to: str = "lqr") -> dict:
     """``{case: ise[case] / refs[to][case]}`` (keys of ``refs`` may be strings, as in JSON)."""
     ref = refs[to]
     return {c: ise[c] / ref[str(c)] if str(c) in ref else ise[c] / ref[c] for c in ise}
+
+
+def ise_rel_lqr(policy, env_id: str = DEFAULT_ENV_ID, episodes: dict | None = None) -> dict:
+    """``{case: ISE / ISE_LQR}`` of ``policy`` on ``episodes`` (default
+    :func:`eval_episodes`), both by :func:`rollout_ise`, LQR designed on ``env_id``: the
+    figure of a policy trained outside the benchmark (``benchmarks/zoo_eval.py``,
+    ``benchmarks/single_file_ppo.py``)."""
+    episodes = eval_episodes() if episodes is None else episodes
+    ise = rollout_ise(policy, env_id, episodes)
+    lqr = rollout_ise(reference_policies(env_id)["lqr"], env_id, episodes)
+    return relative_ise(ise, {"lqr": lqr})
 
 
 def reference_policies(env_id: str = DEFAULT_ENV_ID) -> dict:

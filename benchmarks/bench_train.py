@@ -1,5 +1,7 @@
 """Training throughput (env steps/s) of PPO on the native batched env through the SB3
-adapter vs SB3's ``SubprocVecEnv`` over single envs, with the shipped PPO settings.
+adapter vs SB3's ``SubprocVecEnv`` over single envs, with the PPO recipe
+(``train/benchmark/ppo.yaml``) on fewer sub-envs; both envs from the one factory,
+:func:`train.vec.make_vec_env`.
 
 Not a timed test: ``python benchmarks/bench_train.py [--timesteps 40960] [--n-envs 8]``.
 """
@@ -7,10 +9,7 @@ Not a timed test: ``python benchmarks/bench_train.py [--timesteps 40960] [--n-en
 from __future__ import annotations
 
 import argparse
-import tempfile
 import time
-from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 
@@ -35,19 +34,20 @@ def env_rate(backend: str, n_envs: int, steps: int) -> float:
 
 
 def train_rate(backend: str, n_envs: int, steps: int) -> float:
-    """Env steps/s of a whole PPO run (collection + updates, and the one evaluation of
-    the thesis cases at step 0), without the DAgger initialisation, which does not
-    depend on the backend's speed as much as on the MPC's QPs."""
-    from train.cli import train
+    """Env steps/s of PPO's ``learn`` (collection + updates) on the recipe's model."""
+    from train.bench.sb3_train import make_model
+    from train.vec import make_vec_env
 
-    cfg = load_config("ppo").with_overrides(
-        n_envs=n_envs, n_timesteps=steps, eval_freq=10**9, checkpoint_freq=10**9
-    )
-    cfg = replace(cfg, distill=None)
-    with tempfile.TemporaryDirectory() as d:
-        t0 = time.perf_counter()
-        train(cfg, 0, Path(d), backend=backend)
-        return steps / (time.perf_counter() - t0)
+    cfg = load_config("ppo")
+    cfg = cfg.with_overrides(n_envs=n_envs, model={  # one minibatch per rollout
+        **cfg.model, "batch_size": n_envs * cfg.model["n_steps"]})
+    venv = make_vec_env(cfg, 0, backend=backend)
+    model = make_model(cfg, venv, 0)
+    t0 = time.perf_counter()
+    model.learn(steps)
+    rate = model.num_timesteps / (time.perf_counter() - t0)
+    venv.close()
+    return rate
 
 
 def main() -> None:

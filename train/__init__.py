@@ -1,14 +1,20 @@
-"""Training, sweeping and comparing RL agents on ``ACLDBeam-v1``.
+"""Training, benchmarking, sweeping and comparing RL agents on ``ACLDBeam-v1``.
 
-* ``python -m train ppo|sac ...`` trains one agent (:mod:`train.cli`), with the
-  hyperparameters of ``train/ppo.yaml`` / ``train/sac.yaml``.
-* ``python -m train.compare`` compares the shipped agents (``train/agents/``)
-  with passive, LQR, SMC, MPC and the clairvoyant bound.
-* ``python -m train.sweep`` runs seeds / hyperparameters with Ray Tune
-  (optional extra ``acld-gym[sweep]``).
+One stack, behind every command:
 
-The pipeline: :mod:`train.config` (YAML) -> :mod:`train.vec` (the native vector
-env, voltage rescaling, shaping, normalization) -> :mod:`train.callbacks`
-(evaluation on the thesis cases, physics metrics, checkpoints) ->
-:mod:`train.agent` (a trained agent with SB3's ``predict`` in volts).
+* ``python -m train ALGO --seed N`` trains one agent with the recipe
+  ``train/benchmark/ALGO.yaml`` (:mod:`train.cli`): one trial of the benchmark;
+* ``python -m train.benchmark`` trains every recipe with every seed and reports IQMs
+  (:mod:`train.benchmark`);
+* ``python -m train.sweep`` runs seeds x learning rates of a recipe with Ray Tune
+  (optional extra ``acld-gym[sweep]``);
+* ``python -m train.compare`` compares the shipped agents (``train/agents/``) with
+  passive, LQR, SMC, MPC and the clairvoyant bound.
+
+The pipeline: :mod:`train.config` (the one config schema, YAML) -> :mod:`train.vec` (the
+one VecEnv factory: the native vector env, voltage map, shaping, whitening, features,
+normalization) -> :mod:`train.bench.algos` (training: the random search or an SB3
+algorithm) -> :mod:`train.bench.evaluate` (the one evaluator, ISE / LQR through the env)
+-> :mod:`train.bench.trials` (a run and its agent) -> :mod:`train.agent` (a trained agent
+with SB3's ``predict`` in volts, numpy only).
 """

@@ -36,15 +36,33 @@ from .voltage import VoltageMap
 
 __all__ = ["TrainedAgent", "ActorProgram", "AgentFileError", "export_sb3", "actor_parts",
            "linear_program", "observation_width", "POLICY_FILE", "META_FILE", "MODEL_FILE",
-           "STATS_FILE"]
+           "STATS_FILE", "CURVE_FILE", "versions"]
 
 POLICY_FILE = "policy.npz"
 META_FILE = "metadata.json"
 #: SB3's files, for resuming training only (pickled: never read by TrainedAgent).
 MODEL_FILE = "model.zip"
 STATS_FILE = "vecnormalize.pkl"
+#: A trained agent's learning curve (``timesteps,case,ise``: the evaluations of its run).
+CURVE_FILE = "learning_curve.csv"
 #: Version of the agent format.
 FORMAT = 2
+
+
+def versions() -> dict[str, str]:
+    """Versions of Python and the packages a training run used (its metadata)."""
+    import platform
+    from importlib.metadata import PackageNotFoundError, version
+
+    import acld_gym
+
+    out = {"python": platform.python_version(), "acld_gym": acld_gym.__version__}
+    for name in ("gymnasium", "stable_baselines3", "torch", "numpy", "scipy"):
+        try:
+            out[name] = version(name.replace("_", "-"))
+        except PackageNotFoundError:
+            out[name] = "not installed"
+    return out
 
 
 class AgentFileError(ValueError):

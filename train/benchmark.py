@@ -43,18 +43,17 @@ from acld_gym.util.atomic import write_text
 from .bench.evaluate import DEFAULT_ENV_ID
 from .bench.report import markdown, plot_curves, summarize
 from .bench.trials import (
-    CONFIG_DIR,
     DEFAULT_ALGOS,
     agent_dir,
-    load_algo_config,
     policy_program,
     ray_available,
     run_trial,
     run_trials,
     trial_path,
 )
+from .config import CONFIG_DIR, read_config
 
-__all__ = ["CONFIG_DIR", "DEFAULT_ALGOS", "agent_dir", "load_algo_config", "policy_program",
+__all__ = ["CONFIG_DIR", "DEFAULT_ALGOS", "agent_dir", "read_config", "policy_program",
            "run_trial", "run_trials", "summarize", "markdown", "plot_curves", "main"]
 
 
@@ -107,7 +106,7 @@ def main(argv: list[str] | None = None) -> int:
         parser.error('Ray Tune is not installed: pip install -e ".[sweep]" (or --backend local)')
     specs = list(args.algos or ([] if args.config else DEFAULT_ALGOS)) + list(args.config)
     try:
-        configs = [load_algo_config(s) for s in specs]
+        configs = [read_config(s) for s in specs]
     except (OSError, ValueError) as exc:
         parser.error(str(exc))
     out = Path(args.out)

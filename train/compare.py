@@ -180,7 +180,8 @@ def plot_learning_curves(agents: dict, directory: Path) -> Path | None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from .callbacks import CURVE_FILE, lqr_reference_ise
+    from .agent import CURVE_FILE
+    from .bench.evaluate import reference_policies, rollout_ise
 
     curves = {}
     for name, agent in agents.items():
@@ -190,7 +191,7 @@ def plot_learning_curves(agents: dict, directory: Path) -> Path | None:
                 curves[name] = list(csv.DictReader(fh))
     if not curves:
         return None
-    lqr = lqr_reference_ise()
+    lqr = rollout_ise(reference_policies()["lqr"], episodes={c: (0,) for c in (1, 2, 3)})
     fig, axes = plt.subplots(1, 3, figsize=(12, 3.6))
     for ax, case in zip(axes, (1, 2, 3), strict=True):
         for name, rows in curves.items():

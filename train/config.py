@@ -1,99 +1,191 @@
-"""Hyperparameters: one rl-zoo3-style YAML file per algorithm (``train/ppo.yaml``,
-``train/sac.yaml``), validated into a :class:`TrainConfig`."""
+"""The one training configuration: a YAML file per recipe under ``train/benchmark/``
+(``ppo.yaml``, ``sac.yaml``, ``vrs.yaml``, the ablations, the opt-in DAgger starts),
+validated into a :class:`TrainConfig`. ``python -m train`` and ``python -m
+train.benchmark`` read the same files, build the same env (:func:`train.vec.make_vec_env`),
+train with the same function (:func:`train.bench.algos.train_algo`) and evaluate with the
+same evaluator (:mod:`train.bench.evaluate`)."""
 
 from __future__ import annotations
 
+import importlib
+import inspect
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import yaml
 
-from acld_gym.envs.config import check_param_noise
-from acld_gym.physics.loads import LOAD_CASES, parse_load_case
-from acld_gym.physics.truth import MESHES
+from acld_gym.physics.loads import parse_load_case
 from acld_gym.util.validate import check_int, check_real
 
-__all__ = ["ALGOS", "TrainConfig", "load_config", "config_path", "algo_class", "parse_load_case"]
+__all__ = [
+    "ALGOS",
+    "SB3_ALGOS",
+    "CONFIG_DIR",
+    "TrainConfig",
+    "algo_class",
+    "config_path",
+    "read_config",
+    "load_config",
+    "parse_load_case",
+]
 
-ALGOS = ("ppo", "sac")
+#: Algorithms from stable-baselines3 / sb3-contrib (module, class).
+SB3_ALGOS = {
+    "ppo": ("stable_baselines3", "PPO"),
+    "sac": ("stable_baselines3", "SAC"),
+    "td3": ("stable_baselines3", "TD3"),
+    "tqc": ("sb3_contrib", "TQC"),
+    "crossq": ("sb3_contrib", "CrossQ"),
+    "ars": ("sb3_contrib", "ARS"),
+}
+#: Every algorithm: the random search ``vrs`` (:mod:`train.bench.search`) and the SB3 ones.
+ALGOS = ("vrs", *SB3_ALGOS)
+#: The recipes: ``train/benchmark/<name>.yaml``.
+CONFIG_DIR = Path(__file__).resolve().parent / "benchmark"
 RESIDUALS = (None, "lqr")
-FEATURE_NAMES = ("direction",)
-_HERE = Path(__file__).resolve().parent
+#: Smallest value of the SB3 integer arguments that may be below 1 (-1: "as many as").
+_INT_MIN = {"seed": 0, "verbose": 0, "learning_starts": 0, "sde_sample_freq": -1,
+            "gradient_steps": -1}
+
+
+def algo_class(algo: str):
+    """The stable-baselines3 / sb3-contrib class of ``algo`` (:data:`SB3_ALGOS`)."""
+    if algo not in SB3_ALGOS:
+        raise ValueError(f"algo must be one of {list(SB3_ALGOS)}, got {algo!r}")
+    module, name = SB3_ALGOS[algo]
+    return getattr(importlib.import_module(module), name)
 
 
 @dataclass(frozen=True)
 class TrainConfig:
-    """A training run's settings (see the YAML files for the defaults).
+    """One training recipe (a YAML file under ``train/benchmark/``).
 
     Attributes
     ----------
     algo : str
-        ``"ppo"`` or ``"sac"``.
-    n_timesteps : int
-        Environment steps in total (over all sub-envs).
+        One of :data:`ALGOS`.
+    timesteps : int
+        Env-step budget of a run, all sub-envs together (the same for every seed).
     n_envs : int
-        Sub-envs of the native batched env.
-    load_case : int or str
-        Training loads: 1, 2, 3 or ``"random"``.
-    mesh : str
-        Truth plant of ``ACLDBeam-v1``: ``"converged"`` (default) or ``"thesis"``.
-    param_noise : float
-        Relative std of per-episode parameter randomization (0: nominal plant).
-    residual : str or None
-        ``"lqr"``: the agent's action a in [-1, 1] is added to the discrete LQR
-        voltage, ``V = 120 clip(u_lqr / 120 + 2 a, -1, 1)`` [V]; None: ``V = 120 a``.
+        Sub-envs of the native batched env (SB3 algorithms).
+    loads : dict
+        Training loads, ``{case: weight}`` with cases 1, 2, 3, ``random``. For ``vrs``
+        the weights are episodes per candidate per iteration; for SB3 algorithms the
+        sub-envs are split in proportion (:class:`train.vec.ConcatVecEnv`).
     features : str or None
-        ``"direction"``: the networks see :class:`train.features.DirectionFeatures`
-        of the observation (``[z/|z|, log|z|]``); None: SB3's default (flattened).
-    distill : dict or None
-        DAgger initialisation of the actor before reinforcement learning
-        (:class:`train.distill.DistillConfig`'s fields); None: from scratch.
-    shaping : float or None
-        Voltage weight of the LQ potential used for reward shaping during training
-        (:class:`train.vec.VecAgentEnv`, :func:`train.vec.lq_potential`); None: the env's
-        reward as is.
+        ``"direction"``: the agent sees ``[z/|z|, log|z|]``
+        (:class:`train.vec.VecDirectionFeatures`); None: the raw observation.
     normalize : dict
-        Keyword arguments of ``VecNormalize``.
-    eval_freq, checkpoint_freq : int
-        Env steps between evaluations (thesis cases) and between checkpoints.
+        ``VecNormalize`` keyword arguments (SB3 algorithms).
     model : dict
-        Keyword arguments of the SB3 algorithm (``policy`` included).
+        The algorithm's keyword arguments (SB3: ``policy`` included; ``vrs``: the
+        fields of :class:`train.bench.search.RandomSearch`).
+    eval_points : int
+        Learning-curve points (evaluations) over the budget, besides the one at step 0
+        (log-spaced, :class:`train.bench.evaluate.eval_schedule`).
+    whiten_steps : int
+        SB3 algorithms: 0 (default) for none; else the agent first acts with its own
+        initial (stochastic) policy for about this many env steps (whole vector steps,
+        counted in the budget), and :func:`acld_gym.wrappers.whitening` of the observation
+        directions it saw becomes a fixed linear map of the observation, ``u = T^T z``
+        (:class:`train.vec.VecWhiten`), the network's input. Needs ``features: null`` and
+        ``norm_obs: false``; the final actor takes T into its first layer.
+    episode_scale : bool
+        PPO only: the advantages of each episode in a rollout are divided by their
+        root mean square (:class:`train.bench.sb3_policies.EpisodeScaledRolloutBuffer`;
+        the critic's targets are unchanged).
+    env_kwargs : dict
+        SB3 algorithms: options of the *training* env (fields of
+        :class:`acld_gym.envs.config.EnvConfig`, e.g. ``reward_scale: passive``,
+        ``observe_reward_scale: true``, ``param_noise: 0.05``); the evaluation is always on
+        the env id as registered. With ``observe_reward_scale`` the whitening leaves the
+        last entry (log c) alone and the policy must drop it from its actor
+        (:class:`train.bench.sb3_policies.AsymmetricCriticPolicy`).
+    residual : str or None
+        SB3 algorithms: ``"lqr"``: the action a in [-1, 1] is added to the discrete LQR
+        voltage, ``V = 120 clip(u_lqr / 120 + 2 a, -1, 1)`` [V]
+        (:class:`train.voltage.VoltageMap`; controller knowledge in the policy, so the
+        agent is labelled so); None (default): ``V = 120 a``.
+    shaping : float or None
+        SB3 algorithms: voltage weight of the LQ potential used for reward shaping in
+        training (:class:`train.vec.VecAgentEnv`, :func:`train.vec.lq_potential`;
+        controller knowledge in the reward); None (default): the env's reward as is.
+    distill : dict or None
+        SB3 algorithms: DAgger initialisation of the actor before reinforcement learning
+        (:class:`train.distill.DistillConfig`'s fields, e.g. ``{teacher: mpc}``); None
+        (default): from scratch.
     """
 
     algo: str
-    n_timesteps: int
-    n_envs: int
-    load_case: int | str = "random"
-    mesh: str = "converged"
-    param_noise: float = 0.0
+    timesteps: int
+    n_envs: int = 16
+    loads: dict = field(default_factory=lambda: {"random": 1})
+    features: str | None = "direction"
+    normalize: dict = field(default_factory=lambda: {"norm_obs": False, "norm_reward": True})
+    model: dict = field(default_factory=dict)
+    eval_points: int = 10
+    whiten_steps: int = 0
+    episode_scale: bool = False
+    env_kwargs: dict = field(default_factory=dict)
     residual: str | None = None
     shaping: float | None = None
-    features: str | None = None
     distill: dict | None = None
-    normalize: dict = field(default_factory=dict)
-    eval_freq: int = 100_000
-    checkpoint_freq: int = 500_000
-    model: dict = field(default_factory=dict)
 
     def __post_init__(self):
         if self.algo not in ALGOS:
             raise ValueError(f"algo must be one of {list(ALGOS)}, got {self.algo!r}")
-        for name in ("n_timesteps", "n_envs", "eval_freq", "checkpoint_freq"):
+        for name in ("timesteps", "n_envs", "eval_points"):
             check_int(name, getattr(self, name), 1, 10**12)
-        if isinstance(self.load_case, bool) or self.load_case not in LOAD_CASES:
-            raise ValueError(f"load_case must be one of {list(LOAD_CASES)}, "
-                             f"got {self.load_case!r}")
-        if self.mesh not in MESHES:
-            raise ValueError(f"mesh must be one of {list(MESHES)}, got {self.mesh!r}")
-        check_param_noise(self.param_noise, self.mesh)
+        if not isinstance(self.loads, dict) or not self.loads or any(
+            isinstance(w, bool) or not (isinstance(w, (int, float)) and w > 0)
+            for w in self.loads.values()
+        ):
+            raise ValueError(f"loads must map cases to positive weights, got {self.loads!r}")
+        for case in self.loads:
+            parse_load_case(case)
+        if self.features not in (None, "direction"):
+            raise ValueError(f"features must be 'direction' or null, got {self.features!r}")
+        sb3 = self.algo != "vrs"
+        if not isinstance(self.model, dict):
+            raise ValueError(f"model must be a mapping, got {self.model!r}")
+        if sb3 and "policy" not in self.model:
+            raise ValueError(f"{self.algo}: model must name the SB3 policy (e.g. policy: "
+                             "MlpPolicy)")
+        if isinstance(self.whiten_steps, bool) or not isinstance(self.whiten_steps, int) or (
+            self.whiten_steps < 0 or (self.whiten_steps and self.algo in ("vrs", "ars"))
+        ):
+            raise ValueError(f"whiten_steps must be a non-negative integer (SB3 algorithms "
+                             f"other than ars; vrs: model.whiten), got {self.whiten_steps!r}")
+        if not isinstance(self.normalize, dict):
+            raise ValueError(f"normalize must be a mapping, got {self.normalize!r}")
+        if self.whiten_steps and (self.features is not None
+                                  or self.normalize.get("norm_obs", False)):
+            raise ValueError("whiten_steps needs features: null and norm_obs: false (the "
+                             "trained actor takes the whitening into its first layer)")
+        if not isinstance(self.episode_scale, bool) or (self.episode_scale
+                                                        and self.algo != "ppo"):
+            raise ValueError(f"episode_scale must be true or false, and true for ppo only; "
+                             f"got {self.episode_scale!r}")
+        if not isinstance(self.env_kwargs, dict):
+            raise ValueError(f"env_kwargs must be a mapping of env options, got "
+                             f"{self.env_kwargs!r}")
+        if self.env_kwargs:
+            if not sb3:
+                raise ValueError("env_kwargs are for the SB3 algorithms (vrs has its own env)")
+            if "load_case" in self.env_kwargs:
+                raise ValueError("env_kwargs: the training loads are the loads: field, not "
+                                 "load_case")
+            from acld_gym.envs.config import make_config
+
+            try:  # the training env's options, validated by the env's own config
+                make_config(**self.env_kwargs)
+            except (TypeError, ValueError) as exc:
+                raise ValueError(f"env_kwargs: {exc}") from None
         if self.residual not in RESIDUALS:
             raise ValueError(f"residual must be one of {list(RESIDUALS)}, got {self.residual!r}")
         if self.shaping is not None:
             check_real("shaping", self.shaping, 0.0, 1e6, low_open=True)
-        if self.features is not None and self.features not in FEATURE_NAMES:
-            raise ValueError(f"features must be one of {list(FEATURE_NAMES)} or null, "
-                             f"got {self.features!r}")
         if self.distill is not None:
             if not isinstance(self.distill, dict):
                 raise ValueError(f"distill must be a mapping or null, got {self.distill!r}")
@@ -101,13 +193,12 @@ class TrainConfig:
             if self.residual is not None:
                 raise ValueError("distill needs residual: null (the action's sign is the "
                                  f"voltage's), got residual {self.residual!r}")
-        if not isinstance(self.model, dict) or "policy" not in self.model:
-            raise ValueError("model must name the SB3 policy (e.g. policy: MlpPolicy)")
-        check_model_kwargs(self.algo, self.model)
-        if not isinstance(self.normalize, dict):
-            raise ValueError(f"normalize must be a mapping, got {self.normalize!r}")
-        import inspect
+        if not sb3 and (self.residual or self.shaping is not None or self.distill):
+            raise ValueError("residual, shaping and distill are for the SB3 algorithms")
+        if sb3:
+            self._check_sb3()
 
+    def _check_sb3(self) -> None:
         from stable_baselines3.common.vec_env import VecNormalize
 
         allowed = set(inspect.signature(VecNormalize).parameters) - {"venv", "gamma"}
@@ -115,19 +206,31 @@ class TrainConfig:
         if bad:
             raise ValueError(f"normalize: unknown key(s) {bad}; expected some of "
                              f"{sorted(allowed)}")
+        try:
+            cls = algo_class(self.algo)
+        except ImportError:  # sb3-contrib not installed: checked when the run starts
+            return
+        params = inspect.signature(cls).parameters
+        unknown = sorted(k for k in self.model if k not in params)
+        if unknown:
+            raise ValueError(f"model: unknown key(s) {unknown} for {self.algo.upper()}; "
+                             f"expected some of "
+                             f"{sorted(k for k in params if k not in ('env', 'self'))}")
+        for key, value in self.model.items():
+            default = params[key].default
+            if (isinstance(default, bool) or default is None or key == "policy"
+                    or isinstance(value, (dict, list, tuple))):  # a schedule, a train_freq
+                continue
+            if isinstance(default, (int, float)) and not isinstance(value, bool):
+                if isinstance(default, int) and key not in ("learning_rate", "clip_range"):
+                    check_int(f"model.{key}", value, _INT_MIN.get(key, 1))
+                else:
+                    check_real(f"model.{key}", value, 0.0)
 
     @property
-    def teacher(self) -> str | None:
-        """The teacher the actor imitates before RL (``distill.teacher``), or None."""
-        return None if self.distill is None else self.distill_config.teacher
-
-    @property
-    def training(self) -> str:
-        """The label of the agents in every table: ``"from scratch"`` or
-        ``"DAgger from MPC + RL"``."""
-        if self.teacher is None:
-            return "from scratch"
-        return f"DAgger from {self.teacher.upper()} + RL"
+    def load_weights(self) -> dict:
+        """``loads`` with parsed case keys."""
+        return {parse_load_case(c): w for c, w in self.loads.items()}
 
     @property
     def gamma(self) -> float:
@@ -147,6 +250,35 @@ class TrainConfig:
             raise ValueError(f"distill: unknown key(s) {unknown}; expected some of {sorted(known)}")
         return DistillConfig(**self.distill)
 
+    @property
+    def teacher(self) -> str | None:
+        """The teacher the actor imitates before RL (``distill.teacher``), or None."""
+        return None if self.distill is None else self.distill_config.teacher
+
+    @property
+    def training(self) -> str:
+        """The label of the agents in every table: ``"from scratch"``, ``"DAgger from MPC
+        + RL"``, or with controller knowledge in the action or the reward, say so."""
+        teacher = self.teacher
+        label = "from scratch" if teacher is None else f"DAgger from {teacher.upper()} + RL"
+        extra = [s for s, on in (("LQR residual", self.residual == "lqr"),
+                                 ("LQ-potential shaping", self.shaping is not None)) if on]
+        return label if not extra else f"{label} ({', '.join(extra)})"
+
+    @classmethod
+    def from_dict(cls, data: dict) -> TrainConfig:
+        """Validate a config mapping (``ValueError`` naming an unknown key)."""
+        if not isinstance(data, dict):
+            raise ValueError(f"expected a mapping of settings, got {type(data).__name__}")
+        known = set(cls.__dataclass_fields__)
+        unknown = sorted(set(data) - known)
+        if unknown:
+            raise ValueError(f"unknown key(s) {unknown}; expected some of {sorted(known)}")
+        missing = sorted({"algo", "timesteps"} - set(data))
+        if missing:
+            raise ValueError(f"missing key(s) {missing}")
+        return cls(**data)
+
     def with_overrides(self, **changes: Any) -> TrainConfig:
         """A copy with the non-None ``changes`` applied (validated again)."""
         return replace(self, **{k: v for k, v in changes.items() if v is not None})
@@ -155,67 +287,36 @@ class TrainConfig:
         return {k: getattr(self, k) for k in self.__dataclass_fields__}
 
 
-def config_path(algo: str) -> Path:
-    """The shipped YAML file of ``algo``."""
-    if algo not in ALGOS:
-        raise ValueError(f"algo must be one of {list(ALGOS)}, got {algo!r}")
-    return _HERE / f"{algo}.yaml"
-
-
-def check_model_kwargs(algo: str, model: dict) -> None:
-    """``ValueError`` naming a key of ``model`` that ``algo``'s class does not take, or a
-    number given as something else (``learning_rate: fast``), before anything runs."""
-    import inspect
-
-    sig = inspect.signature(algo_class(algo))
-    params = sig.parameters
-    unknown = sorted(k for k in model if k not in params)
-    if unknown:
-        raise ValueError(f"model: unknown key(s) {unknown} for {algo.upper()}; expected some "
-                         f"of {sorted(k for k in params if k not in ('env', 'self'))}")
-    for key, value in model.items():
-        default = params[key].default
-        if isinstance(default, bool) or default is None or key == "policy":
-            continue
-        if isinstance(default, (int, float)) and not isinstance(value, bool):
-            if isinstance(default, int) and key not in ("learning_rate", "clip_range"):
-                check_int(f"model.{key}", value, 0 if key == "seed" else 1)
-            else:
-                check_real(f"model.{key}", value, 0.0)
-
-
-def load_config(algo: str, path: str | Path | None = None) -> TrainConfig:
-    """Read and validate ``algo``'s hyperparameters (``path`` or the shipped file);
-    ``ValueError`` (naming the file and the key) on a malformed file or a bad value."""
-    path = config_path(algo) if path is None else Path(path)
+def config_path(spec: str | Path) -> Path:
+    """The file of a config: a recipe name under ``train/benchmark/`` (``"ppo"``) or a
+    YAML path; ``FileNotFoundError`` naming both if there is none."""
+    path = Path(spec)
+    if not path.suffix:
+        path = CONFIG_DIR / f"{spec}.yaml"
     if not path.is_file():
-        raise FileNotFoundError(f"config file {str(path)!r} does not exist")
+        raise FileNotFoundError(f"config {str(spec)!r}: file {str(path)!r} does not exist")
+    return path
+
+
+def read_config(spec: str | Path) -> tuple[str, dict]:
+    """``(name, mapping)`` of a config (:func:`config_path`), validated; the mapping is the
+    file's own (what a trial records and ``--resume`` compares). ``ValueError`` naming the
+    file and the key on a malformed file or a bad value."""
+    path = config_path(spec)
     try:
         data = yaml.safe_load(path.read_text()) or {}
     except yaml.YAMLError as exc:
         where = getattr(exc, "problem_mark", None)
         at = f" (line {where.line + 1}, column {where.column + 1})" if where else ""
         raise ValueError(f"{path}: not valid YAML{at}: {getattr(exc, 'problem', exc)}") from None
-    if not isinstance(data, dict):
-        raise ValueError(f"{path}: expected a mapping of hyperparameters")
-    known = set(TrainConfig.__dataclass_fields__) - {"algo"}
-    unknown = sorted(set(data) - known)
-    if unknown:
-        raise ValueError(f"{path}: unknown key(s) {unknown}; expected some of {sorted(known)}")
-    missing = sorted({"n_timesteps", "n_envs"} - set(data))
-    if missing:
-        raise ValueError(f"{path}: missing key(s) {missing}")
     try:
-        return TrainConfig(algo=algo, **data)
-    except ValueError as exc:
+        TrainConfig.from_dict(data)
+    except (TypeError, ValueError) as exc:
         raise ValueError(f"{path}: {exc}") from None
+    return path.stem, data
 
 
-def algo_class(algo: str):
-    """The stable-baselines3 class of ``algo`` (:data:`ALGOS`)."""
-    from stable_baselines3 import PPO, SAC
+def load_config(spec: str | Path) -> TrainConfig:
+    """The validated :class:`TrainConfig` of a config (:func:`read_config`)."""
+    return TrainConfig.from_dict(read_config(spec)[1])
 
-    classes = {"ppo": PPO, "sac": SAC}
-    if algo not in classes:
-        raise ValueError(f"algo must be one of {list(classes)}, got {algo!r}")
-    return classes[algo]

@@ -134,18 +134,25 @@ def distill(model, venv, cfg: DistillConfig, seed: int = 0, log=None) -> list[di
     r"""Fit ``model``'s actor to ``cfg.teacher`` by DAgger in ``venv`` (in place).
 
     ``venv`` is the training env of :func:`train.vec.make_vec_env` (``VecNormalize``
-    over :class:`train.vec.VecAgentEnv`, whose voltage map must be the plain
-    :math:`V = 120 a`, so that the action's sign is the voltage's). Observation
-    statistics, if normalized, keep updating, and all labels are normalized with
-    the latest ones before each fit. Returns one dict per iteration: ``beta``,
-    ``labels`` (so far), ``loss`` and ``agreement`` (fraction of this
+    over, somewhere inside, :class:`train.vec.VecAgentEnv`, whose voltage map must be the
+    plain :math:`V = 120 a`, so that the action's sign is the voltage's). The teacher sees
+    the env's raw observation (:attr:`train.vec.VecAgentEnv.last_obs`), the actor what the
+    training env gives it. Observation statistics, if normalized, keep updating, and all
+    labels are normalized with the latest ones before each fit. Returns one dict per
+    iteration: ``beta``, ``labels`` (so far), ``loss`` and ``agreement`` (fraction of this
     iteration's states where the refitted actor's voltage has the teacher's sign).
     """
     import torch
 
-    if venv.venv.residual is not None:
+    from .vec import VecAgentEnv, find_wrapper
+
+    agent_env = find_wrapper(venv, VecAgentEnv)
+    if agent_env is None:
+        raise ValueError("distill needs the training env of train.vec.make_vec_env "
+                         "(no VecAgentEnv inside the given env)")
+    if agent_env.residual is not None:
         raise ValueError("distill needs the plain voltage map (residual: null), got "
-                         f"residual {venv.venv.residual!r}")
+                         f"residual {agent_env.residual!r}")
     from baselines.evaluate import default_policies
 
     teacher = default_policies()[cfg.teacher]
@@ -159,8 +166,8 @@ def distill(model, venv, cfg: DistillConfig, seed: int = 0, log=None) -> list[di
     for it, beta in enumerate(cfg.betas()):
         raw_it, sign_it = [], []
         for _ in range(steps):
-            raw = venv.get_original_obs()
-            volts, _ = teacher.predict(raw)
+            raw = venv.get_original_obs()  # the actor's input before normalization
+            volts, _ = teacher.predict(agent_env.last_obs)
             with torch.no_grad():
                 m = f(torch.as_tensor(obs, dtype=torch.float32)).numpy()
             student = np.tanh(m) if squash else np.clip(m, -1.0, 1.0)

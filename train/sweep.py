@@ -1,7 +1,8 @@
 """``python -m train.sweep``: seeds x learning rates with Ray Tune.
 
-Each trial is one ``python -m train`` run (:func:`trial`) scored by the mean over
-the thesis cases of the last evaluation's ISE relative to LQR (lower is better).
+Each trial is one ``python -m train`` run of the recipe (:func:`trial`: one benchmark trial)
+scored by the mean over the thesis cases of the final policy's ISE relative to LQR (lower
+is better).
 Locally Ray starts with ``--num-cpus`` workers (one trial per CPU); with
 ``--address`` (or ``RAY_ADDRESS``) the same command runs on a Ray cluster.
 Ray is the optional extra ``pip install -e ".[sweep]"`` (Tune only; RLlib
@@ -11,42 +12,46 @@ cannot share an environment with gymnasium 1.4).
 from __future__ import annotations
 
 import argparse
-import csv
 import sys
 from pathlib import Path
 
-from .config import ALGOS, load_config
+from .cli import RECIPES
 
-__all__ = ["trial", "score_run", "main"]
+__all__ = ["trial", "score", "main"]
+
+#: The cases a sweep's trials are scored on.
+THESIS = ("1", "2", "3")
 
 
-def score_run(out: str | Path) -> float:
-    """Mean ISE / ISE_LQR over the thesis cases at the run's last evaluation."""
-    from .callbacks import CURVE_FILE
-
-    path = Path(out) / CURVE_FILE
-    with path.open() as fh:
-        rows = list(csv.DictReader(fh))
-    if not rows:
-        raise ValueError(f"{path} has no evaluation")
-    last = rows[-1]["timesteps"]
-    vals = [float(r["ise_rel_lqr"]) for r in rows if r["timesteps"] == last]
-    return sum(vals) / len(vals)
+def score(rec: dict, lqr: dict) -> float:
+    """Mean over the thesis cases of the final ISE / ISE_LQR of a trial record
+    (:func:`train.bench.trials.run_trial`); ``lqr``: ``{case: ise}``, keys as strings."""
+    missing = [c for c in THESIS if c not in rec.get("final_ise", {})]
+    if missing:
+        raise ValueError(f"the trial record has no final ISE on case(s) {missing}")
+    return sum(rec["final_ise"][c] / lqr[c] for c in THESIS) / len(THESIS)
 
 
 def trial(config: dict, out: str | Path) -> dict:
-    """Train ``config`` (algo, seed, timesteps, optional learning_rate / n_envs /
-    eval_freq) into ``out``; returns ``{"ise_rel_lqr": score}``."""
-    from .cli import train
+    """Train the recipe ``config["algo"]`` (overridden: seed, timesteps, optional
+    learning_rate / n_envs) as one benchmark trial, save the agent in ``out``; returns
+    ``{"ise_rel_lqr": score}`` (:func:`score`)."""
+    from .bench.evaluate import reference_policies, rollout_ise
+    from .bench.trials import run_trial, save_agent
+    from .config import read_config
 
-    cfg = load_config(config["algo"])
-    model = dict(cfg.model)
+    name, data = read_config(config["algo"])
+    data = dict(data, timesteps=int(config["timesteps"]))
     if config.get("learning_rate") is not None:
-        model["learning_rate"] = float(config["learning_rate"])
-    cfg = cfg.with_overrides(n_timesteps=int(config["timesteps"]), model=model,
-                             n_envs=config.get("n_envs"), eval_freq=config.get("eval_freq"))
-    train(cfg, int(config["seed"]), Path(out))
-    return {"ise_rel_lqr": score_run(out)}
+        data["model"] = {**data["model"], "learning_rate": float(config["learning_rate"])}
+    if config.get("n_envs") is not None:
+        data["n_envs"] = int(config["n_envs"])
+    rec, policy = run_trial(name, data, int(config["seed"]), random_episodes=1,
+                            command=f"python -m train.sweep (trial {config})")
+    save_agent(policy, rec, Path(out))
+    episodes = {int(c): (0,) for c in THESIS}
+    lqr = rollout_ise(reference_policies()["lqr"], episodes=episodes)
+    return {"ise_rel_lqr": score(rec, {str(c): v for c, v in lqr.items()})}
 
 
 def _tune_trainable(config: dict) -> None:
@@ -59,12 +64,11 @@ def _tune_trainable(config: dict) -> None:
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="python -m train.sweep", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("algo", choices=ALGOS)
+    p.add_argument("algo", choices=RECIPES)
     p.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
     p.add_argument("--learning-rates", type=float, nargs="+", default=None,
                    help="grid of learning rates (default: the config's)")
     p.add_argument("--timesteps", type=int, default=200_000, help="env steps per trial")
-    p.add_argument("--eval-freq", type=int, default=None, help="env steps between evaluations")
     p.add_argument("--num-cpus", type=int, default=2, help="CPUs for a local Ray (default 2)")
     p.add_argument("--address", default=None, help="Ray cluster address (default: local)")
     p.add_argument("--out", default="runs/sweep", help="Tune's storage directory")
@@ -91,7 +95,7 @@ def main(argv: list[str] | None = None) -> int:
         ray.init(address=args.address)
     else:
         ray.init(num_cpus=args.num_cpus)
-    space = {"algo": args.algo, "timesteps": args.timesteps, "eval_freq": args.eval_freq,
+    space = {"algo": args.algo, "timesteps": args.timesteps,
              "seed": tune.grid_search(args.seeds),
              "learning_rate": (tune.grid_search(args.learning_rates) if args.learning_rates
                                else None)}

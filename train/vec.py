@@ -1,27 +1,33 @@
-"""The training env: the native batched ``ACLDBeam-v1`` through SB3's ``VecEnv``
-adapter, with the action mapped to [-1, 1] (optionally as a residual on the
-discrete LQR), optional potential-based reward shaping, and ``VecNormalize``.
+"""The training env of every SB3 algorithm: the native batched env (``SB3VecEnv`` over
+``gym.make_vec``), one per training load case side by side (:class:`ConcatVecEnv`), the
+agent's action in [-1, 1] mapped to volts (optionally as a residual on the discrete LQR)
+with optional potential-based reward shaping (:class:`VecAgentEnv`), optionally a fixed
+whitening (:class:`VecWhiten`) or direction features (:class:`VecDirectionFeatures`) of
+the observation, and ``VecNormalize``: :func:`make_vec_env`, the one factory.
 
 Wrapper order (inner to outer)::
 
-    SB3VecEnv (volts) -> VecAgentEnv ([-1, 1], shaping) -> VecNormalize
+    SB3VecEnv (volts) [-> ConcatVecEnv] -> VecAgentEnv ([-1, 1], shaping)
+        [-> VecWhiten | VecDirectionFeatures] -> VecNormalize
 """
 
 from __future__ import annotations
 
+import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 from stable_baselines3.common.vec_env import VecEnv, VecEnvWrapper, VecNormalize
 
+import acld_gym  # noqa: F401  (registers the env ids)
 from acld_gym.design.feedback import discrete_lqr_gain
 from acld_gym.design.nominal import nominal_design
-from acld_gym.envs.sb3 import SB3VecEnv
 from acld_gym.physics.actuator import V_LIMIT
 
+from .features import direction_features
 from .voltage import VoltageMap
 
-__all__ = ["VoltageMap", "VecAgentEnv", "lq_potential", "make_vec_env"]
-
+__all__ = ["VoltageMap", "VecAgentEnv", "VecDirectionFeatures", "VecWhiten", "ConcatVecEnv",
+           "lq_potential", "find_wrapper", "make_vec_env"]
 
 def lq_potential(gamma: float, lam: float, y_ref: float = 1e-3, dt: float = 1e-3,
                  mesh: str = "converged") -> np.ndarray:
@@ -71,6 +77,12 @@ class VecAgentEnv(VecEnvWrapper):
         """The action map's residual (None or ``"lqr"``)."""
         return self.map.residual
 
+    @property
+    def last_obs(self) -> np.ndarray | None:
+        """The raw observation of the last reset or step (what the voltage map and a
+        teacher see), before any outer wrapper."""
+        return self._obs
+
     def potential(self, obs: np.ndarray) -> np.ndarray:
         z = np.asarray(obs, dtype=np.float64)[:, : self.P.shape[0]]
         return -np.einsum("ni,ij,nj->n", z, self.P, z)
@@ -94,26 +106,193 @@ class VecAgentEnv(VecEnvWrapper):
         return obs, rewards, dones, infos
 
 
-def make_vec_env(cfg, seed: int, n_envs: int | None = None, backend: str = "native",
-                 load_case=None) -> VecNormalize:
-    """The wrapped training env of a :class:`train.config.TrainConfig` (seeded).
+class VecDirectionFeatures(VecEnvWrapper):
+    """Observation ``z`` -> ``[z/|z|, log|z|]`` (:func:`train.features.direction_features`),
+    so that every SB3 algorithm (ARS included, whose policy takes no feature extractor)
+    sees the same scale-free features."""
 
-    ``backend="native"``: :class:`acld_gym.envs.sb3.SB3VecEnv` (one batched env);
-    ``"subproc"``: SB3's ``SubprocVecEnv`` over single envs (for comparison).
+    def __init__(self, venv: VecEnv):
+        d = venv.observation_space.shape[0] + 1
+        super().__init__(venv, observation_space=spaces.Box(-np.inf, np.inf, (d,), np.float32))
+
+    def _f(self, obs: np.ndarray) -> np.ndarray:
+        return direction_features(obs).astype(np.float32)
+
+    def reset(self) -> np.ndarray:
+        return self._f(self.venv.reset())
+
+    def step_wait(self):
+        obs, rewards, dones, infos = self.venv.step_wait()
+        for i in np.flatnonzero(dones):
+            infos[i]["terminal_observation"] = self._f(infos[i]["terminal_observation"][None])[0]
+        return self._f(obs), rewards, dones, infos
+
+
+class VecWhiten(VecEnvWrapper):
+    r"""Observation ``z`` -> ``u = T^T z`` with a fixed matrix T (identity until
+    :meth:`set_transform`). While ``collect`` is a list, the raw observation directions
+    ``z/|z|`` seen (every sub-env, every step) are appended to it, from which
+    :func:`acld_gym.wrappers.whitening` estimates T (:func:`train.bench.sb3_train.train_sb3` with
+    ``whiten_steps``)."""
+
+    def __init__(self, venv: VecEnv, passthrough: int = 0):
+        super().__init__(venv)
+        self.passthrough = int(passthrough)
+        self.transform = np.eye(venv.observation_space.shape[0] - self.passthrough)
+        self.collect: list | None = None
+
+    def set_transform(self, transform: np.ndarray) -> None:
+        self.transform = np.asarray(transform, dtype=np.float64)
+
+    def _u(self, obs: np.ndarray) -> np.ndarray:
+        """``[T^T z, rest]``: the last ``passthrough`` entries are not whitened."""
+        obs = np.asarray(obs, dtype=np.float64)
+        d = obs.shape[-1] - self.passthrough
+        z = obs[..., :d]
+        if self.collect is not None:
+            r = np.linalg.norm(z, axis=-1, keepdims=True)
+            self.collect.append((z / np.maximum(r, 1e-12))[r[:, 0] > 0])
+        return np.concatenate([z @ self.transform, obs[..., d:]], axis=-1).astype(np.float32)
+
+    def reset(self) -> np.ndarray:
+        return self._u(self.venv.reset())
+
+    def step_wait(self):
+        obs, rewards, dones, infos = self.venv.step_wait()
+        for i in np.flatnonzero(dones):
+            terminal = np.asarray(infos[i]["terminal_observation"], dtype=np.float64)
+            d = terminal.shape[-1] - self.passthrough
+            infos[i]["terminal_observation"] = np.concatenate(
+                [terminal[:d] @ self.transform, terminal[d:]]).astype(np.float32)
+        return self._u(obs), rewards, dones, infos
+
+
+class ConcatVecEnv(VecEnv):
+    """Several SB3 ``VecEnv`` with the same spaces side by side as one (sub-envs in order)."""
+
+    def __init__(self, venvs: list[VecEnv]):
+        self.venvs = list(venvs)
+        self._sizes = [v.num_envs for v in self.venvs]
+        self._splits = np.cumsum(self._sizes)[:-1]
+        v0 = self.venvs[0]
+        super().__init__(sum(self._sizes), v0.observation_space, v0.action_space)
+
+    def reset(self):
+        return np.concatenate([v.reset() for v in self.venvs])
+
+    def step_async(self, actions) -> None:
+        for v, a in zip(self.venvs, np.split(np.asarray(actions), self._splits), strict=True):
+            v.step_async(a)
+
+    def step_wait(self):
+        parts = [v.step_wait() for v in self.venvs]
+        return (
+            np.concatenate([p[0] for p in parts]),
+            np.concatenate([p[1] for p in parts]),
+            np.concatenate([p[2] for p in parts]),
+            [i for p in parts for i in p[3]],
+        )
+
+    def close(self) -> None:
+        for v in self.venvs:
+            v.close()
+
+    def seed(self, seed: int | None = None):
+        out, offset = [], 0
+        for v in self.venvs:
+            out += v.seed(None if seed is None else seed + offset)
+            offset += v.num_envs
+        return out
+
+    def _split_indices(self, indices):
+        idx = (
+            range(self.num_envs)
+            if indices is None
+            else ([indices] if isinstance(indices, int) else indices)
+        )
+        bounds = np.cumsum([0, *self._sizes])
+        for i in idx:
+            k = int(np.searchsorted(bounds, i, side="right") - 1)
+            yield self.venvs[k], int(i - bounds[k])
+
+    def get_attr(self, attr_name, indices=None):
+        return [v.get_attr(attr_name, j)[0] for v, j in self._split_indices(indices)]
+
+    def set_attr(self, attr_name, value, indices=None) -> None:
+        for v in self.venvs:
+            v.set_attr(attr_name, value)
+
+    def env_method(self, method_name, *method_args, indices=None, **method_kwargs):
+        return [
+            v.env_method(method_name, *method_args, indices=j, **method_kwargs)[0]
+            for v, j in self._split_indices(indices)
+        ]
+
+    def env_is_wrapped(self, wrapper_class, indices=None):
+        return [False for _ in self._split_indices(indices)]
+
+    def get_images(self):
+        return [None] * self.num_envs
+
+    def set_options(self, options=None) -> None:
+        for v in self.venvs:
+            v.set_options(options)
+
+
+def _split_envs(weights: dict, n_envs: int) -> dict:
+    """Sub-envs per load case, in proportion to ``weights`` (at least one each)."""
+    total = float(sum(weights.values()))
+    counts = {c: max(1, int(round(n_envs * w / total))) for c, w in weights.items()}
+    last = list(counts)[-1]
+    counts[last] = max(1, n_envs - sum(v for c, v in counts.items() if c != last))
+    return counts
+
+
+def find_wrapper(venv: VecEnv, cls: type) -> VecEnv | None:
+    """The outermost ``cls`` in a chain of SB3 ``VecEnvWrapper`` (or None)."""
+    while venv is not None:
+        if isinstance(venv, cls):
+            return venv
+        venv = getattr(venv, "venv", None)
+    return None
+
+
+def make_vec_env(cfg, seed: int, env_id: str = acld_gym.ENV_ID,
+                 backend: str = "native") -> VecNormalize:
+    """The training env of a :class:`train.config.TrainConfig`, seeded (sub-env i gets
+    ``seed + i``): per training load case a batched env of ``env_id`` with the config's
+    ``env_kwargs`` (sub-envs split as :func:`_split_envs`), :class:`VecAgentEnv` with the
+    config's ``residual`` and ``shaping``, :class:`VecWhiten` if ``cfg.whiten_steps``
+    (identity until :func:`train.bench.sb3_train.train_sb3` sets it), direction features
+    if ``cfg.features``, and ``VecNormalize`` with ``cfg.normalize``.
+
+    ``backend="native"``: :class:`acld_gym.envs.sb3.SB3VecEnv` over ``gym.make_vec``;
+    ``"subproc"``: SB3's ``SubprocVecEnv`` over single envs (the same envs, for
+    comparing throughput).
     """
-    n = cfg.n_envs if n_envs is None else n_envs
-    kw = dict(load_case=cfg.load_case if load_case is None else load_case,
-              param_noise=cfg.param_noise, mesh=cfg.mesh)
-    if backend == "native":
-        venv: VecEnv = SB3VecEnv(num_envs=n, **kw)
-    elif backend == "subproc":
-        from stable_baselines3.common.env_util import make_vec_env as sb3_make_vec_env
-        from stable_baselines3.common.vec_env import SubprocVecEnv
+    from acld_gym.envs.sb3 import SB3VecEnv
 
-        venv = sb3_make_vec_env("acld_gym:ACLDBeam-v1", n_envs=n, env_kwargs=kw,
-                                vec_env_cls=SubprocVecEnv)
-    else:
+    if backend not in ("native", "subproc"):
         raise ValueError(f"backend must be 'native' or 'subproc', got {backend!r}")
+    parts = []
+    for case, n in _split_envs(cfg.load_weights, cfg.n_envs).items():
+        kwargs = dict(cfg.env_kwargs, load_case=case)
+        if backend == "native":
+            parts.append(SB3VecEnv(venv=gym.make_vec(env_id, num_envs=n, **kwargs).unwrapped))
+        else:
+            from stable_baselines3.common.env_util import make_vec_env as sb3_make_vec_env
+            from stable_baselines3.common.vec_env import SubprocVecEnv
+
+            # "module:id": the worker processes import acld_gym, which registers the ids
+            full_id = env_id if ":" in env_id else f"acld_gym:{env_id}"
+            parts.append(sb3_make_vec_env(full_id, n_envs=n, env_kwargs=kwargs,
+                                          vec_env_cls=SubprocVecEnv))
+    venv: VecEnv = parts[0] if len(parts) == 1 else ConcatVecEnv(parts)
     venv.seed(seed)
-    venv = VecAgentEnv(venv, cfg.residual, cfg.gamma, cfg.shaping, mesh=cfg.mesh)
+    mesh = cfg.env_kwargs.get("mesh", "converged")
+    venv = VecAgentEnv(venv, cfg.residual, cfg.gamma, cfg.shaping, mesh=mesh)
+    if cfg.whiten_steps:  # log c, if observed, stays as it is (the critic's scale)
+        venv = VecWhiten(venv, passthrough=int(bool(cfg.env_kwargs.get("observe_reward_scale"))))
+    if cfg.features == "direction":
+        venv = VecDirectionFeatures(venv)
     return VecNormalize(venv, gamma=cfg.gamma, **cfg.normalize)

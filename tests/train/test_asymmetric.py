@@ -47,14 +47,14 @@ def test_actor_ignores_log_scale_and_critic_is_scale_invariant():
 
 def test_recipe_trains_and_exports_onto_the_plain_observation():
     from train.bench.algos import train_algo
-    from train.bench.config import AlgoConfig
     from train.benchmark import policy_program
+    from train.config import TrainConfig
 
     data = yaml.safe_load(open("train/benchmark/ppo.yaml"))
     assert data["env_kwargs"] == {"reward_scale": "passive", "observe_reward_scale": True}
     data.update(timesteps=2048, n_envs=4, whiten_steps=256, eval_points=1)
     data["model"] = {**data["model"], "n_steps": 128, "batch_size": 256, "n_epochs": 1}
-    policy, record = train_algo(AlgoConfig.from_dict(data), 0, "ACLDBeam-v1",
+    policy, record = train_algo(TrainConfig.from_dict(data), 0, "ACLDBeam-v1",
                                 lambda steps, pol: None)
     assert np.asarray(record["transform"]).shape == (9, 9)  # log c is not whitened
     assert policy.model.observation_space.shape == (10,)
@@ -65,10 +65,10 @@ def test_recipe_trains_and_exports_onto_the_plain_observation():
 
 
 def test_env_kwargs_are_validated_by_the_env_config():
-    from train.bench.config import AlgoConfig
+    from train.config import TrainConfig
 
     base = {"algo": "ppo", "timesteps": 10, "model": {"policy": "MlpPolicy"}}
     with pytest.raises(ValueError, match="env_kwargs: .*observe_reward_scale=True needs"):
-        AlgoConfig.from_dict({**base, "env_kwargs": {"observe_reward_scale": True}})
+        TrainConfig.from_dict({**base, "env_kwargs": {"observe_reward_scale": True}})
     with pytest.raises(ValueError, match="env_kwargs: unexpected keyword"):
-        AlgoConfig.from_dict({**base, "env_kwargs": {"reward_scael": "passive"}})
+        TrainConfig.from_dict({**base, "env_kwargs": {"reward_scael": "passive"}})

@@ -96,13 +96,13 @@ def test_benchmark_runs_end_to_end(tmp_path, capsys):
 ])
 def test_sb3_algorithms_train_and_act_in_volts(name, changes, model):
     from train.bench.algos import train_algo
-    from train.bench.config import AlgoConfig
+    from train.config import TrainConfig
 
     data = yaml.safe_load(open(f"train/benchmark/{name}.yaml"))
     data.update(changes, eval_points=1)
     data["model"] = {**data["model"], **model}
     seen = []
-    policy, record = train_algo(AlgoConfig.from_dict(data), 0, "ACLDBeam-v1",
+    policy, record = train_algo(TrainConfig.from_dict(data), 0, "ACLDBeam-v1",
                                 lambda steps, pol: seen.append(steps))
     assert seen[0] == 0 and record["steps"] >= changes["timesteps"]
     n_obs = gym.make("ACLDBeam-v1").observation_space.shape[0]
@@ -117,16 +117,16 @@ def test_ppo_with_whitening_quadratic_critic_and_episode_scale():
     estimated from the agent's own first steps (counted in the budget) and folded into
     the final actor, which then takes the raw observation and exports as a plain actor."""
     from train.bench.algos import train_algo
-    from train.bench.config import AlgoConfig
     from train.bench.sb3_policies import SplitCriticPolicy
     from train.benchmark import policy_program
+    from train.config import TrainConfig
 
     data = yaml.safe_load(open("train/benchmark/ppo.yaml"))
     data.update(timesteps=4000, n_envs=2, whiten_steps=1000, episode_scale=True,
                 eval_points=1)
     data["model"] = {**data["model"], "n_steps": 500, "batch_size": 500, "n_epochs": 1}
     seen = []
-    policy, record = train_algo(AlgoConfig.from_dict(data), 0, "ACLDBeam-v1",
+    policy, record = train_algo(TrainConfig.from_dict(data), 0, "ACLDBeam-v1",
                                 lambda steps, pol: seen.append((steps, pol.transform)))
     assert seen[0] == (0, None) and record["whiten_steps"] == 1000
     assert record["steps"] >= 4000 and np.asarray(record["transform"]).shape == (9, 9)
@@ -234,11 +234,11 @@ def test_recipe_seed_on_case1(algo, bound):
     """One seed of a teacher-free recipe (train/benchmark/<algo>.yaml, full budget) against
     LQR on case 1."""
     from train.bench.algos import train_algo
-    from train.bench.config import AlgoConfig
     from train.bench.evaluate import reference_policies, rollout_ise
+    from train.config import TrainConfig
 
     env_id = "ACLDBeam-v1"
-    cfg = AlgoConfig.from_dict(yaml.safe_load(open(f"train/benchmark/{algo}.yaml")))
+    cfg = TrainConfig.from_dict(yaml.safe_load(open(f"train/benchmark/{algo}.yaml")))
     policy, record = train_algo(cfg, seed=0, env_id=env_id)
     eps = {1: (0,)}
     agent = rollout_ise(policy, env_id, eps)[1]

@@ -1,48 +1,94 @@
-"""train.config: the YAML hyperparameters and their validation."""
+"""train.config: the one training configuration (the recipes under train/benchmark/) and
+its validation."""
 
 import pytest
 
-from train.config import ALGOS, TrainConfig, config_path, load_config, parse_load_case
+from train.config import (
+    ALGOS,
+    CONFIG_DIR,
+    TrainConfig,
+    config_path,
+    load_config,
+    parse_load_case,
+    read_config,
+)
+
+RECIPES = sorted(p.stem for p in CONFIG_DIR.glob("*.yaml"))
 
 
-@pytest.mark.parametrize("algo", ALGOS)
-def test_shipped_yaml_loads(algo):
-    cfg = load_config(algo)
-    assert cfg.algo == algo and cfg.load_case == "random"
-    assert cfg.model["policy"] == "MlpPolicy"
-    assert 0 < cfg.gamma < 1
-    assert config_path(algo).name == f"{algo}.yaml"
+@pytest.mark.parametrize("name", RECIPES)
+def test_every_recipe_file_validates(name):
+    cfg = load_config(name)
+    assert cfg.algo in ALGOS and cfg.timesteps > 0
+    assert read_config(name) == (name, read_config(config_path(name))[1])
+    if cfg.algo != "vrs":
+        assert 0 < cfg.gamma < 1 and "policy" in cfg.model
+
+
+def test_recipes_are_from_scratch_unless_named_so():
+    for name in RECIPES:
+        cfg = load_config(name)
+        if "dagger" in name:
+            assert cfg.teacher == "mpc" and cfg.training.startswith("DAgger from MPC + RL")
+        else:
+            assert cfg.teacher is None and cfg.training == "from scratch", name
 
 
 def test_overrides_revalidate():
     cfg = load_config("ppo")
-    assert cfg.with_overrides(n_timesteps=10, load_case=None).n_timesteps == 10
-    assert cfg.with_overrides(n_timesteps=10).load_case == cfg.load_case
-    with pytest.raises(ValueError, match="n_timesteps"):
-        cfg.with_overrides(n_timesteps=-5)
+    assert cfg.with_overrides(timesteps=10, n_envs=None).timesteps == 10
+    assert cfg.with_overrides(timesteps=10).n_envs == cfg.n_envs
+    with pytest.raises(ValueError, match="timesteps"):
+        cfg.with_overrides(timesteps=-5)
+
+
+BASE = dict(algo="ppo", timesteps=10, n_envs=2, model={"policy": "MlpPolicy"})
 
 
 @pytest.mark.parametrize("change, word", [
-    ({"algo": "dqn"}, "algo"), ({"n_envs": 0}, "n_envs"), ({"load_case": 4}, "load_case"),
-    ({"load_case": True}, "load_case"), ({"param_noise": -0.1}, "param_noise"),
+    ({"algo": "dqn"}, "algo"), ({"n_envs": 0}, "n_envs"), ({"loads": {4: 1}}, "1, 2, 3"),
+    ({"loads": {1: 0}}, "loads"), ({"loads": {1: True}}, "loads"),
+    ({"env_kwargs": {"param_noise": -0.1}}, "param_noise"),
+    ({"env_kwargs": {"load_case": 1}}, "loads"),
+    ({"env_kwargs": {"reward_scael": "passive"}}, "reward_scael"),
     ({"residual": "mpc"}, "residual"), ({"shaping": 0}, "shaping"),
-    ({"model": {}}, "policy"),
+    ({"model": {}}, "policy"), ({"model": {"policy": "MlpPolicy", "learning_rat": 1}},
+                                "learning_rat"),
+    ({"model": {"policy": "MlpPolicy", "n_steps": "64"}}, "n_steps"),
+    ({"model": {"policy": "MlpPolicy", "max_grad_norm": "1.0e6"}}, "max_grad_norm"),
+    ({"normalize": {"norm_obbs": True}}, "norm_obbs"),
+    ({"features": "fourier"}, "features"), ({"episode_scale": 1}, "episode_scale"),
+    ({"whiten_steps": 100, "features": "direction"}, "whiten_steps"),
+    ({"distill": {"itertions": 3}}, "itertions"),
+    ({"distill": {"teacher": "mpc"}, "residual": "lqr"}, "residual"),
 ])
 def test_bad_values_name_the_field(change, word):
-    base = dict(algo="ppo", n_timesteps=10, n_envs=2, model={"policy": "MlpPolicy"})
     with pytest.raises(ValueError, match=word):
-        TrainConfig(**{**base, **change})
+        TrainConfig(**{**BASE, **change})
+
+
+def test_vrs_takes_no_sb3_options():
+    with pytest.raises(ValueError, match="SB3"):
+        TrainConfig(algo="vrs", timesteps=10, shaping=0.1)
+    with pytest.raises(ValueError, match="env_kwargs"):
+        TrainConfig(algo="vrs", timesteps=10, env_kwargs={"reward_scale": "passive"})
 
 
 def test_bad_files(tmp_path):
     with pytest.raises(FileNotFoundError, match="does not exist"):
-        load_config("ppo", tmp_path / "nope.yaml")
+        load_config(tmp_path / "nope.yaml")
+    with pytest.raises(FileNotFoundError, match="does not exist"):
+        load_config("no_such_recipe")
     bad = tmp_path / "bad.yaml"
-    bad.write_text("n_timesteps: 10\nn_envs: 2\nlearning_rat: 1\nmodel: {policy: MlpPolicy}\n")
-    with pytest.raises(ValueError, match="learning_rat"):
-        load_config("ppo", bad)
-    with pytest.raises(ValueError, match="algo"):
-        config_path("a2c")
+    bad.write_text("algo: ppo\ntimesteps: 10\nlearning_rat: 1\nmodel: {policy: MlpPolicy}\n")
+    with pytest.raises(ValueError, match="bad.yaml.*learning_rat"):
+        load_config(bad)
+    bad.write_text("algo: ppo\nmodel: {policy: MlpPolicy}\n")
+    with pytest.raises(ValueError, match="missing.*timesteps"):
+        load_config(bad)
+    bad.write_text("algo: ppo\n  timesteps: [\n")
+    with pytest.raises(ValueError, match="not valid YAML"):
+        load_config(bad)
 
 
 @pytest.mark.parametrize("value, expected", [(1, 1), ("2", 2), (3, 3), ("random", "random")])

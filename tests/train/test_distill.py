@@ -10,9 +10,11 @@ import torch
 from acld_gym.envs.beam_env import ACLDBeamEnv
 from baselines.evaluate import metrics_row, rollout
 from baselines.policies import MPCPolicy
-from train.agent import TrainedAgent, export_sb3
-from train.cli import make_model
-from train.config import TrainConfig, config_path, load_config
+from train.agent import TrainedAgent
+from train.bench.sb3_policies import SB3Policy
+from train.bench.sb3_train import make_model
+from train.bench.trials import policy_program
+from train.config import TrainConfig, load_config
 from train.distill import DistillConfig, distill, fit_sign
 from train.features import DirectionFeatures, direction_features
 from train.vec import make_vec_env
@@ -62,7 +64,7 @@ def test_distill_config_validation():
                      ({"max_iter": 2.5}, "max_iter")]:
         with pytest.raises(ValueError, match=word):
             DistillConfig(**kw)
-    base = dict(algo="ppo", n_timesteps=10, n_envs=2, model={"policy": "MlpPolicy"})
+    base = dict(algo="ppo", timesteps=10, n_envs=2, model={"policy": "MlpPolicy"})
     with pytest.raises(ValueError, match="residual"):
         TrainConfig(**base, residual="lqr", distill={"teacher": "mpc"})
     with pytest.raises(ValueError, match="itertions"):
@@ -73,10 +75,9 @@ def test_distill_config_validation():
 
 @pytest.fixture(scope="module")
 def distilled():
-    """PPO's shipped config, two DAgger iterations on 2 sub-envs (4000 MPC labels)."""
+    """The opt-in DAgger config, two DAgger iterations on 2 sub-envs (4000 MPC labels)."""
     torch.set_num_threads(1)
-    cfg = load_config("ppo", config_path("ppo").with_name("ppo_dagger.yaml")).with_overrides(
-        n_envs=2)
+    cfg = load_config("ppo_dagger").with_overrides(n_envs=2)
     cfg = cfg.with_overrides(model={**cfg.model, "batch_size": 512})
     venv = make_vec_env(cfg, seed=3)
     model = make_model(cfg, venv, seed=3)
@@ -93,21 +94,25 @@ def test_dagger_imitates_the_mpc(distilled):
     # as a policy in volts it comes close to its teacher on thesis case 1 after only two
     # iterations (v1: MPC 0.95 x LQR; the shipped agents use six)
     venv.training = False
-    agent = TrainedAgent(export_sb3(model, venv), {"residual": cfg.residual}, "distilled")
+    agent = TrainedAgent(policy_program(SB3Policy(model, None, cfg.features)),
+                         {"residual": cfg.residual}, "distilled")
     ise = {name: metrics_row(1, name, rollout(p, ACLDBeamEnv(load_case=1), seed=0)).ise
            for name, p in [("mpc", MPCPolicy()), ("distilled", agent)]}
     assert ise["distilled"] < 1.15 * ise["mpc"]
 
 
 def test_exported_actor_with_direction_features(distilled):
-    _, _, model, _ = distilled
+    """The direction features are an env wrapper in training; the exported agent applies
+    them itself, and equals SB3's own prediction on them."""
+    cfg, _, model, _ = distilled
     obs = np.random.default_rng(2).normal(0.0, 0.3, (128, 9)).astype(np.float32)
-    sb3, _ = model.predict(obs, deterministic=True)
-    assert np.allclose(export_sb3(model)(obs), sb3, atol=1e-5)
+    sb3, _ = model.predict(direction_features(obs).astype(np.float32), deterministic=True)
+    prog = policy_program(SB3Policy(model, None, cfg.features))
+    assert np.allclose(prog(obs.astype(np.float64)), sb3, atol=1e-5)
 
 
 def test_distill_refuses_the_residual_map():
-    cfg = replace(load_config("ppo"), n_envs=1, distill=None, residual="lqr")
+    cfg = replace(load_config("ppo_dagger"), n_envs=1, distill=None, residual="lqr")
     cfg = cfg.with_overrides(model={**cfg.model, "batch_size": 256})
     venv = make_vec_env(cfg, seed=0)
     model = make_model(cfg, venv, seed=0)

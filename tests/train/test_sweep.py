@@ -2,22 +2,18 @@
 
 import pytest
 
-from train.sweep import score_run
+from train.sweep import score
 
 
-def test_score_is_the_mean_of_the_last_evaluation(tmp_path):
-    (tmp_path / "learning_curve.csv").write_text(
-        "timesteps,case,ise,ise_rel_lqr,peak_mm,tip_rms_mm,max_voltage_V\n"
-        "10,1,1,2.0,0,0,0\n10,2,1,2.0,0,0,0\n10,3,1,2.0,0,0,0\n"
-        "20,1,1,0.5,0,0,0\n20,2,1,1.0,0,0,0\n20,3,1,1.5,0,0,0\n")
-    assert score_run(tmp_path) == pytest.approx(1.0)
+def test_score_is_the_mean_over_the_thesis_cases():
+    rec = {"final_ise": {"1": 1.0, "2": 4.0, "3": 9.0, "random": 100.0}}
+    lqr = {"1": 2.0, "2": 4.0, "3": 6.0, "random": 1.0}
+    assert score(rec, lqr) == pytest.approx((0.5 + 1.0 + 1.5) / 3)  # random is not scored
 
 
-def test_score_needs_an_evaluation(tmp_path):
-    (tmp_path / "learning_curve.csv").write_text(
-        "timesteps,case,ise,ise_rel_lqr,peak_mm,tip_rms_mm,max_voltage_V\n")
-    with pytest.raises(ValueError, match="no evaluation"):
-        score_run(tmp_path)
+def test_score_needs_the_thesis_cases():
+    with pytest.raises(ValueError, match="case"):
+        score({"final_ise": {"1": 1.0}}, {"1": 1.0, "2": 1.0, "3": 1.0})
 
 
 @pytest.mark.slow
@@ -25,7 +21,7 @@ def test_tune_sweep_runs_locally(tmp_path, capsys):
     pytest.importorskip("ray", reason="Ray Tune is the optional extra .[sweep]")
     from train.sweep import main
 
-    assert main(["ppo", "--seeds", "0", "1", "--timesteps", "4096", "--eval-freq", "2048",
-                 "--num-cpus", "2", "--out", str(tmp_path)]) == 0
+    assert main(["vrs", "--seeds", "0", "1", "--timesteps", "4000", "--num-cpus", "2",
+                 "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert "best:" in out and "ise_rel_lqr" in out

@@ -27,6 +27,10 @@ def _exit2(fn, argv, capsys, word):
     (["ppo", "--seed", "-1"], "--seed"),
     (["ppo", "--param-noise", "-0.1"], "--param-noise"),
     (["ppo", "--config", "/nonexistent/ppo.yaml"], "does not exist"),
+    (["sac", "--config", "ppo_dagger"], "not 'sac'"),
+    (["vrs", "--param-noise", "0.01"], "env_kwargs"),
+    (["ppo", "--random-episodes", "0"], "--random-episodes"),
+    (["ppo", "--env-id", "ACLDBeam-v9"], "--env-id"),
     (["ppo", "--backend", "ray"], "--backend"),
 ])
 def test_train_cli_bad_input(argv, word, capsys):
@@ -35,7 +39,8 @@ def test_train_cli_bad_input(argv, word, capsys):
 
 def test_train_cli_bad_config_values(tmp_path, capsys):
     bad = tmp_path / "ppo.yaml"
-    bad.write_text("n_timesteps: 10\nn_envs: 2\nresidual: pid\nmodel: {policy: MlpPolicy}\n")
+    bad.write_text("algo: ppo\ntimesteps: 10\nn_envs: 2\nresidual: pid\n"
+                   "model: {policy: MlpPolicy}\n")
     _exit2(train_main, ["ppo", "--config", str(bad)], capsys, "residual")
 
 
@@ -76,19 +81,7 @@ def test_ship_cli_bad_input(tmp_path, capsys):
     from train.ship import main as ship_main
 
     _exit2(ship_main, [str(tmp_path), "ppo"], capsys, "lacks")
+    (tmp_path / "policy.npz").write_bytes(b"not an npz")
+    (tmp_path / "metadata.json").write_text("{}")
+    _exit2(ship_main, [str(tmp_path), "ppo"], capsys, str(tmp_path))
     _exit2(ship_main, [str(tmp_path), "../x"], capsys, "name")
-
-
-def test_best_timesteps_follows_the_eval_ranking(tmp_path):
-    """The lowest mean ISE / LQR over the thesis cases; the first of equal ones."""
-    from train.ship import best_timesteps
-
-    head = "timesteps,case,ise,ise_rel_lqr,peak_mm,tip_rms_mm,max_voltage_V\n"
-    rows = [(0, 1, 0.5), (0, 2, 0.5), (100, 1, 0.4), (100, 2, 0.5), (200, 1, 0.5),
-            (200, 2, 0.4)]
-    curve = tmp_path / "learning_curve.csv"
-    curve.write_text(head + "".join(f"{t},{c},0,{r},0,0,0\n" for t, c, r in rows))
-    assert best_timesteps(curve) == 100
-    curve.write_text(head)
-    with pytest.raises(ValueError, match="empty"):
-        best_timesteps(curve)

@@ -7,7 +7,14 @@ import scipy.linalg as sla
 from acld_gym.design.nominal import nominal_design
 from baselines.policies import LQRPolicy
 from train.config import load_config
-from train.vec import VecAgentEnv, VoltageMap, lq_potential, make_vec_env
+from train.vec import (
+    ConcatVecEnv,
+    VecAgentEnv,
+    VoltageMap,
+    find_wrapper,
+    lq_potential,
+    make_vec_env,
+)
 
 
 def test_voltage_map_plain_and_residual():
@@ -49,7 +56,7 @@ def test_lq_potential_solves_the_discounted_riccati_equation():
 
 def test_shaping_is_potential_based():
     """Shaped minus raw reward is gamma Phi(s') - Phi(s) step by step (terminal obs at the end)."""
-    cfg = load_config("ppo").with_overrides(n_envs=2, load_case=1, shaping=0.01)
+    cfg = load_config("ppo").with_overrides(n_envs=2, loads={1: 1}, shaping=0.01)
     raw = VecAgentEnv(_base(cfg), None, cfg.gamma, None)
     shaped = VecAgentEnv(_base(cfg), None, cfg.gamma, cfg.shaping)
     o_raw, o_sh = raw.reset(), shaped.reset()
@@ -74,16 +81,16 @@ def test_shaping_is_potential_based():
 def _base(cfg):
     from acld_gym.envs.sb3 import SB3VecEnv
 
-    v = SB3VecEnv(num_envs=cfg.n_envs, load_case=cfg.load_case)
+    v = SB3VecEnv(num_envs=cfg.n_envs, load_case=1)
     v.seed(3)
     return v
 
 
 def test_make_vec_env_is_seeded_and_normalized():
-    cfg = load_config("ppo").with_overrides(n_envs=3)
+    cfg = load_config("ppo_dagger").with_overrides(n_envs=3)
     a, b = make_vec_env(cfg, seed=5), make_vec_env(cfg, seed=5)
     oa, ob = a.reset(), b.reset()
-    assert np.array_equal(oa, ob) and oa.shape == (3, 9)
+    assert np.array_equal(oa, ob) and oa.shape == (3, 10)  # direction features of the 9
     assert a.action_space.low[0] == -1 and a.action_space.high[0] == 1
     act = np.full((3, 1), 0.3, np.float32)
     for _ in range(20):
@@ -91,5 +98,37 @@ def test_make_vec_env_is_seeded_and_normalized():
         b.step_async(act)
         ra, rb = a.step_wait(), b.step_wait()
     assert np.array_equal(ra[0], rb[0]) and np.array_equal(ra[1], rb[1])
+    assert find_wrapper(a, VecAgentEnv).P is not None  # the config's shaping
     with pytest.raises(ValueError, match="backend"):
         make_vec_env(cfg, 0, backend="ray")
+
+
+def test_make_vec_env_splits_the_loads_and_passes_env_options():
+    """Sub-envs per load in proportion to the weights, each with the config's env options
+    (here the recipe's reward scale, observed as the last entry)."""
+    cfg = load_config("ppo").with_overrides(n_envs=4, loads={1: 1, "random": 3})
+    venv = make_vec_env(cfg, seed=0)
+    obs = venv.reset()
+    assert obs.shape == (4, 10)  # 9 + log c (observe_reward_scale)
+    inner = find_wrapper(venv, ConcatVecEnv)
+    assert [v.num_envs for v in inner.venvs] == [1, 3]
+    assert inner.get_attr("load_case") == [1, "random", "random", "random"]
+    venv.step_async(np.zeros((4, 1), np.float32))
+    _, _, _, infos = venv.step_wait()
+    assert all("reward_scale" in i for i in infos)
+
+
+def test_subproc_backend_is_the_same_env():
+    cfg = load_config("ppo").with_overrides(n_envs=2, loads={1: 1})
+    native, sub = make_vec_env(cfg, seed=4), make_vec_env(cfg, seed=4, backend="subproc")
+    try:
+        on, os_ = native.reset(), sub.reset()
+        assert np.allclose(on, os_, rtol=1e-6, atol=1e-7)
+        act = np.full((2, 1), -0.2, np.float32)
+        for _ in range(5):
+            rn, rs = native.step(act), sub.step(act)
+        assert np.allclose(rn[0], rs[0], rtol=1e-5, atol=1e-6)
+        assert np.allclose(rn[1], rs[1], rtol=1e-5, atol=1e-12)
+    finally:
+        native.close()
+        sub.close()

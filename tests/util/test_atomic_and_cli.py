@@ -70,14 +70,13 @@ def test_check_writable_names_the_problem(tmp_path):
     check_writable(tmp_path / "new" / "deep" / "x.json", "--json")  # creatable: fine
 
 
+_HEAD = "algo: ppo\ntimesteps: 10\nn_envs: 2\n"
 CONFIGS = {
     "malformed YAML": ("n_envs: [1,\n", "YAML"),
-    "learning_rate: fast": ("n_timesteps: 10\nn_envs: 2\nmodel: {policy: MlpPolicy, "
-                            "learning_rate: fast}\n", "learning_rate"),
-    "misspelled key": ("n_timesteps: 10\nn_envs: 2\nmodel: {policy: MlpPolicy, n_stepz: 3}\n",
-                       "n_stepz"),
-    "shaping .inf": ("n_timesteps: 10\nn_envs: 2\nshaping: .inf\nmodel: {policy: MlpPolicy}\n",
-                     "shaping"),
+    "learning_rate: fast": (_HEAD + "model: {policy: MlpPolicy, learning_rate: fast}\n",
+                            "learning_rate"),
+    "misspelled key": (_HEAD + "model: {policy: MlpPolicy, n_stepz: 3}\n", "n_stepz"),
+    "shaping .inf": (_HEAD + "shaping: .inf\nmodel: {policy: MlpPolicy}\n", "shaping"),
 }
 
 

@@ -19,21 +19,21 @@ reports learning-curve points through a callback, and returns a policy with SB3'
   differ by three decades weigh alike (reward normalisation per load).
 * ``ars``: sb3-contrib's ``ARS`` (linear policy, clipped) on the direction features.
 * ``ppo``, ``sac``, ``td3``, ``tqc``, ``crossq``: stable-baselines3 / sb3-contrib
-  through :func:`train.bench.sb3_envs.make_sb3_env`: the native batched env (``SB3VecEnv``),
-  actions in
-  [-1, 1] (``train.vec.VecAgentEnv``, no residual, no shaping), optionally the
-  direction features as the observation (:class:`train.bench.sb3_envs.VecDirectionFeatures`), and
-  ``VecNormalize``. Options for them (fields of :class:`train.bench.config.AlgoConfig`):
-  ``whiten_steps``,
+  on the env of :func:`train.vec.make_vec_env`: the native batched env (``SB3VecEnv``),
+  actions in [-1, 1] (:class:`train.vec.VecAgentEnv`; no residual, no shaping in the
+  from-scratch recipes), optionally the direction features as the observation
+  (:class:`train.vec.VecDirectionFeatures`), and ``VecNormalize``. Options for them
+  (fields of :class:`train.config.TrainConfig`): ``whiten_steps``,
   a ZCA whitening of the observation estimated from the agent's own first rollouts
-  (:class:`train.bench.sb3_envs.VecWhiten`, the steps counted in the budget); for PPO the policy
+  (:class:`train.vec.VecWhiten`, the steps counted in the budget); for PPO the policy
   ``SplitCriticPolicy`` (the critic on its own features, e.g. quadratic ones,
   :class:`train.bench.sb3_policies.SplitCriticPolicy`) and ``episode_scale``, advantages normalised
   per episode
   (:class:`train.bench.sb3_policies.EpisodeScaledRolloutBuffer`).
 
-Modules, in the order of a run: ``config`` (an algorithm's YAML settings), ``search``
-(``vrs``), ``sb3_envs``, ``sb3_policies`` and ``sb3_train`` (the SB3 algorithms),
+Modules, in the order of a run (the config is :mod:`train.config`, the env
+:mod:`train.vec`): ``search`` (``vrs``), ``sb3_policies`` and ``sb3_train`` (the SB3
+algorithms),
 ``algos`` (:func:`~train.bench.algos.train_algo`), ``evaluate`` (ISE / LQR through the
 env), ``trials`` (one run, many runs, Ray Tune), ``stats`` (IQM, bootstrap) and
 ``report`` (tables and learning curves). The command is :mod:`train.benchmark`.

@@ -5,7 +5,8 @@ from __future__ import annotations
 import time
 from typing import Any
 
-from .config import AlgoConfig, CurveCallback
+from ..config import TrainConfig
+from .evaluate import CurveCallback
 from .sb3_train import train_sb3
 from .search import train_random_search
 
@@ -13,7 +14,7 @@ __all__ = ["train_algo"]
 
 
 def train_algo(
-    cfg: AlgoConfig,
+    cfg: TrainConfig,
     seed: int,
     env_id: str,
     callback: CurveCallback | None = None,

@@ -19,6 +19,7 @@ Two evaluators:
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -39,9 +40,13 @@ __all__ = [
     "ise_rel_lqr",
     "reference_policies",
     "references",
+    "CurveCallback",
+    "eval_schedule",
 ]
 
 DEFAULT_ENV_ID = acld_gym.ENV_ID
+#: Learning-curve callback of a training run: ``callback(env_steps, policy)``.
+CurveCallback = Callable[[int, Any], None]
 #: Evaluation cases, in table order (every named load case).
 CASES: tuple = LOAD_CASES
 
@@ -178,3 +183,21 @@ def references(
     if cache is not None:
         write_text(cache, json.dumps(data, indent=2) + "\n")
     return data
+
+
+class eval_schedule:  # noqa: N801  (used like a function)
+    """Learning-curve evaluations: at step 0 and at ``points`` env-step counts spaced
+    logarithmically from 1 % of ``budget`` to ``budget``; :meth:`due` is true once per
+    threshold crossed."""
+
+    def __init__(self, budget: int, points: int):
+        self.thresholds = sorted({int(round(x)) for x in budget * np.logspace(-2, 0, points)})
+        self.thresholds = [0] + [t for t in self.thresholds if t > 0]
+        self._next = 0
+
+    def due(self, steps: int) -> bool:
+        if self._next >= len(self.thresholds) or steps < self.thresholds[self._next]:
+            return False
+        while self._next < len(self.thresholds) and steps >= self.thresholds[self._next]:
+            self._next += 1
+        return True

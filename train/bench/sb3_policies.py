@@ -178,28 +178,36 @@ class EpisodeScaledRolloutBuffer(RolloutBuffer):
 
 class SB3Policy:
     """A trained SB3 model with its frozen ``VecNormalize`` statistics as a policy on the
-    env's raw observation, ``predict`` in volts (``V = v_max * clip(a, -1, 1)``);
-    ``transform``: the agent's whitening matrix (:class:`train.bench.sb3_envs.VecWhiten`), or
-    None."""
+    env's raw observation, ``predict`` in volts (``voltage_map``: the training env's
+    :class:`train.voltage.VoltageMap`, default ``V = 120 clip(a, -1, 1)``);
+    ``transform``: the agent's whitening matrix (:class:`train.vec.VecWhiten`), or None."""
 
     def __init__(
         self,
         model,
         obs_norm: VecNormalize | None,
         features: str | None,
-        v_max: float = 120.0,
         transform: np.ndarray | None = None,
+        voltage_map=None,
     ):
+        from ..voltage import VoltageMap
+
         self.model = model
         self.obs_norm = obs_norm
         self.features = features
-        self.v_max = float(v_max)
         self.transform = None if transform is None else np.asarray(transform, np.float64)
+        self.voltage_map = VoltageMap() if voltage_map is None else voltage_map
+
+    @property
+    def residual(self) -> str | None:
+        """The voltage map's residual (None or ``"lqr"``)."""
+        return self.voltage_map.residual
 
     def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
         obs = np.asarray(observation, dtype=np.float32)
         batched = obs.ndim == 2
-        x = np.atleast_2d(obs)
+        raw = np.atleast_2d(obs)
+        x = raw
         if self.transform is not None:
             x = (x.astype(np.float64) @ self.transform).astype(np.float32)
         if self.features == "direction":
@@ -213,8 +221,7 @@ class SB3Policy:
 
         with torch.no_grad():  # the deterministic action of model.predict, without its checks
             a = self.model.policy._predict(torch.as_tensor(x), deterministic=True).numpy()
-        v = self.v_max * np.clip(np.asarray(a, dtype=np.float64).reshape(-1, 1), -1, 1)
-        v = v.astype(np.float32)
+        v = self.voltage_map(a, raw)
         return (v if batched else v[0]), state
 
 

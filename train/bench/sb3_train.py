@@ -1,5 +1,7 @@
 """Training of the stable-baselines3 / sb3-contrib algorithms (PPO, SAC, TD3, TQC,
-CrossQ, ARS) for the benchmark, from scratch on the env's observation and reward."""
+CrossQ, ARS): the model of a :class:`train.config.TrainConfig` (:func:`make_model`) on the
+env of :func:`train.vec.make_vec_env`, from scratch on the env's observation and reward
+(or, opt-in, after a DAgger start: ``distill``)."""
 
 from __future__ import annotations
 
@@ -11,8 +13,10 @@ import acld_gym  # noqa: F401  (registers the env ids)
 from acld_gym.wrappers import whitening
 
 from ..agent import actor_parts
-from .config import SB3_ALGOS, AlgoConfig, CurveCallback, eval_schedule
-from .sb3_envs import VecWhiten, make_sb3_env
+from ..config import TrainConfig, algo_class
+from ..vec import VecWhiten, make_vec_env
+from ..voltage import VoltageMap
+from .evaluate import CurveCallback, eval_schedule
 from .sb3_policies import (
     AsymmetricCriticPolicy,
     AsymmetricSACPolicy,
@@ -21,14 +25,7 @@ from .sb3_policies import (
     SplitCriticPolicy,
 )
 
-__all__ = ["fold_whitening", "train_sb3"]
-
-
-def _sb3_class(algo: str):
-    import importlib
-
-    module, name = SB3_ALGOS[algo]
-    return getattr(importlib.import_module(module), name)
+__all__ = ["fold_whitening", "make_model", "train_sb3"]
 
 
 class _linear_schedule:  # noqa: N801  (an SB3 schedule: progress remaining 1 -> 0)
@@ -75,26 +72,44 @@ def fold_whitening(model, transform: np.ndarray) -> None:
         layer.weight.copy_(layer.weight @ t)
 
 
+def make_model(cfg: TrainConfig, venv, seed: int, **kwargs):
+    """The (untrained) SB3 model of ``cfg`` on ``venv``: the config's keyword arguments
+    (schedules and policy names resolved, :func:`_resolve_policy_kwargs`), CPU, seeded;
+    ``kwargs`` add to them."""
+    model_kwargs = _resolve_policy_kwargs(dict(cfg.model))
+    policy = model_kwargs.pop("policy")
+    if cfg.episode_scale:
+        model_kwargs["rollout_buffer_class"] = EpisodeScaledRolloutBuffer
+    model_kwargs.setdefault("verbose", 0)
+    return algo_class(cfg.algo)(policy, venv, seed=seed, device="cpu",
+                                **{**model_kwargs, **kwargs})
+
+
 def train_sb3(
-    cfg: AlgoConfig,
+    cfg: TrainConfig,
     seed: int,
     env_id: str,
     callback: CurveCallback | None = None,
 ) -> tuple[SB3Policy, dict]:
     """Train an SB3 / sb3-contrib algorithm for ``cfg.timesteps`` env steps (with
     ``cfg.whiten_steps``: first that many steps of the initial policy, from which the
-    whitening is estimated, then the rest of the budget of training)."""
+    whitening is estimated, then the rest of the budget of training; with
+    ``cfg.distill``: the DAgger start first, its env steps not counted)."""
     from stable_baselines3.common.callbacks import BaseCallback
 
     torch.set_num_threads(1)
-    kwargs = _resolve_policy_kwargs(dict(cfg.model))
-    policy = kwargs.pop("policy")
-    gamma = float(kwargs.get("gamma", 0.99))
-    if cfg.episode_scale:
-        kwargs["rollout_buffer_class"] = EpisodeScaledRolloutBuffer
-    venv = make_sb3_env(cfg, seed, env_id, gamma)
-    v_max = 120.0
-    model = _sb3_class(cfg.algo)(policy, venv, seed=seed, device="cpu", verbose=0, **kwargs)
+    venv = make_vec_env(cfg, seed, env_id)
+    model = make_model(cfg, venv, seed)
+    vmap = VoltageMap(cfg.residual, cfg.env_kwargs.get("mesh", "converged"))
+    distilled = None
+    if cfg.distill is not None:
+        import time
+
+        from ..distill import distill
+
+        t0 = time.perf_counter()
+        distilled = {"history": distill(model, venv, cfg.distill_config, seed=seed),
+                     "seconds": round(time.perf_counter() - t0, 1)}
     schedule = eval_schedule(cfg.timesteps, cfg.eval_points)
     white = venv.venv  # under VecNormalize (whiten_steps: no direction features)
     transform = None
@@ -108,7 +123,7 @@ def train_sb3(
             norm = copy.deepcopy(venv)
             norm.venv = None
             norm.training = False
-        return SB3Policy(model, norm, cfg.features, v_max, transform)
+        return SB3Policy(model, norm, cfg.features, transform, vmap)
 
     if cfg.whiten_steps:
         assert isinstance(white, VecWhiten)
@@ -141,6 +156,7 @@ def train_sb3(
         "steps": offset + int(model.num_timesteps),
         "whiten_steps": offset,
         "transform": None if transform is None else transform.tolist(),
+        "distill": distilled,
     }
     if transform is not None:  # u = T' z into the actor's first layer: a plain SB3 actor on z
         fold_whitening(model, transform)

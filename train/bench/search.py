@@ -12,8 +12,9 @@ import numpy as np
 import acld_gym  # noqa: F401  (registers the env ids)
 from acld_gym.wrappers import whitening
 
+from ..config import TrainConfig
 from ..features import direction_features
-from .config import AlgoConfig, CurveCallback, eval_schedule
+from .evaluate import CurveCallback, eval_schedule
 
 __all__ = ["LinearDirectionActor", "whitening", "RandomSearch", "train_random_search"]
 
@@ -200,7 +201,7 @@ class _CandidateEnvs:
 
 
 def train_random_search(
-    cfg: AlgoConfig,
+    cfg: TrainConfig,
     seed: int,
     env_id: str,
     callback: CurveCallback | None = None,

@@ -9,17 +9,16 @@ import time
 from pathlib import Path
 
 import numpy as np
-import yaml
 
 from acld_gym.util.atomic import write_text
 
+from ..config import CONFIG_DIR, TrainConfig
 from .evaluate import DEFAULT_ENV_ID
 
 __all__ = [
     "CONFIG_DIR",
     "DEFAULT_ALGOS",
     "REFERENCES",
-    "load_algo_config",
     "run_trial",
     "agent_dir",
     "policy_program",
@@ -28,24 +27,9 @@ __all__ = [
     "ray_available",
 ]
 
-CONFIG_DIR = Path(__file__).resolve().parents[1] / "benchmark"
 #: The benchmark's algorithms (``train/benchmark/<name>.yaml``).
 DEFAULT_ALGOS = ("vrs", "ars", "ppo", "sac", "tqc")
 REFERENCES = ("lqr", "smc", "mpc", "bound")
-
-
-def load_algo_config(spec: str | Path) -> tuple[str, dict]:
-    """``(name, mapping)`` of a config: a name under ``train/benchmark/`` or a YAML path."""
-    path = Path(spec)
-    if not path.suffix:
-        path = CONFIG_DIR / f"{spec}.yaml"
-    if not path.is_file():
-        raise FileNotFoundError(f"config {str(spec)!r}: no file {str(path)!r}")
-    data = yaml.safe_load(path.read_text()) or {}
-    from .config import AlgoConfig
-
-    AlgoConfig.from_dict(data)  # validate early
-    return path.stem, data
 
 
 def run_trial(
@@ -55,19 +39,20 @@ def run_trial(
     env_id: str = DEFAULT_ENV_ID,
     random_episodes: int = 20,
     out: str | Path | None = None,
-) -> dict:
-    """Train one (config, seed) and evaluate it; returns the trial's record (JSON-able):
-    the learning curve (mean ISE per case at each evaluation, batched), the final ISE
-    per case (single-env rollouts) and the training wall time (evaluations excluded).
-    With ``out``, the final policy is saved as an agent in :func:`agent_dir`."""
+    command: str | None = None,
+) -> tuple[dict, object]:
+    """Train one (config, seed) and evaluate it; returns ``(record, policy)``: the trial's
+    record (JSON-able: the learning curve, mean ISE per case at each evaluation, batched;
+    the final ISE per case, single-env rollouts; the training wall time, evaluations
+    excluded; the command) and the final policy. With ``out``, the policy is saved as an
+    agent in :func:`agent_dir`."""
     import torch
 
     from .algos import train_algo
-    from .config import AlgoConfig
     from .evaluate import batched_ise, eval_episodes, rollout_ise
 
     torch.set_num_threads(1)
-    cfg = AlgoConfig.from_dict(config)
+    cfg = TrainConfig.from_dict(config)
     episodes = eval_episodes(random_episodes)
     curve = []
 
@@ -86,6 +71,8 @@ def run_trial(
         "env_id": env_id,
         "config": config,
         "random_episodes": int(random_episodes),
+        "command": command or f"python -m train.benchmark --config {name} --seeds {seed} "
+        f"--env-id {env_id}",
         "budget": cfg.timesteps,
         "steps": int(record.get("steps", 0)),
         "train_seconds": float(record["train_seconds"]),
@@ -98,8 +85,8 @@ def run_trial(
         },
     }
     if out is not None:
-        save_agent(policy, rec, Path(out))
-    return rec
+        save_agent(policy, rec, agent_dir(out, name, seed))
+    return rec, policy
 
 
 def trial_path(out: Path, name: str, seed: int) -> Path:
@@ -128,29 +115,29 @@ def policy_program(policy):
     raise TypeError(f"cannot export a {type(policy).__name__}")
 
 
-def save_agent(policy, rec: dict, out: Path) -> Path:
+def save_agent(policy, rec: dict, directory: str | Path) -> Path:
     """Save a trial's final policy as an agent directory (``policy.npz``,
-    ``metadata.json`` with ``training: "from scratch"``, no teacher, the command, config,
-    budget, times and the observation fingerprint of the env it was trained on)."""
+    ``metadata.json`` with how it was trained -- ``"from scratch"`` unless the config has
+    a teacher or controller knowledge --, the command, config, budget, times and the
+    observation fingerprint of the env it was trained on, and ``learning_curve.csv``)."""
     import gymnasium as gym
 
     from acld_gym.envs.fingerprint import observation_fingerprint
 
-    from ..agent import TrainedAgent
-    from ..callbacks import CURVE_FILE
-    from ..cli import versions
+    from ..agent import CURVE_FILE, TrainedAgent, versions
 
+    cfg = TrainConfig.from_dict(rec["config"])
     probe = gym.make(rec["env_id"])
     meta = {
         "algo": rec["algo"],
         "seed": rec["seed"],
         "benchmark": rec["name"],
-        "command": f"python -m train.benchmark --config {rec['name']} "
-        f"--seeds {rec['seed']} --env-id {rec['env_id']}",
+        "command": rec["command"],
         "config": rec["config"],
-        "training": "from scratch",
-        "teacher": None,
-        "residual": None,
+        "training": cfg.training,
+        "teacher": cfg.teacher,
+        "residual": cfg.residual,
+        "distill": rec["record"].get("distill"),
         "timesteps": rec["steps"],
         "budget": rec["budget"],
         "train_seconds": round(rec["train_seconds"], 1),
@@ -161,9 +148,7 @@ def save_agent(policy, rec: dict, out: Path) -> Path:
         "observation": observation_fingerprint(probe),
     }
     probe.close()
-    d = TrainedAgent(policy_program(policy), meta, rec["algo"]).save(
-        agent_dir(out, rec["name"], rec["seed"])
-    )
+    d = TrainedAgent(policy_program(policy), meta, rec["algo"]).save(Path(directory))
     # its learning curve on the thesis cases and the random set, batched evaluations
     lines = ["timesteps,case,ise"] + [
         f"{p['steps']},{c},{ise!r}" for p in rec["curve"] for c, ise in p["ise"].items()
@@ -177,7 +162,7 @@ def _tune_trainable(config: dict) -> None:  # pragma: no cover - runs inside Ray
 
     kwargs = json.loads(config["trial"])
     out = Path(kwargs["out"])
-    rec = run_trial(**kwargs)
+    rec, _ = run_trial(**kwargs)
     # written here too, so that --resume finds the finished runs after an interruption (on a
     # cluster the driver writes them again from the reported results)
     write_text(trial_path(out, rec["name"], rec["seed"]), json.dumps(rec) + "\n")
@@ -196,7 +181,7 @@ def run_trials(
     records = []
     if backend == "local":
         for t in trials:
-            rec = run_trial(**t, out=out)
+            rec, _ = run_trial(**t, out=out)
             write_text(trial_path(out, rec["name"], rec["seed"]), json.dumps(rec) + "\n")
             print(
                 f"  {rec['name']} seed {rec['seed']}: trained in {rec['train_seconds']:.0f} s",

@@ -1,0 +1,80 @@
+"""One training stack: ``python -m train`` runs one trial of ``python -m train.benchmark``
+(the same config schema, env factory, training and evaluator), for PPO and SAC on a tiny
+budget, and its agent loads and acts in volts."""
+
+import json
+
+import numpy as np
+import pytest
+import yaml
+
+from acld_gym.envs.beam_env import ACLDBeamEnv
+from baselines.evaluate import rollout
+from train.agent import TrainedAgent
+from train.cli import build_parser, configure
+
+
+def _tiny(tmp_path, algo):
+    data = yaml.safe_load(open(f"train/benchmark/{algo}.yaml"))
+    if algo == "ppo":
+        data.update(timesteps=1536, n_envs=4, eval_points=1, whiten_steps=256)
+        data["model"] = {**data["model"], "n_steps": 128, "batch_size": 256, "n_epochs": 1}
+    else:
+        data.update(timesteps=600, n_envs=4, eval_points=1, whiten_steps=128)
+        data["model"] = {**data["model"], "learning_starts": 200, "buffer_size": 2000,
+                         "batch_size": 64}
+    path = tmp_path / f"tiny_{algo}.yaml"
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+def test_the_default_config_is_the_benchmark_recipe():
+    from train.config import read_config
+
+    for algo in ("ppo", "sac"):
+        args = build_parser().parse_args([algo, "--seed", "7"])
+        assert configure(args) == read_config(algo) == (algo, yaml.safe_load(
+            open(f"train/benchmark/{algo}.yaml")))
+
+
+def test_overrides_of_the_command_line():
+    args = build_parser().parse_args(["ppo", "--timesteps", "100", "--n-envs", "3",
+                                      "--load-case", "2", "--param-noise", "0.02"])
+    name, data = configure(args)
+    assert name == "ppo" and data["timesteps"] == 100 and data["n_envs"] == 3
+    assert data["loads"] == {2: 1}
+    assert data["env_kwargs"]["param_noise"] == 0.02
+    assert data["env_kwargs"]["reward_scale"] == "passive"  # the recipe's options stay
+
+
+@pytest.mark.parametrize("algo", ["ppo", "sac"])
+def test_train_cli_is_a_benchmark_trial(algo, tmp_path, capsys):
+    """``python -m train ALGO --seed N`` and ``python -m train.benchmark --seeds N`` give the
+    same agent, bit for bit; it loads (validated) and acts in volts."""
+    from train.benchmark import main as bench_main
+    from train.cli import main as train_main
+
+    cfg = _tiny(tmp_path, algo)
+    a = tmp_path / "cli"
+    assert train_main([algo, "--config", str(cfg), "--seed", "3", "--random-episodes", "1",
+                       "--out", str(a)]) == 0
+    out = capsys.readouterr().out
+    assert "ISE / LQR" in out and "case random" in out
+    assert bench_main(["--config", str(cfg), "--seeds", "3", "--backend", "local",
+                       "--random-episodes", "1", "--no-bound", "--out",
+                       str(tmp_path / "bench")]) == 0
+    b = tmp_path / "bench" / "agents" / f"tiny_{algo}-s3"
+    pa, pb = np.load(a / "policy.npz"), np.load(b / "policy.npz")
+    assert sorted(pa.files) == sorted(pb.files)
+    assert all(np.array_equal(pa[k], pb[k]) for k in pa.files)
+    for f in ("policy.npz", "metadata.json", "learning_curve.csv", "trial.json"):
+        assert (a / f).is_file(), f
+    meta = json.loads((a / "metadata.json").read_text())
+    assert meta["training"] == "from scratch" and meta["teacher"] is None
+    assert meta["seed"] == 3 and meta["command"].startswith(f"python -m train {algo}")
+    trial = json.loads((a / "trial.json").read_text())
+    bench = json.loads((tmp_path / "bench" / "trials" / f"tiny_{algo}-s3.json").read_text())
+    assert trial["final_ise"] == bench["final_ise"] and trial["config"] == bench["config"]
+    agent = TrainedAgent.load(a)
+    traj = rollout(agent, ACLDBeamEnv(load_case=1), seed=0)
+    assert np.all(np.abs(traj.voltage) <= 120.0) and np.abs(traj.voltage).max() > 0

@@ -90,7 +90,10 @@ class TrainConfig:
         counted in the budget), and :func:`acld_gym.wrappers.whitening` of the observation
         directions it saw becomes a fixed linear map of the observation, ``u = T^T z``
         (:class:`train.vec.VecWhiten`), the network's input. Needs ``features: null`` and
-        ``norm_obs: false``; the final actor takes T into its first layer.
+        ``norm_obs: false``; the final actor takes T into its first layer. Let it cover
+        whole episodes (the recipe: 1000 vector steps, one episode per sub-env): estimated
+        from the first 64 ms of each episode only, it preconditions the policy gradient
+        badly on some seeds (``docs/training.md``).
     episode_scale : bool
         PPO only: the advantages of each episode in a rollout are divided by their
         root mean square (:class:`train.bench.sb3_policies.EpisodeScaledRolloutBuffer`;

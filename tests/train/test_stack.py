@@ -78,3 +78,44 @@ def test_train_cli_is_a_benchmark_trial(algo, tmp_path, capsys):
     agent = TrainedAgent.load(a)
     traj = rollout(agent, ACLDBeamEnv(load_case=1), seed=0)
     assert np.all(np.abs(traj.voltage) <= 120.0) and np.abs(traj.voltage).max() > 0
+
+
+def _documented_commands(module: str) -> list[list[str]]:
+    """The arguments of every ``python -m <module> ...`` line of the README and the docs'
+    shell blocks (line continuations joined, comments dropped, brace lists expanded to
+    their first item)."""
+    import re
+    import shlex
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    out = []
+    for page in [root / "README.md", *sorted((root / "docs").rglob("*.md"))]:
+        for block in re.findall(r"^```bash\n(.*?)^```", page.read_text(), flags=re.S | re.M):
+            for line in block.replace("\\\n", " ").splitlines():
+                line = re.sub(r"\{([^,}]+)(,[^}]*)?\}", r"\1", line.split("  #")[0])
+                words = shlex.split(line, comments=True)
+                if words[:3] == ["python", "-m", module]:
+                    out.append(words[3:])
+    return out
+
+
+def test_documented_train_commands_parse():
+    """Every ``python -m train ...`` the README and the docs show is a valid command for
+    the one stack (its flags and its config)."""
+    commands = _documented_commands("train")
+    assert len(commands) >= 3
+    for argv in commands:
+        configure(build_parser().parse_args(argv))
+
+
+def test_documented_benchmark_commands_parse():
+    from train.benchmark import build_parser as bench_parser
+    from train.config import read_config
+
+    commands = _documented_commands("train.benchmark")
+    assert len(commands) >= 5
+    for argv in commands:
+        args = bench_parser().parse_args(argv)
+        for spec in [*(args.algos or []), *args.config]:
+            read_config(spec)

@@ -226,19 +226,27 @@ class SB3Policy:
 
 
 class ScaledQuadraticCritic(ContinuousCritic):
-    r"""SAC's twin critic as quadratic forms (plus linear terms and a constant) of
-    :math:`w = [u, a] / \sqrt{c}` on the observation ``[u, log c]`` of an env with
-    ``reward_scale: passive`` and ``observe_reward_scale: true``: the shape of the
-    state-action value of a linear policy on a linear plant with a quadratic reward, divided
-    by the episode's passive cost c (:class:`ScaledQuadraticFeatures` for the state value)."""
+    r"""SAC's twin critic on the quadratic features (and linear terms and a constant) of
+    :math:`w = [u, a] / \sqrt{c}`, the observation being ``[u, log c]`` of an env with
+    ``reward_scale: passive`` and ``observe_reward_scale: true``. With ``net_arch: {qf: []}``
+    each critic is a quadratic form of w: the shape of the state-action value of a linear
+    policy on a linear plant with a quadratic reward, divided by the episode's passive cost
+    c (:class:`ScaledQuadraticFeatures` for the state value). With hidden layers
+    (``qf: [64, 64]``) an MLP on those features, which can also represent what the
+    saturation at +/-120 V does to the value."""
 
-    def __init__(self, observation_space, action_space, *args, n_critics: int = 2, **kwargs):
-        super().__init__(observation_space, action_space, *args, n_critics=n_critics, **kwargs)
+    def __init__(self, observation_space, action_space, net_arch, *args, n_critics: int = 2,
+                 activation_fn=nn.ReLU, **kwargs):
+        super().__init__(observation_space, action_space, net_arch, *args, n_critics=n_critics,
+                         activation_fn=activation_fn, **kwargs)
+        from stable_baselines3.common.torch_layers import create_mlp
+
         d = int(observation_space.shape[0]) - 1 + int(np.prod(action_space.shape))
         self.quadratic = QuadraticFeatures(spaces.Box(-np.inf, np.inf, (d,), np.float32))
         self.q_networks = []
         for idx in range(n_critics):
-            q_net = nn.Linear(self.quadratic.features_dim, 1)
+            q_net = nn.Sequential(*create_mlp(self.quadratic.features_dim, 1, list(net_arch),
+                                              activation_fn))
             self.add_module(f"qf{idx}", q_net)  # replaces the MLP of the same name
             self.q_networks.append(q_net)
 

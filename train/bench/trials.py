@@ -179,6 +179,8 @@ def run_trials(
     """Run ``trials`` (keyword arguments of :func:`run_trial`) and write each record to
     ``out/trials/``; ``backend="ray"`` runs them as Ray Tune trials (one CPU each)."""
     records = []
+    if not trials:  # nothing to train (e.g. --resume --no-train): no Ray start either
+        return records
     if backend == "local":
         for t in trials:
             rec, _ = run_trial(**t, out=out)

@@ -121,7 +121,7 @@ def main(argv: list[str] | None = None) -> int:
         gym.spec(args.env_id)
     except gym.error.Error as exc:
         parser.error(f"--env-id: {exc}")
-    from .bench.evaluate import eval_episodes, reference_policies, rollout_ise
+    from .bench.evaluate import eval_episodes, lqr_ise
     from .bench.trials import run_trial, save_agent
     from .config import TrainConfig
 
@@ -135,7 +135,7 @@ def main(argv: list[str] | None = None) -> int:
     save_agent(policy, rec, out)
     write_text(out / "trial.json", json.dumps(rec) + "\n")
     episodes = eval_episodes(args.random_episodes)
-    lqr = rollout_ise(reference_policies(args.env_id)["lqr"], args.env_id, episodes)
+    lqr = lqr_ise(args.env_id, episodes)
     rel = "  ".join(f"case {c}: {rec['final_ise'][str(c)] / lqr[c]:.3f}" for c in episodes)
     print(f"trained in {rec['train_seconds']:.0f} s; ISE / LQR  {rel}")
     print(f"wrote {out}/: policy.npz + metadata.json (the agent), learning_curve.csv, "

@@ -181,7 +181,7 @@ def plot_learning_curves(agents: dict, directory: Path) -> Path | None:
     import matplotlib.pyplot as plt
 
     from .agent import CURVE_FILE
-    from .bench.evaluate import reference_policies, rollout_ise
+    from .bench.evaluate import lqr_ise
 
     curves = {}
     for name, agent in agents.items():
@@ -191,7 +191,7 @@ def plot_learning_curves(agents: dict, directory: Path) -> Path | None:
                 curves[name] = list(csv.DictReader(fh))
     if not curves:
         return None
-    lqr = rollout_ise(reference_policies()["lqr"], episodes={c: (0,) for c in (1, 2, 3)})
+    lqr = lqr_ise(episodes={c: (0,) for c in (1, 2, 3)})
     fig, axes = plt.subplots(1, 3, figsize=(12, 3.6))
     for ax, case in zip(axes, (1, 2, 3), strict=True):
         for name, rows in curves.items():

@@ -236,6 +236,11 @@ class TrainConfig:
         return {parse_load_case(c): w for c, w in self.loads.items()}
 
     @property
+    def mesh(self) -> str:
+        """Truth plant of the training env (``env_kwargs.mesh``; ``"converged"`` if unset)."""
+        return self.env_kwargs.get("mesh", "converged")
+
+    @property
     def gamma(self) -> float:
         """Discount factor of the algorithm (SB3's default 0.99 if not set)."""
         return float(self.model.get("gamma", 0.99))

@@ -36,7 +36,7 @@ def trial(config: dict, out: str | Path) -> dict:
     """Train the recipe ``config["algo"]`` (overridden: seed, timesteps, optional
     learning_rate / n_envs) as one benchmark trial, save the agent in ``out``; returns
     ``{"ise_rel_lqr": score}`` (:func:`score`)."""
-    from .bench.evaluate import reference_policies, rollout_ise
+    from .bench.evaluate import lqr_ise
     from .bench.trials import run_trial, save_agent
     from .config import read_config
 
@@ -50,7 +50,7 @@ def trial(config: dict, out: str | Path) -> dict:
                             command=f"python -m train.sweep (trial {config})")
     save_agent(policy, rec, Path(out))
     episodes = {int(c): (0,) for c in THESIS}
-    lqr = rollout_ise(reference_policies()["lqr"], episodes=episodes)
+    lqr = lqr_ise(episodes=episodes)
     return {"ise_rel_lqr": score(rec, {str(c): v for c, v in lqr.items()})}
 
 

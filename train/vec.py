@@ -289,8 +289,7 @@ def make_vec_env(cfg, seed: int, env_id: str = acld_gym.ENV_ID,
                                           vec_env_cls=SubprocVecEnv))
     venv: VecEnv = parts[0] if len(parts) == 1 else ConcatVecEnv(parts)
     venv.seed(seed)
-    mesh = cfg.env_kwargs.get("mesh", "converged")
-    venv = VecAgentEnv(venv, cfg.residual, cfg.gamma, cfg.shaping, mesh=mesh)
+    venv = VecAgentEnv(venv, cfg.residual, cfg.gamma, cfg.shaping, mesh=cfg.mesh)
     if cfg.whiten_steps:  # log c, if observed, stays as it is (the critic's scale)
         venv = VecWhiten(venv, passthrough=int(bool(cfg.env_kwargs.get("observe_reward_scale"))))
     if cfg.features == "direction":

@@ -38,6 +38,7 @@ __all__ = [
     "batched_ise",
     "relative_ise",
     "ise_rel_lqr",
+    "lqr_ise",
     "reference_policies",
     "references",
     "CurveCallback",
@@ -125,8 +126,16 @@ def ise_rel_lqr(policy, env_id: str = DEFAULT_ENV_ID, episodes: dict | None = No
     ``benchmarks/single_file_ppo.py``)."""
     episodes = eval_episodes() if episodes is None else episodes
     ise = rollout_ise(policy, env_id, episodes)
-    lqr = rollout_ise(reference_policies(env_id)["lqr"], env_id, episodes)
-    return relative_ise(ise, {"lqr": lqr})
+    return relative_ise(ise, {"lqr": lqr_ise(env_id, episodes)})
+
+
+def lqr_ise(env_id: str = DEFAULT_ENV_ID, episodes: dict | None = None) -> dict:
+    """Mean ISE [m^2 s] per case of the LQR designed on ``env_id`` (:func:`rollout_ise`),
+    the yardstick of ISE / LQR, without designing the other references."""
+    from baselines.policies import LQRPolicy
+
+    lqr = LQRPolicy.for_env(_make_env(env_id, 1))
+    return rollout_ise(lqr, env_id, eval_episodes() if episodes is None else episodes)
 
 
 def reference_policies(env_id: str = DEFAULT_ENV_ID) -> dict:

@@ -100,7 +100,7 @@ def train_sb3(
     torch.set_num_threads(1)
     venv = make_vec_env(cfg, seed, env_id)
     model = make_model(cfg, venv, seed)
-    vmap = VoltageMap(cfg.residual, cfg.env_kwargs.get("mesh", "converged"))
+    vmap = VoltageMap(cfg.residual, cfg.mesh)
     distilled = None
     if cfg.distill is not None:
         import time

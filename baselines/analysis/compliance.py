@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .effort import at_limit
 from .excitation import PulseSuperposition
 from .frequency import Multisine, band_peak, frequency_response, transient_residual
 
@@ -93,7 +94,7 @@ def compliance_test(policy, rig: PulseSuperposition, ms: Multisine, edges: np.nd
         f = rms * unit
         run = rig.run(policy, f)
         vmax = float(np.max(np.abs(run.voltage)))
-        if vmax < v_max * (1 - 1e-9):
+        if not at_limit(vmax, v_max):
             break
         rms *= 0.5
     else:

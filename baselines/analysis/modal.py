@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .effort import at_limit
 from .excitation import PulseSuperposition, Response
 from .modes import Mode, band_edges, poles_and_residues, select_modes, window_energy
 from .sysid import Identification, identify, order_check
@@ -94,11 +95,11 @@ def modal_test(policy, rig: PulseSuperposition, edges: np.ndarray, v_max: float)
     n = min(rig.n_steps, RECORD_STEPS)
     rest = rig.run(policy, np.zeros(n))
     v0 = rest.voltage
-    at_limit = float(np.mean(np.abs(v0) >= v_max * (1 - 1e-9)))
+    at_limit_share = float(np.mean(at_limit(v0, v_max)))
     tail = v0[-n // 10:]
-    if at_limit > 0:
+    if at_limit_share > 0:
         return _invalid(f"without any load the policy holds the patch at the {v_max:g} V "
-                        f"limit in {100 * at_limit:.0f} % of the steps: no small-signal "
+                        f"limit in {100 * at_limit_share:.0f} % of the steps: no small-signal "
                         "modes", rests=False, rest_voltage_V=float(v0[-1]))
     if np.ptp(tail) > 1e-3 * v_max:
         return _invalid(f"without any load the voltage does not come to rest (it still "
@@ -128,7 +129,7 @@ def modal_test(policy, rig: PulseSuperposition, edges: np.ndarray, v_max: float)
     lin = float(np.linalg.norm(h - half) / np.linalg.norm(h))
     common = {"pulse_N": a, "max_voltage_V": vmax, "rest_voltage_V": float(v0[-1]),
               "linearity_error": lin, "response": h}
-    if vmax >= v_max * (1 - 1e-9):
+    if at_limit(vmax, v_max):
         return _invalid(f"even a {a:.3g} N pulse drives the patch to the {v_max:g} V limit",
                         **common)
     ident = identify(h, rig.dt)

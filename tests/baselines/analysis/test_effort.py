@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from acld_gym.physics.actuator import patch_capacitance
-from baselines.analysis.effort import SETTLE_DELAY, effort, settled_from
+from baselines.analysis.effort import AT_LIMIT_RTOL, SETTLE_DELAY, at_limit, effort, settled_from
 
 DT = 1e-3
 
@@ -48,6 +48,17 @@ def test_time_at_the_limit_and_residual_tip_in_the_settled_window():
     assert e.settled_rms_voltage_V == pytest.approx(math.sqrt((3 * 120.0**2 + 9.0) / 4))
     assert effort(v, y, DT, 0.5).reactive_power_var == pytest.approx(
         effort(v, y, DT, 0.5, capacitance=patch_capacitance()).reactive_power_var)
+
+
+def test_the_limit_within_a_solver_tolerance():
+    """A QP's saturated voltage, 1e-7 short of the bound by a CPU-dependent round-off
+    (the MPC's OSQP tolerance), is at the limit; 10 mV short is not."""
+    assert AT_LIMIT_RTOL >= 100 * 1e-7
+    v = np.array([120.0, -120.0 * (1 - 1e-7), 120.0 * (1 - 3e-7), 119.99, 0.0, 150.0])
+    assert at_limit(v).tolist() == [True, True, True, False, False, True]
+    assert at_limit(v, v_max=150.0).tolist() == [False] * 5 + [True]
+    w = np.concatenate([np.zeros(500), np.tile([120.0 * (1 - 1e-7), 3.0], 250)])
+    assert effort(w, np.zeros(1000), DT, settle_s=0.5).limit_fraction == pytest.approx(0.5)
 
 
 def test_settled_windows_of_the_thesis_cases():

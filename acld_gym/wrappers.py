@@ -1,7 +1,15 @@
 r"""Gymnasium wrappers that help every RL library on ACLDBeam (not one algorithm's code).
 
 * :class:`UnitAction`: actions in [-1, 1] instead of volts. A standard Gaussian policy
-  (unit std) explores +/-1 V on the +/-120 V actuator without it and learns nothing.
+  (unit std) explores +/-1 V on the +/-120 V actuator without it and learns nothing. With
+  ``headroom`` k > 1 the action's range spans k times the actuator's (the env clips and
+  reports): a tanh-squashed policy (SAC) then reaches the limit at a = 1/k, not only
+  in tanh's flat tail, where its entropy bonus forbids it.
+* :class:`ObserveModes`: the ``"estimate"`` observation restricted to the first modes and
+  the tip. Modes 3 and 4 of the design model (422 and 848 Hz) lie near and above the
+  500 Hz Nyquist frequency of the 1 kHz loop; per-entry observation normalization scales
+  their small, noise-dominated estimates up 5-30 times, and an MLP policy that feeds back
+  on them chatters at +/-120 V.
 * :class:`WhitenObservation`: a fixed linear map of the observation, ``u = T^T z``, e.g.
   :func:`whitening` of observation directions collected with an initial policy.
 
@@ -24,32 +32,98 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-__all__ = ["UnitAction", "WhitenObservation", "whitening"]
+__all__ = ["UnitAction", "ObserveModes", "WhitenObservation", "whitening", "check_headroom",
+           "MAX_HEADROOM"]
 
 
 class UnitAction(gym.ActionWrapper):
     r"""Actions ``a`` in [-1, 1] for an env whose action is a voltage in [-v_max, v_max]:
-    ``V = v_max a``, computed in float64, so the round trip :meth:`reverse_action` of
-    :meth:`action` is exact for every float32 action (v_max = 120 V is 15 2^3: a float32
-    times it is exact in float64, and so is the division back). Out-of-range actions are
-    passed on scaled, and the env clips and reports them (``info["clipped"]``), as it
-    does for volts."""
+    ``V = k v_max a`` with the ``headroom`` k (default 1), computed in float64, so the
+    round trip :meth:`reverse_action` of :meth:`action` is exact for every float32 action
+    when :math:`k v_{max}` is a small integer times a power of two (120 V is 15 2^3, and
+    360 V, k = 3, is 45 2^3: a float32 times it is exact in float64, and so is the
+    division back). Out-of-range voltages are passed on, and the env clips and reports them
+    (``info["clipped"]``), as it does for volts.
 
-    def __init__(self, env: gym.Env):
+    ``headroom`` k >= 1 makes the actuator's limit the action :math:`\pm 1/k`. For a policy
+    whose actions are squashed by tanh (SAC and its kin), reaching the limit with k = 1
+    takes tanh's flat tail, where the log-density correction
+    :math:`-\log(1 - \tanh^2)` grows without bound, so an entropy-regularised agent keeps
+    away from a limit that the optimal control of this beam sits on for much of an
+    episode; with k = 3 the limit is at tanh's argument 0.35. The deterministic policy
+    :math:`V = v_{max}\,\mathrm{clip}(k \tanh(\cdot), -1, 1)` is then a saturated law, like
+    LQR's and the random search's. Evaluate the trained policy through the same wrapper.
+    """
+
+    def __init__(self, env: gym.Env, headroom: float = 1.0):
         super().__init__(env)
         box = env.action_space
         if not (isinstance(box, spaces.Box) and box.shape == (1,)
                 and np.all(box.low == -box.high) and np.all(box.high > 0)):
             raise ValueError(f"env: UnitAction needs a symmetric 1-D Box action space "
                              f"(-v_max, v_max), got {box!r}")
+        self.headroom = check_headroom(headroom)
         self.v_max = float(box.high[0])
         self.action_space = spaces.Box(-1.0, 1.0, (1,), np.float32)
 
     def action(self, action):
-        return self.v_max * np.asarray(action, dtype=np.float64)
+        return (self.headroom * self.v_max) * np.asarray(action, dtype=np.float64)
 
     def reverse_action(self, action):
-        return (np.asarray(action, dtype=np.float64) / self.v_max).astype(np.float32)
+        return (np.asarray(action, dtype=np.float64)
+                / (self.headroom * self.v_max)).astype(np.float32)
+
+
+#: Largest ``headroom`` of :class:`UnitAction` and the training configs (the limit at
+#: a = 0.01).
+MAX_HEADROOM = 100.0
+
+
+def check_headroom(headroom) -> float:
+    """``headroom`` as a float in [1, :data:`MAX_HEADROOM`], or ``ValueError`` naming it."""
+    if isinstance(headroom, bool) or not isinstance(headroom, (int, float, np.integer,
+                                                               np.floating)) \
+            or not 1.0 <= float(headroom) <= MAX_HEADROOM:
+        raise ValueError(f"headroom must be a number in [1, {MAX_HEADROOM:g}] (the action "
+                         f"range over the actuator's), got {headroom!r}")
+    return float(headroom)
+
+
+class ObserveModes(gym.ObservationWrapper):
+    r"""The ``"estimate"`` observation (``obs_mode="estimate"``, the default) restricted to
+    the first ``modes`` modes of the design model and the tip: the slots of
+    :func:`acld_gym.envs.step.estimate_slots`, then any appended entries (``log c`` of
+    ``observe_reward_scale``) as they are. ``modes=2`` on ``ACLDBeam-v1`` gives 5 entries
+    (modes 1 and 2, 28 and 155 Hz, and the tip) of the 9.
+
+    A training aid for policies without a structure of their own (an MLP on normalized
+    inputs): the estimates of modes 3 and 4 (422 and 848 Hz, near and above the 500 Hz
+    Nyquist frequency; the Kalman filter sees mode 4 at about a tenth) are small and
+    dominated by the sensor noise and by the policy's own voltage, so normalizing each entry
+    (``NormalizeObservation``, ``VecNormalize``) magnifies them, and a policy that feeds
+    back on them chatters. What a policy loses by not seeing them was not measured; the
+    wrapper is a training aid, off unless applied. Evaluate a policy trained through this
+    wrapper through it too (or apply the same slots).
+    """
+
+    def __init__(self, env: gym.Env, modes: int = 2):
+        super().__init__(env)
+        config = getattr(env.unwrapped, "config", None)
+        if config is None or config.obs_mode != "estimate":
+            raise ValueError("env: ObserveModes needs an ACLDBeam env with obs_mode="
+                             "'estimate'")
+        if isinstance(modes, bool) or not isinstance(modes, (int, np.integer)):
+            raise ValueError(f"modes must be an integer, got {modes!r}")
+        n = env.observation_space.shape[0]
+        extra = int(bool(config.observe_reward_scale))
+        from acld_gym.envs.step import estimate_slots
+
+        self.modes = int(modes)
+        self.slots = np.r_[estimate_slots(n - 1 - extra, self.modes), np.arange(n - extra, n)]
+        self.observation_space = spaces.Box(-np.inf, np.inf, (len(self.slots),), np.float32)
+
+    def observation(self, observation):
+        return np.asarray(observation, dtype=np.float32)[..., self.slots]
 
 
 class WhitenObservation(gym.ObservationWrapper):
@@ -89,3 +163,4 @@ def whitening(directions: np.ndarray, ridge: float = 1e-3) -> np.ndarray:
     lam, vec = np.linalg.eigh(sigma)
     lam = np.maximum(lam, 0.0) + ridge * lam.max()
     return (vec / np.sqrt(lam)) @ vec.T
+

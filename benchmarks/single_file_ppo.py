@@ -4,17 +4,18 @@ any RL library" section tells it to add, and its ISE / LQR through the env.
 The file is the user's own copy of CleanRL's ``cleanrl/ppo_continuous_action.py`` (not part of
 this repository). This script makes the README's edits to a temporary copy, nothing else:
 
-1. ``import acld_gym`` and ``from acld_gym.wrappers import UnitAction``;
+1. ``import acld_gym`` and ``from acld_gym.wrappers import ObserveModes, UnitAction``;
 2. in ``make_env``, ``gym.make(env_id)`` becomes
-   ``UnitAction(gym.make(env_id, load_case="random", reward_scale="passive"))``;
+   ``ObserveModes(UnitAction(gym.make(env_id, load_case="random", reward_scale="passive")))``;
 3. (Gymnasium 1.x, any env) ``TransformObservation`` gets its third argument,
    ``env.observation_space``.
 
 It runs the copy (``--env-id ACLDBeam-v1 --total-timesteps N --seed S --no-cuda``), and to
 measure it saves the trained agent with its ``NormalizeObservation`` statistics (an appended
 instrumentation block, after training), then evaluates the deterministic actor (its mean,
-clipped to [-1, 1], times 120 V) on the plain env: thesis cases 1, 2, 3 (seed 0) and the
-held-out random set, divided by LQR's ISE (:mod:`train.bench.evaluate`).
+clipped to [-1, 1], times 120 V, on the observation slots ``ObserveModes`` keeps) on the
+plain env: thesis cases 1, 2, 3 (seed 0) and the held-out random set, divided by LQR's ISE
+(:mod:`train.bench.evaluate`).
 
 Needs ``pip install tyro tensorboard`` (the file's own imports). Not a test::
 
@@ -36,8 +37,9 @@ import numpy as np
 MAKE = "env = gym.make(env_id)"
 CLIP_OBS = "lambda obs: np.clip(obs, -10, 10))"
 CLIP_OBS_1X = "lambda obs: np.clip(obs, -10, 10), env.observation_space)"
-EDIT = 'env = UnitAction(gym.make(env_id, load_case="random", reward_scale="passive"))'
-IMPORTS = "import acld_gym  # noqa\nfrom acld_gym.wrappers import UnitAction\n"
+EDIT = ('env = ObserveModes(UnitAction(gym.make(env_id, load_case="random", '
+        'reward_scale="passive")))')
+IMPORTS = "import acld_gym  # noqa\nfrom acld_gym.wrappers import ObserveModes, UnitAction\n"
 SAVE = '''
 # --- instrumentation (benchmarks/single_file_ppo.py): save the agent and its normalization ---
 import pickle as _pickle
@@ -67,15 +69,19 @@ def edited_source(text: str, out: Path) -> str:
 
 
 class _Actor:
-    """The deterministic actor of the saved file as an SB3-``predict`` policy in volts."""
+    """The deterministic actor of the saved file as an SB3-``predict`` policy in volts, on
+    the env's full observation (``slots``: the entries the trained agent saw)."""
 
-    def __init__(self, saved: dict):
+    def __init__(self, saved: dict, slots=None):
         self.layers = [(saved["actor"][f"{i}.weight"], saved["actor"][f"{i}.bias"])
                        for i in (0, 2, 4)]
         self.mean, self.var = saved["mean"], saved["var"]
+        self.slots = None if slots is None else np.asarray(slots)
 
     def predict(self, obs, state=None, episode_start=None, deterministic=True):
         x = np.asarray(obs, dtype=np.float64)
+        if self.slots is not None:
+            x = x[..., self.slots]
         z = np.clip((x - self.mean) / np.sqrt(self.var + 1e-8), -10, 10)
         for i, (W, b) in enumerate(self.layers):
             z = z @ W.T + b
@@ -107,7 +113,10 @@ def main(argv=None) -> int:
         wall = time.perf_counter() - t0
         import pickle
 
-        actor = _Actor(pickle.loads(saved.read_bytes()))
+        from acld_gym.envs.beam_env import ACLDBeamEnv
+        from acld_gym.wrappers import ObserveModes
+
+        actor = _Actor(pickle.loads(saved.read_bytes()), ObserveModes(ACLDBeamEnv()).slots)
     rel = ise_rel_lqr(actor, "ACLDBeam-v1")
     out = {"seed": args.seed, "total_timesteps": args.total_timesteps, "wall_seconds": wall,
            "ise_rel_lqr": {str(k): float(v) for k, v in rel.items()}}

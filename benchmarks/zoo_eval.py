@@ -33,7 +33,11 @@ def main(argv=None) -> int:
     if not path.is_file():
         p.error(f"run: no {path}")
     model = {"ppo": PPO, "sac": SAC}[args.algo].load(path, device="cpu")
-    policy = SB3Policy(model, None, None)
+    from train.voltage import VoltageMap
+
+    # the recipe's action headroom (AsymmetricSACPolicy records it; 1 for the others)
+    headroom = getattr(model.policy, "action_headroom", 1.0)
+    policy = SB3Policy(model, None, None, voltage_map=VoltageMap(headroom=headroom))
     rel = {str(k): round(float(v), 4) for k, v in ise_rel_lqr(policy, "ACLDBeam-v1").items()}
     print(json.dumps({"run": str(args.run), "algo": args.algo, "ise_rel_lqr": rel}, indent=1))
     return 0

@@ -9,7 +9,8 @@ from gymnasium.utils.env_checker import check_env
 
 import acld_gym  # noqa: F401
 from acld_gym.envs.beam_env import ACLDBeamEnv
-from acld_gym.wrappers import UnitAction, WhitenObservation, whitening
+from acld_gym.envs.step import estimate_slots
+from acld_gym.wrappers import ObserveModes, UnitAction, WhitenObservation, whitening
 
 
 def test_unit_action_round_trip_is_exact():
@@ -35,6 +36,67 @@ def test_unit_action_steps_like_volts():
         assert np.array_equal(o1, o2) and r1 == r2 and i1["voltage"] == i2["voltage"]
     _, _, _, _, info = unit.step(np.array([1.5], np.float32))  # beyond: clipped, reported
     assert info["clipped"] and info["voltage"] == 120.0
+
+
+def test_unit_action_headroom_round_trip_and_limit():
+    env = UnitAction(ACLDBeamEnv(load_case=1), headroom=3)
+    assert env.headroom == 3.0 and env.action_space == gym.spaces.Box(-1, 1, (1,), np.float32)
+    a = np.random.default_rng(5).uniform(-1, 1, 100_000).astype(np.float32)
+    volts = env.action(a)  # 360 V = 45 2^3: exact in float64 both ways
+    assert np.array_equal(volts, 360.0 * a.astype(np.float64))
+    assert np.array_equal(env.reverse_action(volts), a)
+    env.reset(seed=0)
+    _, _, _, _, info = env.step(np.array([0.25], np.float32))  # 90 V: inside the limit
+    assert info["voltage"] == 90.0 and not info["clipped"]
+    _, _, _, _, info = env.step(np.array([-0.5], np.float32))  # -180 V: clipped, reported
+    assert info["voltage"] == -120.0 and info["clipped"]
+    check_env(UnitAction(ACLDBeamEnv(load_case=1, episode_length=0.05), headroom=2.5),
+              skip_render_check=True)
+
+
+@pytest.mark.parametrize("bad", [0.5, 0.0, -2.0, 101.0, float("nan"), True, "3", None])
+def test_unit_action_rejects_a_bad_headroom(bad):
+    with pytest.raises(ValueError, match=r"headroom must be a number in \[1, 100\]"):
+        UnitAction(ACLDBeamEnv(load_case=1), headroom=bad)
+
+
+def test_observe_modes_keeps_the_first_modes_and_the_tip():
+    """Slots of modes 1..m and the tip, exactly; log c passes through; check_env is clean."""
+    plain = ACLDBeamEnv(load_case=2)
+    env = ObserveModes(ACLDBeamEnv(load_case=2), modes=2)
+    assert env.observation_space.shape == (5,)
+    z, _ = plain.reset(seed=4)
+    u, _ = env.reset(seed=4)
+    assert np.array_equal(u, z[[0, 1, 2, 3, 8]])
+    for a in (30.0, -120.0):
+        z, *_ = plain.step(np.array([a], np.float32))
+        u, *_ = env.step(np.array([a], np.float32))
+        assert np.array_equal(u, z[[0, 1, 2, 3, 8]])
+    scaled = ObserveModes(ACLDBeamEnv(load_case="random", reward_scale="passive",
+                                      observe_reward_scale=True), modes=1)
+    u, info = scaled.reset(seed=0)
+    assert u.shape == (4,) and np.isclose(u[-1], np.log(info["reward_scale"]), rtol=1e-6)
+    assert np.array_equal(ObserveModes(ACLDBeamEnv(load_case=1), 4).slots, np.arange(9))
+    assert np.array_equal(ObserveModes(ACLDBeamEnv(load_case=1, mesh="thesis"), 3).slots,
+                          np.arange(7))
+    check_env(ObserveModes(ACLDBeamEnv(load_case=1, episode_length=0.05)),
+              skip_render_check=True)
+
+
+@pytest.mark.parametrize("kwargs, modes, match", [
+    ({}, 0, r"modes must be in \[1, 4\]"), ({}, 5, r"modes must be in \[1, 4\]"),
+    ({}, 2.0, "modes must be an integer"), ({"obs_mode": "measurement"}, 2, "obs_mode"),
+])
+def test_observe_modes_rejects_bad_input(kwargs, modes, match):
+    with pytest.raises(ValueError, match=match):
+        ObserveModes(ACLDBeamEnv(load_case=1, **kwargs), modes)
+
+
+def test_estimate_slots_is_the_layout():
+    assert estimate_slots(8, 2).tolist() == [0, 1, 2, 3, 8]
+    assert estimate_slots(6, 3).tolist() == [0, 1, 2, 3, 4, 5, 6]
+    with pytest.raises(ValueError, match="modes must be in"):
+        estimate_slots(8, 0)
 
 
 def test_whiten_observation_keeps_passthrough_and_checks():

@@ -270,7 +270,8 @@ class TrainedAgent:
     """An agent directory (module docstring) as a policy on the env's raw observation.
 
     ``predict`` runs the :class:`ActorProgram` and maps its action to volts with the
-    same :class:`train.voltage.VoltageMap` as in training.
+    same :class:`train.voltage.VoltageMap` as in training (its ``residual`` and
+    ``action_headroom`` from the metadata; an agent without them: none and 1).
     """
 
     def __init__(self, actor: ActorProgram, metadata: dict, name: str = "agent",
@@ -279,7 +280,11 @@ class TrainedAgent:
         self.metadata = dict(metadata)
         self.name = name
         self.directory = directory
-        self.map = VoltageMap(self.metadata.get("residual"))
+        try:
+            self.map = VoltageMap(self.metadata.get("residual"),
+                                  headroom=self.metadata.get("action_headroom", 1.0))
+        except ValueError as exc:
+            raise AgentFileError(f"{META_FILE}: {exc}") from None
 
     # --- what it was trained on --------------------------------------------------------
     @property

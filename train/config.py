@@ -110,6 +110,12 @@ class TrainConfig:
         voltage, ``V = 120 clip(u_lqr / 120 + 2 a, -1, 1)`` [V]
         (:class:`train.voltage.VoltageMap`; controller knowledge in the policy, so the
         agent is labelled so); None (default): ``V = 120 a``.
+    action_headroom : float
+        SB3 algorithms: the action a in [-1, 1] drives ``V = 120 clip(k a, -1, 1)`` with
+        k = ``action_headroom`` (default 1; :class:`train.voltage.VoltageMap`, the same
+        map as :class:`acld_gym.wrappers.UnitAction`'s ``headroom``). A tanh-squashed actor
+        (SAC) reaches the +/-120 V limit at a = 1/k instead of only in tanh's flat tail,
+        which its entropy term forbids; the agent records k and applies it when deployed.
     shaping : float or None
         SB3 algorithms: voltage weight of the LQ potential used for reward shaping in
         training (:class:`train.vec.VecAgentEnv`, :func:`train.vec.lq_potential`;
@@ -132,6 +138,7 @@ class TrainConfig:
     episode_scale: bool = False
     env_kwargs: dict = field(default_factory=dict)
     residual: str | None = None
+    action_headroom: float = 1.0
     shaping: float | None = None
     distill: dict | None = None
 
@@ -187,6 +194,15 @@ class TrainConfig:
                 raise ValueError(f"env_kwargs: {exc}") from None
         if self.residual not in RESIDUALS:
             raise ValueError(f"residual must be one of {list(RESIDUALS)}, got {self.residual!r}")
+        from acld_gym.wrappers import check_headroom
+
+        try:
+            check_headroom(self.action_headroom)
+        except ValueError as exc:
+            raise ValueError(f"action_{exc}") from None
+        if self.action_headroom != 1.0 and not sb3:
+            raise ValueError("action_headroom is for the SB3 algorithms (vrs: a saturated "
+                             "linear actor)")
         if self.shaping is not None:
             check_real("shaping", self.shaping, 0.0, 1e6, low_open=True)
         if self.distill is not None:

@@ -52,7 +52,8 @@ def lq_potential(gamma: float, lam: float, y_ref: float = 1e-3, dt: float = 1e-3
 
 class VecAgentEnv(VecEnvWrapper):
     r"""The agent's side of the env: action space ``Box(-1, 1, (1,))`` mapped to volts
-    by :class:`VoltageMap` (the role of gymnasium's ``RescaleAction`` for a ``VecEnv``)
+    by :class:`VoltageMap` (the role of :class:`acld_gym.wrappers.UnitAction` for a
+    ``VecEnv``, ``headroom`` included)
     and, for training, potential-based reward shaping (Ng, Harada & Russell 1999),
 
     .. math:: r' = r + \gamma \Phi(s') - \Phi(s), \qquad \Phi(z) = -z^T P z,
@@ -65,9 +66,10 @@ class VecAgentEnv(VecEnvWrapper):
     are synchronized level by level)."""
 
     def __init__(self, venv: VecEnv, residual: str | None = None, gamma: float = 0.99,
-                 shaping: float | None = None, mesh: str = "converged"):
+                 shaping: float | None = None, mesh: str = "converged",
+                 headroom: float = 1.0):
         super().__init__(venv, action_space=spaces.Box(-1.0, 1.0, (1,), np.float32))
-        self.map = VoltageMap(residual, mesh)
+        self.map = VoltageMap(residual, mesh, headroom)
         self.gamma = float(gamma)
         self.P = None if shaping is None else lq_potential(self.gamma, shaping, mesh=mesh)
         self._obs: np.ndarray | None = None
@@ -262,9 +264,9 @@ def make_vec_env(cfg, seed: int, env_id: str = acld_gym.ENV_ID,
     """The training env of a :class:`train.config.TrainConfig`, seeded (sub-env i gets
     ``seed + i``): per training load case a batched env of ``env_id`` with the config's
     ``env_kwargs`` (sub-envs split as :func:`_split_envs`), :class:`VecAgentEnv` with the
-    config's ``residual`` and ``shaping``, :class:`VecWhiten` if ``cfg.whiten_steps``
-    (identity until :func:`train.bench.sb3_train.train_sb3` sets it), direction features
-    if ``cfg.features``, and ``VecNormalize`` with ``cfg.normalize``.
+    config's ``residual``, ``action_headroom`` and ``shaping``, :class:`VecWhiten` if
+    ``cfg.whiten_steps`` (identity until :func:`train.bench.sb3_train.train_sb3` sets it),
+    direction features if ``cfg.features``, and ``VecNormalize`` with ``cfg.normalize``.
 
     ``backend="native"``: :class:`acld_gym.envs.sb3.SB3VecEnv` over ``gym.make_vec``;
     ``"subproc"``: SB3's ``SubprocVecEnv`` over single envs (the same envs, for
@@ -289,7 +291,8 @@ def make_vec_env(cfg, seed: int, env_id: str = acld_gym.ENV_ID,
                                           vec_env_cls=SubprocVecEnv))
     venv: VecEnv = parts[0] if len(parts) == 1 else ConcatVecEnv(parts)
     venv.seed(seed)
-    venv = VecAgentEnv(venv, cfg.residual, cfg.gamma, cfg.shaping, mesh=cfg.mesh)
+    venv = VecAgentEnv(venv, cfg.residual, cfg.gamma, cfg.shaping, mesh=cfg.mesh,
+                       headroom=cfg.action_headroom)
     if cfg.whiten_steps:  # log c, if observed, stays as it is (the critic's scale)
         venv = VecWhiten(venv, passthrough=int(bool(cfg.env_kwargs.get("observe_reward_scale"))))
     if cfg.features == "direction":

@@ -18,6 +18,7 @@ if TYPE_CHECKING:
     from acld_gym.design.nominal import NominalDesign
 
 __all__ = ["StepLayout", "Y_SCALE", "OBS_HIST", "INFO_KEYS", "TERMINATED_BY", "observation_size",
+           "estimate_slots",
            "estimate_map", "output_matrix", "rest_output", "load_schedule",
            "reward_terms", "reward_of", "termination_codes"]
 
@@ -201,6 +202,16 @@ class StepLayout:
 def observation_size(nom: NominalDesign, obs_mode: str, hist: int = OBS_HIST) -> int:
     return {"estimate": nom.design.reduced.order + 1, "measurement": hist + 1,
             "full": nom.plant.Ad.shape[0]}[obs_mode]
+
+
+def estimate_slots(order: int, modes: int) -> np.ndarray:
+    """Slots of the ``"estimate"`` observation (``order`` scaled reduced-state entries, one
+    (cosine, sine)-like pair per mode in mode order, then the tip) that hold the first
+    ``modes`` modes' pairs and the tip: ``[0, ..., 2 modes - 1, order]``."""
+    if order % 2 or not 1 <= modes <= order // 2:
+        raise ValueError(f"modes must be in [1, {order // 2}] (the design model's modes), "
+                         f"got {modes!r}")
+    return np.r_[np.arange(2 * modes), order]
 
 
 def estimate_map(obs: DiscreteObserver, xr_scale: np.ndarray) -> np.ndarray:

@@ -146,6 +146,21 @@ def test_bad_metadata_is_named(agent_dir):
         TrainedAgent.load(agent_dir)
 
 
+def test_action_headroom_is_applied_and_checked(agent_dir):
+    """An agent's ``action_headroom`` k (metadata) maps its action a to 120 clip(k a) V,
+    as in training; a bad k is refused at load, naming the file."""
+    obs = np.random.default_rng(3).normal(size=(64, 9)).astype(np.float32)
+    plain = TrainedAgent.load(agent_dir)
+    a = plain.actor(obs)[:, 0]
+    meta = json.loads((agent_dir / META_FILE).read_text())
+    (agent_dir / META_FILE).write_text(json.dumps(dict(meta, action_headroom=2.0)))
+    v, _ = TrainedAgent.load(agent_dir).predict(obs)
+    assert np.allclose(v[:, 0], np.clip(240.0 * a, -120, 120), atol=1e-4)
+    (agent_dir / META_FILE).write_text(json.dumps(dict(meta, action_headroom=0.5)))
+    with pytest.raises(AgentFileError, match=rf"{META_FILE}: headroom must be a number"):
+        TrainedAgent.load(agent_dir)
+
+
 def _damage(agent_dir: Path, key: str, change) -> None:
     """Rewrite one array of the agent's policy file with ``change(array)``."""
     with np.load(agent_dir / POLICY_FILE) as z:

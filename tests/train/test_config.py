@@ -52,6 +52,7 @@ BASE = dict(algo="ppo", timesteps=10, n_envs=2, model={"policy": "MlpPolicy"})
     ({"env_kwargs": {"load_case": 1}}, "loads"),
     ({"env_kwargs": {"reward_scael": "passive"}}, "reward_scael"),
     ({"residual": "mpc"}, "residual"), ({"shaping": 0}, "shaping"),
+    ({"action_headroom": 0.5}, "action_headroom"), ({"action_headroom": "2"}, "action_headroom"),
     ({"model": {}}, "policy"), ({"model": {"policy": "MlpPolicy", "learning_rat": 1}},
                                 "learning_rat"),
     ({"model": {"policy": "MlpPolicy", "n_steps": "64"}}, "n_steps"),
@@ -72,6 +73,8 @@ def test_vrs_takes_no_sb3_options():
         TrainConfig(algo="vrs", timesteps=10, shaping=0.1)
     with pytest.raises(ValueError, match="env_kwargs"):
         TrainConfig(algo="vrs", timesteps=10, env_kwargs={"reward_scale": "passive"})
+    with pytest.raises(ValueError, match="action_headroom is for the SB3"):
+        TrainConfig(algo="vrs", timesteps=10, action_headroom=2.0)
 
 
 def test_bad_files(tmp_path):

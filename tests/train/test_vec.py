@@ -34,6 +34,32 @@ def test_voltage_map_plain_and_residual():
         VoltageMap("pid")
 
 
+def test_voltage_map_headroom_is_the_wrappers_map():
+    """``headroom`` k: V = 120 clip(k a), the map of acld_gym.wrappers.UnitAction (whose env
+    clips); k = 1 is the plain map bit for bit; with the LQR residual the action moves the
+    LQR voltage by 240 k a."""
+    from acld_gym.envs.beam_env import ACLDBeamEnv
+    from acld_gym.wrappers import UnitAction
+
+    rng = np.random.default_rng(1)
+    obs = rng.normal(size=(7, 9))
+    a = np.array([[-1.5], [-0.4], [-0.2], [0.0], [0.1], [1 / 3], [1.0]])
+    v = VoltageMap(headroom=3.0)(a, obs)[:, 0]
+    assert np.allclose(v, [-120, -120, -72, 0, 36, 120, 120])
+    unit = UnitAction(ACLDBeamEnv(load_case=1), headroom=3.0)
+    assert np.allclose(v, np.clip(unit.action(a[:, 0]), -120, 120))
+    a1 = rng.uniform(-2, 2, (50, 1))
+    assert np.array_equal(VoltageMap(headroom=1.0)(a1, obs[:1].repeat(50, 0)),
+                          VoltageMap()(a1, obs[:1].repeat(50, 0)))
+    lqr = LQRPolicy()
+    u0 = lqr.voltage(lqr.reduced_state(obs))
+    res = VoltageMap("lqr", headroom=2.0)
+    assert np.allclose(res(np.full((7, 1), 0.1), obs)[:, 0], np.clip(u0 + 48.0, -120, 120),
+                       atol=1e-3)
+    with pytest.raises(ValueError, match="headroom must be a number"):
+        VoltageMap(headroom=0.9)
+
+
 def test_lq_potential_solves_the_discounted_riccati_equation():
     gamma, lam = 0.99, 0.01
     P = lq_potential(gamma, lam)

@@ -17,7 +17,11 @@ ZOO_ONLY = {"env_wrapper", "env_kwargs", "n_envs", "n_timesteps", "policy", "pol
 def test_zoo_file_is_the_benchmark_recipe(algo):
     zoo = yaml.safe_load(open(f"train/zoo/{algo}.yml"))["ACLDBeam-v1"]
     bench = yaml.safe_load(open(f"train/benchmark/{algo}.yaml"))
-    assert zoo["env_wrapper"] == ["acld_gym.wrappers.UnitAction"]
+    headroom = bench.get("action_headroom", 1.0)
+    if headroom == 1.0:
+        assert zoo["env_wrapper"] == ["acld_gym.wrappers.UnitAction"]
+    else:  # the wrapper's headroom, and the critic's (AsymmetricSACPolicy), are the recipe's
+        assert zoo["env_wrapper"] == [{"acld_gym.wrappers.UnitAction": {"headroom": headroom}}]
     assert zoo["env_kwargs"] == {"load_case": "random", **bench["env_kwargs"]}
     assert bench["loads"] == {"random": 1}
     assert zoo["n_envs"] == bench["n_envs"] and zoo["n_timesteps"] == bench["timesteps"]
@@ -31,6 +35,8 @@ def test_zoo_file_is_the_benchmark_recipe(algo):
     else:
         assert zoo["learning_rate"] == lr
     kwargs = eval(zoo["policy_kwargs"])  # rl-zoo3 evaluates the string the same way
+    if headroom != 1.0:
+        assert kwargs.pop("action_headroom") == headroom
     assert kwargs == bench["model"]["policy_kwargs"]
 
 

@@ -78,6 +78,13 @@ def make_model(cfg: TrainConfig, venv, seed: int, **kwargs):
     ``kwargs`` add to them."""
     model_kwargs = _resolve_policy_kwargs(dict(cfg.model))
     policy = model_kwargs.pop("policy")
+    if policy is AsymmetricSACPolicy:  # its critic takes the applied action (the env's map)
+        pk = dict(model_kwargs.get("policy_kwargs") or {})
+        if pk.get("action_headroom", cfg.action_headroom) != cfg.action_headroom:
+            raise ValueError(f"model.policy_kwargs.action_headroom "
+                             f"{pk['action_headroom']!r} differs from action_headroom "
+                             f"{cfg.action_headroom!r}: give it once, as action_headroom")
+        model_kwargs["policy_kwargs"] = {**pk, "action_headroom": cfg.action_headroom}
     if cfg.episode_scale:
         model_kwargs["rollout_buffer_class"] = EpisodeScaledRolloutBuffer
     model_kwargs.setdefault("verbose", 0)
@@ -100,7 +107,7 @@ def train_sb3(
     torch.set_num_threads(1)
     venv = make_vec_env(cfg, seed, env_id)
     model = make_model(cfg, venv, seed)
-    vmap = VoltageMap(cfg.residual, cfg.mesh)
+    vmap = VoltageMap(cfg.residual, cfg.mesh, cfg.action_headroom)
     distilled = None
     if cfg.distill is not None:
         import time

@@ -137,6 +137,7 @@ def save_agent(policy, rec: dict, directory: str | Path) -> Path:
         "training": cfg.training,
         "teacher": cfg.teacher,
         "residual": cfg.residual,
+        "action_headroom": cfg.action_headroom,
         "distill": rec["record"].get("distill"),
         "timesteps": rec["steps"],
         "budget": rec["budget"],

@@ -41,6 +41,50 @@ def _rows(text: str, score: bool = False) -> list[list[str]]:
     return [r[:-1] if len(r) == 9 else r for r in rows]  # (9 columns: a row with ms/step)
 
 
+def _same_rows(printed: list[list[str]], page: list[list[str]]) -> list[str]:
+    """The rows that differ. Every row must be printed as on the page, except the MPC's in
+    its last printed digit: its QP is solved to OSQP's tolerance (1e-7), and in a limit
+    cycle (the lab and hard presets) that CPU-dependent round-off reaches the fourth digit
+    (tip RMS 56.32 against 56.31 um with OpenBLAS's Nehalem kernels). The MPC's numbers
+    are compared to one unit of their last digit, its shares at the limit to 0.5 points."""
+    bad = [f"{len(printed)} rows printed, {len(page)} on the page"] if len(printed) != len(
+        page) else []
+    for a, b in zip(printed, page, strict=False):
+        if a == b:
+            continue
+        if a[0] != "mpc" or b[0] != "mpc" or len(a) != len(b):
+            bad.append(f"{a} != {b}")
+            continue
+        for x, y in zip(a[1:], b[1:], strict=True):
+            pct = y.endswith("%")
+            x, y = x.strip("[],%"), y.strip("[],%")  # also the score's "[0.004," entries
+            xv, yv = float(x), float(y)
+            digits = y.partition("e")[0].partition(".")[2]
+            unit = 0.5 if pct else 10.0 ** -len(digits) * (
+                10.0 ** int(y.partition("e")[2]) if "e" in y else 1.0)
+            if abs(xv - yv) > unit * (1 + 1e-9):
+                bad.append(f"{a} != {b}")
+                break
+    return bad
+
+
+def test_same_rows_tolerates_only_the_mpc_last_digit():
+    row = ["mpc", "104.6", "415.40", "193.18", "70.3%", "56.31"]
+    assert _same_rows([row], [row]) == []
+    assert _same_rows([row[:5] + ["56.32"]], [row]) == []
+    assert _same_rows([row[:4] + ["70.7%", "56.31"]], [row]) == []
+    assert _same_rows([row[:5] + ["56.33"]], [row]) != []
+    assert _same_rows([row[:4] + ["71.0%", "56.31"]], [row]) != []
+    lqr = ["lqr", "0.680", "1.592e-08"]
+    assert _same_rows([["lqr", "0.680", "1.593e-08"]], [lqr]) != []
+    assert _same_rows([["mpc", "0.680", "1.593e-08"]], [["mpc", "0.680", "1.592e-08"]]) == []
+    assert _same_rows([["mpc", "0.680", "1.594e-08"]], [["mpc", "0.680", "1.592e-08"]]) != []
+    assert _same_rows([], [lqr]) != []
+    score = ["mpc", "0.019", "[0.004,", "0.035]"]
+    assert _same_rows([["mpc", "0.019", "[0.005,", "0.035]"]], [score]) == []
+    assert _same_rows([["mpc", "0.019", "[0.006,", "0.035]"]], [score]) != []
+
+
 def _sections() -> list[tuple[str, str]]:
     text = "\n".join((DOCS / page).read_text() for page in TABLE_PAGES)
     sections = re.findall(r"`python -m baselines\.evaluate --env-id (\S+)`:\n\n```\n(.*?)```",
@@ -57,7 +101,7 @@ def test_variant_tables_are_what_their_commands_print(capsys):
     for env_id, table in _sections():
         assert "\nscore on " in table, env_id  # the page shows the score too
         assert main(["--env-id", env_id, "--score-episodes", "0", "--quiet"]) == 0
-        assert _rows(capsys.readouterr().out) == _rows(table), env_id
+        assert _same_rows(_rows(capsys.readouterr().out), _rows(table)) == [], env_id
 
 
 @pytest.mark.slow
@@ -68,5 +112,6 @@ def test_variant_scores_are_what_their_commands_print(capsys):
     for env_id, table in _sections():
         assert main(["--env-id", env_id, "--quiet"]) == 0
         out = capsys.readouterr().out
-        assert _rows(out) == _rows(table), env_id
-        assert _rows(out, score=True) == _rows(table, score=True) != [], env_id
+        assert _same_rows(_rows(out), _rows(table)) == [], env_id
+        assert _same_rows(_rows(out, score=True), _rows(table, score=True)) == [], env_id
+        assert _rows(table, score=True) != [], env_id

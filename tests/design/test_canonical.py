@@ -5,7 +5,12 @@ Other CPUs' BLAS kernels return Schur and singular vectors with other signs and
 round-off. These tests perturb the *inputs* of the Schur and SVD steps the same way --
 renumbering, sign-flipping or rotating the full model's coordinates -- and require the
 reduced model, the observation scales, the observer gains and a whole episode's
-observations to come out the same to 1e-9 (relative to each quantity's largest entry).
+observations to come out the same to 1e-8 (relative to each quantity's largest entry;
+float32 observations, to twice their resolution). Measured, the largest such difference
+is 8e-10 with this machine's kernels (a rotation of the thesis mesh, SR) and 1.7e-9 with
+OpenBLAS's Nehalem kernels (a signed permutation, SR; B and C 1.3e-9 under a rotation):
+1e-8 keeps a margin of 6 over every kernel tried and stays 10 times below what a float32
+observation can show.
 They never touch the BLAS settings (``benchmarks/check_kernels.py`` compares kernels by
 hand).
 
@@ -37,7 +42,7 @@ from acld_gym.physics.plant import Plant
 from acld_gym.physics.truth import plant
 from baselines.policies import LQRPolicy
 
-RTOL = 1e-9
+RTOL = 1e-8
 
 
 def _rel(a, b) -> float:

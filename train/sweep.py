@@ -87,14 +87,12 @@ def main(argv: list[str] | None = None) -> int:
     if args.learning_rates and any(not lr > 0 for lr in args.learning_rates):
         parser.error(f"--learning-rates must be positive, got {args.learning_rates}")
     try:
-        import ray
         from ray import tune
+
+        from train.bench.trials import init_ray
     except ImportError:
         parser.error('Ray Tune is not installed: pip install -e ".[sweep]"')
-    if args.address:
-        ray.init(address=args.address)
-    else:
-        ray.init(num_cpus=args.num_cpus)
+    init_ray(args.address, args.num_cpus)
     space = {"algo": args.algo, "timesteps": args.timesteps,
              "seed": tune.grid_search(args.seeds),
              "learning_rate": (tune.grid_search(args.learning_rates) if args.learning_rates

@@ -170,6 +170,15 @@ def _tune_trainable(config: dict) -> None:  # pragma: no cover - runs inside Ray
     tune.report({"train_seconds": rec["train_seconds"], "record": json.dumps(rec)})
 
 
+def init_ray(address: str | None, num_cpus: int) -> None:
+    """Connect to the Ray cluster at ``address``, or start a local one with ``num_cpus``;
+    a session already running in this process (an earlier benchmark or sweep) is reused."""
+    import ray
+
+    if not ray.is_initialized():
+        ray.init(address=address) if address else ray.init(num_cpus=num_cpus)
+
+
 def run_trials(
     trials: list[dict],
     out: Path,
@@ -192,11 +201,9 @@ def run_trials(
             )
             records.append(rec)
         return records
-    import ray
     from ray import tune
 
-    if not ray.is_initialized():
-        ray.init(address=address) if address else ray.init(num_cpus=num_cpus)
+    init_ray(address, num_cpus)
     # one grid point per run: run_trial's arguments as JSON text (Tune's loggers sort config
     # keys, and the load weights mix int and str keys)
     tuner = tune.Tuner(

@@ -130,7 +130,10 @@ def test_the_presets_are_read_with_their_actuator_and_observation(tmp_path):
     _check_schema(lab)
     assert lab["linear"] and not lab["margins"]["closed_loop_stable"]
     assert lab["margins"]["closed_loop_spectral_radius"] > 1.01
-    assert lab["score"]["test_set"] == "ACLDBeamLab-v1/test-v1" and lab["score"]["iqm"] == 0.0
+    # LQR against its own cached reference: 0 up to round-off (3e-16 measured on the lab
+    # rig, whose limit cycle carries the last bits of a batched vs a single-env run)
+    assert lab["score"]["test_set"] == "ACLDBeamLab-v1/test-v1"
+    assert lab["score"]["iqm"] == pytest.approx(0.0, abs=1e-9)
     hard = _run(tmp_path, "smc", "--env-id", "ACLDBeamHard-v1", "--score-episodes", "3")
     _check_schema(hard)
     assert not hard["linear"] and "state" in hard["small_signal_law"]

@@ -79,14 +79,16 @@ class UnitAction(gym.ActionWrapper):
 MAX_HEADROOM = 100.0
 
 
-def check_headroom(headroom) -> float:
-    """``headroom`` as a float in [1, :data:`MAX_HEADROOM`], or ``ValueError`` naming it."""
-    if isinstance(headroom, bool) or not isinstance(headroom, (int, float, np.integer,
-                                                               np.floating)) \
-            or not 1.0 <= float(headroom) <= MAX_HEADROOM:
-        raise ValueError(f"headroom must be a number in [1, {MAX_HEADROOM:g}] (the action "
-                         f"range over the actuator's), got {headroom!r}")
-    return float(headroom)
+def check_headroom(headroom, name: str = "headroom") -> float:
+    """``headroom`` as a float in [1, :data:`MAX_HEADROOM`], or ``ValueError`` naming it
+    (as ``name``)."""
+    from acld_gym.util.validate import check_real
+
+    try:
+        return check_real(name, headroom, 1.0, MAX_HEADROOM)
+    except ValueError:
+        raise ValueError(f"{name} must be a number in [1, {MAX_HEADROOM:g}] (the action "
+                         f"range over the actuator's), got {headroom!r}") from None
 
 
 class ObserveModes(gym.ObservationWrapper):

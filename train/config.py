@@ -196,10 +196,7 @@ class TrainConfig:
             raise ValueError(f"residual must be one of {list(RESIDUALS)}, got {self.residual!r}")
         from acld_gym.wrappers import check_headroom
 
-        try:
-            check_headroom(self.action_headroom)
-        except ValueError as exc:
-            raise ValueError(f"action_{exc}") from None
+        check_headroom(self.action_headroom, "action_headroom")
         if self.action_headroom != 1.0 and not sb3:
             raise ValueError("action_headroom is for the SB3 algorithms (vrs: a saturated "
                              "linear actor)")

@@ -43,11 +43,10 @@ class VoltageMap:
 
     def __call__(self, action: np.ndarray, obs: np.ndarray) -> np.ndarray:
         """Volts, shape (n, 1), for actions (n, 1) and raw observations (n, d)."""
-        a = np.clip(self.headroom * np.asarray(action, dtype=np.float64).reshape(-1, 1),
-                    -self.headroom, self.headroom)
-        if self._lqr is None:
-            a = np.clip(a, -1.0, 1.0)
-        else:
+        a = self.headroom * np.clip(np.asarray(action, dtype=np.float64).reshape(-1, 1),
+                                    -1.0, 1.0)
+        if self._lqr is not None:
             u0 = self._lqr.voltage(self._lqr.reduced_state(np.atleast_2d(obs)))[:, None]
-            a = np.clip(u0 / V_LIMIT + 2.0 * a, -1.0, 1.0)
+            a = u0 / V_LIMIT + 2.0 * a
+        a = np.clip(a, -1.0, 1.0)
         return (V_LIMIT * a).astype(np.float32)

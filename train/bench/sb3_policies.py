@@ -21,6 +21,7 @@ from stable_baselines3.common.vec_env import VecNormalize
 from stable_baselines3.sac.policies import SACPolicy
 
 import acld_gym  # noqa: F401  (registers the env ids)
+from acld_gym.util.validate import check_real
 
 from ..features import DirectionFeatures, direction_features
 
@@ -261,12 +262,8 @@ class ScaledQuadraticCritic(ContinuousCritic):
         from acld_gym.wrappers import check_headroom
 
         self.action_headroom = check_headroom(action_headroom)
-        if offset_scale is not None and not (isinstance(offset_scale, (int, float))
-                                             and not isinstance(offset_scale, bool)
-                                             and 0 < offset_scale < np.inf):
-            raise ValueError(f"offset_scale must be a positive number or None, got "
-                             f"{offset_scale!r}")
-        self.offset_scale = None if offset_scale is None else float(offset_scale)
+        self.offset_scale = (None if offset_scale is None else
+                             check_real("offset_scale", offset_scale, 0.0, low_open=True))
         d = int(observation_space.shape[0]) - 1 + int(np.prod(action_space.shape))
         self.quadratic = QuadraticFeatures(spaces.Box(-np.inf, np.inf, (d,), np.float32))
         # and the constant feature offset_scale, if any
@@ -314,13 +311,10 @@ class AsymmetricSACPolicy(SACPolicy):
         from acld_gym.wrappers import check_headroom
 
         self.action_headroom = check_headroom(action_headroom)
-        for name, value in (("mean_clip", mean_clip), ("log_std_min", log_std_min)):
-            if value is not None and not (isinstance(value, (int, float))
-                                          and np.isfinite(value)):
-                raise ValueError(f"{name} must be a number or None, got {value!r}")
-        if mean_clip is not None and not mean_clip > 0:
-            raise ValueError(f"mean_clip must be positive, got {mean_clip!r}")
-        if log_std_min is not None and not -20.0 <= log_std_min < 2.0:
+        if mean_clip is not None:
+            check_real("mean_clip", mean_clip, 0.0, low_open=True)
+        if log_std_min is not None and not -20.0 <= check_real("log_std_min",
+                                                               log_std_min) < 2.0:
             raise ValueError(f"log_std_min must be in [-20, 2) (SAC's log std range), got "
                              f"{log_std_min!r}")
         self.offset_scale = offset_scale

@@ -23,6 +23,7 @@ __all__ = [
     "SB3_ALGOS",
     "CONFIG_DIR",
     "TrainConfig",
+    "SelectConfig",
     "algo_class",
     "config_path",
     "read_config",
@@ -47,6 +48,37 @@ RESIDUALS = (None, "lqr")
 #: Smallest value of the SB3 integer arguments that may be below 1 (-1: "as many as").
 _INT_MIN = {"seed": 0, "verbose": 0, "learning_starts": 0, "sde_sample_freq": -1,
             "gradient_steps": -1}
+
+
+@dataclass(frozen=True)
+class SelectConfig:
+    """Checkpoint selection on validation loads (``TrainConfig.select``), as SB3's
+    ``EvalCallback`` keeps its best model: every ``every`` env steps from ``start`` on, and
+    at the end, the deterministic policy runs ``episodes`` random loads of the validation
+    seeds (:func:`train.bench.evaluate.validation_seeds`, disjoint from the held-out test
+    loads) and is scored by the env's reward per load
+    (:func:`train.bench.evaluate.validation_cost`: 1 for the passive beam); the run
+    returns the best-scoring policy. Its env steps are not counted in the budget (they
+    train nothing); its time is in the training wall time.
+
+    Attributes
+    ----------
+    episodes : int
+        Validation episodes per check (random loads), at least 1.
+    every : int
+        Env steps between checks, at least 1.
+    start : int
+        Env steps before the first check (0: from the start).
+    """
+
+    episodes: int
+    every: int
+    start: int = 0
+
+    def __post_init__(self):
+        check_int("select.episodes", self.episodes, 1, 10**4)
+        check_int("select.every", self.every, 1, 10**12)
+        check_int("select.start", self.start, 0, 10**12)
 
 
 def algo_class(algo: str):
@@ -124,6 +156,10 @@ class TrainConfig:
         SB3 algorithms: DAgger initialisation of the actor before reinforcement learning
         (:class:`train.distill.DistillConfig`'s fields, e.g. ``{teacher: mpc}``); None
         (default): from scratch.
+    select : dict or None
+        SB3 algorithms: checkpoint selection on validation loads (:class:`SelectConfig`'s
+        fields, e.g. ``{episodes: 32, every: 50000, start: 300000}``); None (default): the
+        final policy.
     """
 
     algo: str
@@ -141,6 +177,7 @@ class TrainConfig:
     action_headroom: float = 1.0
     shaping: float | None = None
     distill: dict | None = None
+    select: dict | None = None
 
     def __post_init__(self):
         if self.algo not in ALGOS:
@@ -209,8 +246,17 @@ class TrainConfig:
             if self.residual is not None:
                 raise ValueError("distill needs residual: null (the action's sign is the "
                                  f"voltage's), got residual {self.residual!r}")
-        if not sb3 and (self.residual or self.shaping is not None or self.distill):
-            raise ValueError("residual, shaping and distill are for the SB3 algorithms")
+        if self.select is not None:
+            if not isinstance(self.select, dict):
+                raise ValueError(f"select must be a mapping or null, got {self.select!r}")
+            _ = self.select_config  # validates the fields
+            if self.normalize.get("norm_obs", False):
+                raise ValueError("select needs norm_obs: false (the chosen parameters would "
+                                 "meet the final observation statistics)")
+        if not sb3 and (self.residual or self.shaping is not None or self.distill
+                        or self.select is not None):
+            raise ValueError("residual, shaping, distill and select are for the SB3 "
+                             "algorithms")
         if sb3:
             self._check_sb3()
 
@@ -270,6 +316,19 @@ class TrainConfig:
         if unknown:
             raise ValueError(f"distill: unknown key(s) {unknown}; expected some of {sorted(known)}")
         return DistillConfig(**self.distill)
+
+    @property
+    def select_config(self) -> SelectConfig | None:
+        """The :class:`SelectConfig` of ``select`` (None if off)."""
+        if self.select is None:
+            return None
+        known = set(SelectConfig.__dataclass_fields__)
+        unknown = sorted(set(self.select) - known)
+        missing = sorted({"episodes", "every"} - set(self.select))
+        if unknown or missing:
+            raise ValueError(f"select: unknown key(s) {unknown}, missing {missing}; expected "
+                             f"episodes, every and optionally start")
+        return SelectConfig(**self.select)
 
     @property
     def teacher(self) -> str | None:

@@ -62,6 +62,11 @@ BASE = dict(algo="ppo", timesteps=10, n_envs=2, model={"policy": "MlpPolicy"})
     ({"whiten_steps": 100, "features": "direction"}, "whiten_steps"),
     ({"distill": {"itertions": 3}}, "itertions"),
     ({"distill": {"teacher": "mpc"}, "residual": "lqr"}, "residual"),
+    ({"select": 5}, "select"), ({"select": {"episodes": 4}}, "select.*missing.*every"),
+    ({"select": {"episodes": 4, "every": 10, "strat": 1}}, "select.*strat"),
+    ({"select": {"episodes": 0, "every": 10}}, "select.episodes"),
+    ({"select": {"episodes": 4, "every": 10, "start": -1}}, "select.start"),
+    ({"select": {"episodes": 4, "every": 10}, "normalize": {"norm_obs": True}}, "norm_obs"),
 ])
 def test_bad_values_name_the_field(change, word):
     with pytest.raises(ValueError, match=word):
@@ -75,6 +80,8 @@ def test_vrs_takes_no_sb3_options():
         TrainConfig(algo="vrs", timesteps=10, env_kwargs={"reward_scale": "passive"})
     with pytest.raises(ValueError, match="action_headroom is for the SB3"):
         TrainConfig(algo="vrs", timesteps=10, action_headroom=2.0)
+    with pytest.raises(ValueError, match="select are for the SB3"):
+        TrainConfig(algo="vrs", timesteps=10, select={"episodes": 2, "every": 10})
 
 
 def test_bad_files(tmp_path):

@@ -37,6 +37,9 @@ __all__ = [
     "rollout_ise",
     "batched_ise",
     "relative_ise",
+    "VALIDATION_SEED0",
+    "validation_seeds",
+    "validation_cost",
     "ise_rel_lqr",
     "lqr_ise",
     "reference_policies",
@@ -111,6 +114,46 @@ def batched_ise(policy, env_id: str = DEFAULT_ENV_ID, episodes: dict | None = No
     return {
         case: float(part.mean()) for case, part in zip(episodes, np.split(ise, sizes), strict=True)
     }
+
+
+#: First random-load seed of the validation loads (checkpoint selection,
+#: :class:`train.config.SelectConfig`): seeds from here on, disjoint from the held-out test
+#: loads (:data:`train.compare.HELDOUT_SEEDS`, 100000-100019).
+VALIDATION_SEED0 = 200_000
+
+
+def validation_seeds(n: int) -> tuple:
+    """The first ``n`` validation seeds (random loads), from :data:`VALIDATION_SEED0`."""
+    return tuple(range(VALIDATION_SEED0, VALIDATION_SEED0 + int(n)))
+
+
+def validation_cost(policy, env_id: str = DEFAULT_ENV_ID, seeds=None) -> float:
+    r"""The deterministic ``policy``'s cost on the random loads of ``seeds``, by the env's own
+    reward per load (``reward_scale="passive"``, :mod:`acld_gym.envs.scale`):
+
+    .. math:: J = \frac{1}{N} \sum_{i=1}^{N} \frac{-1}{T_i} \sum_{t < T_i} r_{i,t},
+
+    the mean over the episodes of the step cost divided by the passive beam's on the same
+    load, so 1 for the passive beam and lower is better. No reference controller enters it;
+    all episodes run side by side in one native vector env. ``seeds``: default the first 32
+    validation seeds (:func:`validation_seeds`)."""
+    seeds = [int(s) for s in (validation_seeds(32) if seeds is None else seeds)]
+    if not seeds:
+        raise ValueError("seeds must hold at least one random-load seed, got none")
+    venv = gym.make_vec(env_id, num_envs=len(seeds), load_case="random",
+                        reward_scale="passive")
+    obs, _ = venv.reset(seed=seeds)
+    ret = np.zeros(len(seeds))
+    steps = np.zeros(len(seeds))
+    alive = np.ones(len(seeds), dtype=bool)
+    while alive.any():
+        act, _ = policy.predict(obs, deterministic=True)
+        obs, r, term, trunc, _ = venv.step(np.asarray(act, dtype=np.float64).reshape(-1, 1))
+        ret += np.where(alive, r, 0.0)
+        steps += alive
+        alive &= ~(term | trunc)
+    venv.close()
+    return float(np.mean(-ret / steps))
 
 
 def relative_ise(ise: dict, refs: dict, to: str = "lqr") -> dict:

@@ -92,6 +92,51 @@ def make_model(cfg: TrainConfig, venv, seed: int, **kwargs):
                                 **{**model_kwargs, **kwargs})
 
 
+class Selection:
+    """Checkpoint selection of :class:`train.config.SelectConfig` (``cfg.select``; inert if
+    None): :meth:`check` scores the policy on the validation loads
+    (:func:`train.bench.evaluate.validation_cost`) and keeps a copy of the SB3 policy's
+    parameters when it is the best so far; :meth:`finish` checks the final policy too,
+    loads the best parameters back into the model and returns the record (the step and
+    cost of each check, the step chosen)."""
+
+    def __init__(self, cfg: TrainConfig, env_id: str):
+        from .evaluate import validation_seeds
+
+        self.config = cfg.select_config
+        self.env_id = env_id
+        self.seeds = () if self.config is None else validation_seeds(self.config.episodes)
+        self.next = None if self.config is None else self.config.start
+        self.history: list[dict] = []
+        self.best: tuple | None = None  # (cost, steps, state_dict)
+
+    def due(self, steps: int) -> bool:
+        return self.next is not None and steps >= self.next
+
+    def check(self, steps: int, model, policy) -> None:
+        import copy
+
+        from .evaluate import validation_cost
+
+        cost = validation_cost(policy, self.env_id, self.seeds)
+        self.history.append({"steps": int(steps), "cost": cost})
+        if self.best is None or cost < self.best[0]:
+            self.best = (cost, int(steps), copy.deepcopy(model.policy.state_dict()))
+        if self.next is not None:
+            while self.next <= steps:
+                self.next += self.config.every
+
+    def finish(self, steps: int, model, policy) -> dict | None:
+        if self.config is None:
+            return None
+        if not self.history or self.history[-1]["steps"] != steps:
+            self.check(steps, model, policy)
+        cost, chosen, state = self.best
+        model.policy.load_state_dict(state)
+        return {"episodes": self.config.episodes, "history": self.history,
+                "steps": chosen, "cost": cost}
+
+
 def train_sb3(
     cfg: TrainConfig,
     seed: int,
@@ -148,22 +193,28 @@ def train_sb3(
         white.collect = None
         white.set_transform(transform)
 
+    select = Selection(cfg, env_id)
+
     class Curve(BaseCallback):
         def _on_step(self) -> bool:
             steps = offset + int(self.num_timesteps)
             if callback is not None and schedule.due(steps):
                 callback(steps, snapshot())
+            if select.due(steps):
+                select.check(steps, model, snapshot())
             return True
 
         def _on_training_start(self) -> None:
             self._on_step()
 
     model.learn(max(cfg.timesteps - offset, 1), callback=Curve())
+    steps = offset + int(model.num_timesteps)
     record = {
-        "steps": offset + int(model.num_timesteps),
+        "steps": steps,
         "whiten_steps": offset,
         "transform": None if transform is None else transform.tolist(),
         "distill": distilled,
+        "select": select.finish(steps, model, snapshot()),
     }
     if transform is not None:  # u = T' z into the actor's first layer: a plain SB3 actor on z
         fold_whitening(model, transform)

@@ -1,0 +1,95 @@
+"""Checkpoint selection on validation loads (``TrainConfig.select``): the validation cost is
+the env's reward per load (1 for the passive beam), its loads are not the test loads, and
+a run returns the parameters of its best check, not its last."""
+
+import numpy as np
+import pytest
+import torch
+import yaml
+
+from baselines.policies import LQRPolicy, PassivePolicy
+from train.bench import evaluate
+from train.bench.sb3_train import Selection
+from train.compare import HELDOUT_SEEDS
+from train.config import TrainConfig
+
+
+@pytest.fixture(scope="module")
+def design_env():
+    import gymnasium as gym
+
+    return gym.make("ACLDBeam-v1").unwrapped
+
+
+def test_validation_loads_are_not_the_test_loads():
+    seeds = evaluate.validation_seeds(64)
+    assert len(set(seeds)) == 64 and not set(seeds) & set(HELDOUT_SEEDS)
+    assert evaluate.validation_seeds(3) == seeds[:3]  # more episodes only add loads
+
+
+def test_validation_cost_is_one_for_the_passive_beam(design_env):
+    """The reward per load divides by the passive beam's cost on the same load, so the
+    passive beam scores 1 on every set of loads (up to round-off); LQR damps, below 1."""
+    seeds = evaluate.validation_seeds(8)
+    assert evaluate.validation_cost(PassivePolicy.for_env(design_env), seeds=seeds) == \
+        pytest.approx(1.0, rel=1e-12)
+    lqr = evaluate.validation_cost(LQRPolicy.for_env(design_env), seeds=seeds)
+    assert 0.2 < lqr < 0.9
+
+
+def _cfg(**select):
+    return TrainConfig(algo="sac", timesteps=10, model={"policy": "MlpPolicy"},
+                       features=None, normalize={}, select=select or None)
+
+
+class _Model:
+    def __init__(self):
+        self.policy = torch.nn.Linear(2, 1)
+
+
+def test_selection_keeps_the_best_check_and_restores_it(monkeypatch):
+    costs = iter([0.9, 0.5, 0.7, 0.6])  # the best is the second check
+    monkeypatch.setattr(evaluate, "validation_cost", lambda *a, **k: next(costs))
+    sel = Selection(_cfg(episodes=3, every=100, start=50), "ACLDBeam-v1")
+    model = _Model()
+    assert not sel.due(49) and sel.due(50)
+    saved = {}
+    for steps in (50, 150, 260):
+        with torch.no_grad():
+            model.policy.weight.fill_(steps)
+        saved[steps] = model.policy.weight.clone()
+        sel.check(steps, model, None)
+    assert not sel.due(349) and sel.due(350)  # every 100 from 50, past the last check
+    with torch.no_grad():
+        model.policy.weight.fill_(-1.0)
+    rec = sel.finish(400, model, None)  # the final policy is checked too (0.6)
+    assert [h["steps"] for h in rec["history"]] == [50, 150, 260, 400]
+    assert rec["steps"] == 150 and rec["cost"] == 0.5 and rec["episodes"] == 3
+    assert torch.equal(model.policy.weight, saved[150])
+
+
+def test_selection_off_is_inert():
+    sel = Selection(_cfg(), "ACLDBeam-v1")
+    model = _Model()
+    before = model.policy.weight.clone()
+    assert not sel.due(10**9) and sel.finish(10, model, None) is None
+    assert torch.equal(model.policy.weight, before)
+
+
+def test_a_run_returns_its_best_checkpoint(tmp_path):
+    """A tiny SAC run of the recipe with selection: the returned (whitening-folded) policy
+    scores the chosen check's validation cost again."""
+    from train.bench.sb3_train import train_sb3
+
+    data = yaml.safe_load(open("train/benchmark/sac.yaml"))
+    data.update(timesteps=800, n_envs=4, eval_points=1, whiten_steps=128,
+                select={"episodes": 2, "every": 200, "start": 0})
+    data["model"] = {**data["model"], "learning_starts": 200, "buffer_size": 2000,
+                     "batch_size": 64}
+    policy, record = train_sb3(TrainConfig.from_dict(data), 0, "ACLDBeam-v1")
+    sel = record["select"]
+    costs = [h["cost"] for h in sel["history"]]
+    assert len(costs) >= 3 and sel["cost"] == min(costs)
+    assert sel["steps"] == sel["history"][int(np.argmin(costs))]["steps"]
+    again = evaluate.validation_cost(policy, "ACLDBeam-v1", evaluate.validation_seeds(2))
+    assert again == pytest.approx(sel["cost"], rel=1e-5)

@@ -49,7 +49,7 @@ class _Model:
 
 def test_selection_keeps_the_best_check_and_restores_it(monkeypatch):
     costs = iter([0.9, 0.5, 0.7, 0.6])  # the best is the second check
-    monkeypatch.setattr(evaluate, "validation_cost", lambda *a, **k: next(costs))
+    monkeypatch.setattr(evaluate, "validation_rollout", lambda *a, **k: (next(costs), 7))
     sel = Selection(_cfg(episodes=3, every=100, start=50), "ACLDBeam-v1")
     model = _Model()
     assert not sel.due(49) and sel.due(50)
@@ -65,6 +65,7 @@ def test_selection_keeps_the_best_check_and_restores_it(monkeypatch):
     rec = sel.finish(400, model, None)  # the final policy is checked too (0.6)
     assert [h["steps"] for h in rec["history"]] == [50, 150, 260, 400]
     assert rec["steps"] == 150 and rec["cost"] == 0.5 and rec["episodes"] == 3
+    assert rec["validation_env_steps"] == 4 * 7
     assert torch.equal(model.policy.weight, saved[150])
 
 
@@ -93,3 +94,4 @@ def test_a_run_returns_its_best_checkpoint(tmp_path):
     assert sel["steps"] == sel["history"][int(np.argmin(costs))]["steps"]
     again = evaluate.validation_cost(policy, "ACLDBeam-v1", evaluate.validation_seeds(2))
     assert again == pytest.approx(sel["cost"], rel=1e-5)
+    assert sel["validation_env_steps"] == len(costs) * 2 * 1000  # 2 episodes of 1000 steps

@@ -40,6 +40,7 @@ __all__ = [
     "VALIDATION_SEED0",
     "validation_seeds",
     "validation_cost",
+    "validation_rollout",
     "ise_rel_lqr",
     "lqr_ise",
     "reference_policies",
@@ -136,7 +137,13 @@ def validation_cost(policy, env_id: str = DEFAULT_ENV_ID, seeds=None) -> float:
     the mean over the episodes of the step cost divided by the passive beam's on the same
     load, so 1 for the passive beam and lower is better. No reference controller enters it;
     all episodes run side by side in one native vector env. ``seeds``: default the first 32
-    validation seeds (:func:`validation_seeds`)."""
+    validation seeds (:func:`validation_seeds`). :func:`validation_rollout` also gives the
+    env steps it took."""
+    return validation_rollout(policy, env_id, seeds)[0]
+
+
+def validation_rollout(policy, env_id: str = DEFAULT_ENV_ID, seeds=None) -> tuple[float, int]:
+    """``(cost, env_steps)``: :func:`validation_cost` and the env steps of its episodes."""
     seeds = [int(s) for s in (validation_seeds(32) if seeds is None else seeds)]
     if not seeds:
         raise ValueError("seeds must hold at least one random-load seed, got none")
@@ -153,7 +160,7 @@ def validation_cost(policy, env_id: str = DEFAULT_ENV_ID, seeds=None) -> float:
         steps += alive
         alive &= ~(term | trunc)
     venv.close()
-    return float(np.mean(-ret / steps))
+    return float(np.mean(-ret / steps)), int(steps.sum())
 
 
 def relative_ise(ise: dict, refs: dict, to: str = "lqr") -> dict:

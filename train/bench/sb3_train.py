@@ -98,7 +98,7 @@ class Selection:
     (:func:`train.bench.evaluate.validation_cost`) and keeps a copy of the SB3 policy's
     parameters when it is the best so far; :meth:`finish` checks the final policy too,
     loads the best parameters back into the model and returns the record (the step and
-    cost of each check, the step chosen)."""
+    cost of each check, the step chosen, the env steps of all validation episodes)."""
 
     def __init__(self, cfg: TrainConfig, env_id: str):
         from .evaluate import validation_seeds
@@ -108,6 +108,7 @@ class Selection:
         self.seeds = () if self.config is None else validation_seeds(self.config.episodes)
         self.next = None if self.config is None else self.config.start
         self.history: list[dict] = []
+        self.env_steps = 0  # of the validation episodes (not training: not in the budget)
         self.best: tuple | None = None  # (cost, steps, state_dict)
 
     def due(self, steps: int) -> bool:
@@ -116,9 +117,10 @@ class Selection:
     def check(self, steps: int, model, policy) -> None:
         import copy
 
-        from .evaluate import validation_cost
+        from . import evaluate
 
-        cost = validation_cost(policy, self.env_id, self.seeds)
+        cost, env_steps = evaluate.validation_rollout(policy, self.env_id, self.seeds)
+        self.env_steps += env_steps
         self.history.append({"steps": int(steps), "cost": cost})
         if self.best is None or cost < self.best[0]:
             self.best = (cost, int(steps), copy.deepcopy(model.policy.state_dict()))
@@ -134,7 +136,7 @@ class Selection:
         cost, chosen, state = self.best
         model.policy.load_state_dict(state)
         return {"episodes": self.config.episodes, "history": self.history,
-                "steps": chosen, "cost": cost}
+                "steps": chosen, "cost": cost, "validation_env_steps": self.env_steps}
 
 
 def train_sb3(

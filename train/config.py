@@ -59,7 +59,9 @@ class SelectConfig:
     loads) and is scored by the env's reward per load
     (:func:`train.bench.evaluate.validation_cost`: 1 for the passive beam); the run
     returns the best-scoring policy. Its env steps are not counted in the budget (they
-    train nothing); its time is in the training wall time.
+    train nothing; the run records them); its time is in the training wall time. The
+    learning curve follows the policy being trained, the final evaluation is the returned
+    one's.
 
     Attributes
     ----------

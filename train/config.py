@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import importlib
 import inspect
-from dataclasses import dataclass, field, replace
+from dataclasses import MISSING, dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
@@ -81,6 +81,19 @@ class SelectConfig:
         check_int("select.episodes", self.episodes, 1, 10**4)
         check_int("select.every", self.every, 1, 10**12)
         check_int("select.start", self.start, 0, 10**12)
+
+
+def _section(cls, data: dict, name: str):
+    """The dataclass ``cls`` of a config's mapping ``name`` (``distill``, ``select``);
+    ``ValueError`` naming ``name`` and its unknown or missing keys."""
+    known = {f.name for f in fields(cls)}
+    required = {f.name for f in fields(cls)
+                if f.default is MISSING and f.default_factory is MISSING}
+    unknown, missing = sorted(set(data) - known), sorted(required - set(data))
+    if unknown or missing:
+        raise ValueError(f"{name}: unknown key(s) {unknown}, missing {missing}; expected "
+                         f"some of {sorted(known)}")
+    return cls(**data)
 
 
 def algo_class(algo: str):
@@ -313,24 +326,14 @@ class TrainConfig:
 
         if self.distill is None:
             return None
-        known = set(DistillConfig.__dataclass_fields__)
-        unknown = sorted(set(self.distill) - known)
-        if unknown:
-            raise ValueError(f"distill: unknown key(s) {unknown}; expected some of {sorted(known)}")
-        return DistillConfig(**self.distill)
+        return _section(DistillConfig, self.distill, "distill")
 
     @property
     def select_config(self) -> SelectConfig | None:
         """The :class:`SelectConfig` of ``select`` (None if off)."""
         if self.select is None:
             return None
-        known = set(SelectConfig.__dataclass_fields__)
-        unknown = sorted(set(self.select) - known)
-        missing = sorted({"episodes", "every"} - set(self.select))
-        if unknown or missing:
-            raise ValueError(f"select: unknown key(s) {unknown}, missing {missing}; expected "
-                             f"episodes, every and optionally start")
-        return SelectConfig(**self.select)
+        return _section(SelectConfig, self.select, "select")
 
     @property
     def teacher(self) -> str | None:

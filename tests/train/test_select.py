@@ -58,11 +58,11 @@ def test_selection_keeps_the_best_check_and_restores_it(monkeypatch):
         with torch.no_grad():
             model.policy.weight.fill_(steps)
         saved[steps] = model.policy.weight.clone()
-        sel.check(steps, model, None)
+        sel.check(steps, model, lambda: None)
     assert not sel.due(349) and sel.due(350)  # every 100 from 50, past the last check
     with torch.no_grad():
         model.policy.weight.fill_(-1.0)
-    rec = sel.finish(400, model, None)  # the final policy is checked too (0.6)
+    rec = sel.finish(400, model, lambda: None)  # the final policy is checked too (0.6)
     assert [h["steps"] for h in rec["history"]] == [50, 150, 260, 400]
     assert rec["steps"] == 150 and rec["cost"] == 0.5 and rec["episodes"] == 3
     assert rec["validation_env_steps"] == 4 * 7
@@ -73,7 +73,7 @@ def test_selection_off_is_inert():
     sel = Selection(_cfg(), "ACLDBeam-v1")
     model = _Model()
     before = model.policy.weight.clone()
-    assert not sel.due(10**9) and sel.finish(10, model, None) is None
+    assert not sel.due(10**9) and sel.finish(10, model, lambda: None) is None
     assert torch.equal(model.policy.weight, before)
 
 

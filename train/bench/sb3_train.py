@@ -94,8 +94,8 @@ def make_model(cfg: TrainConfig, venv, seed: int, **kwargs):
 
 class Selection:
     """Checkpoint selection of :class:`train.config.SelectConfig` (``cfg.select``; inert if
-    None): :meth:`check` scores the policy on the validation loads
-    (:func:`train.bench.evaluate.validation_cost`) and keeps a copy of the SB3 policy's
+    None): :meth:`check` scores the policy made by ``snapshot()`` on the validation loads
+    (:func:`train.bench.evaluate.validation_rollout`) and keeps a copy of the SB3 policy's
     parameters when it is the best so far; :meth:`finish` checks the final policy too,
     loads the best parameters back into the model and returns the record (the step and
     cost of each check, the step chosen, the env steps of all validation episodes)."""
@@ -114,25 +114,24 @@ class Selection:
     def due(self, steps: int) -> bool:
         return self.next is not None and steps >= self.next
 
-    def check(self, steps: int, model, policy) -> None:
+    def check(self, steps: int, model, snapshot) -> None:
         import copy
 
         from . import evaluate
 
-        cost, env_steps = evaluate.validation_rollout(policy, self.env_id, self.seeds)
+        cost, env_steps = evaluate.validation_rollout(snapshot(), self.env_id, self.seeds)
         self.env_steps += env_steps
         self.history.append({"steps": int(steps), "cost": cost})
         if self.best is None or cost < self.best[0]:
             self.best = (cost, int(steps), copy.deepcopy(model.policy.state_dict()))
-        if self.next is not None:
-            while self.next <= steps:
-                self.next += self.config.every
+        while self.next <= steps:
+            self.next += self.config.every
 
-    def finish(self, steps: int, model, policy) -> dict | None:
+    def finish(self, steps: int, model, snapshot) -> dict | None:
         if self.config is None:
             return None
         if not self.history or self.history[-1]["steps"] != steps:
-            self.check(steps, model, policy)
+            self.check(steps, model, snapshot)
         cost, chosen, state = self.best
         model.policy.load_state_dict(state)
         return {"episodes": self.config.episodes, "history": self.history,
@@ -203,7 +202,7 @@ def train_sb3(
             if callback is not None and schedule.due(steps):
                 callback(steps, snapshot())
             if select.due(steps):
-                select.check(steps, model, snapshot())
+                select.check(steps, model, snapshot)
             return True
 
         def _on_training_start(self) -> None:
@@ -216,7 +215,7 @@ def train_sb3(
         "whiten_steps": offset,
         "transform": None if transform is None else transform.tolist(),
         "distill": distilled,
-        "select": select.finish(steps, model, snapshot()),
+        "select": select.finish(steps, model, snapshot),
     }
     if transform is not None:  # u = T' z into the actor's first layer: a plain SB3 actor on z
         fold_whitening(model, transform)

@@ -97,7 +97,9 @@ def main(argv=None) -> int:
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--total-timesteps", type=int, default=1_000_000)
     p.add_argument("--json", type=Path, default=None, help="write the figures here")
-    args = p.parse_args(argv)
+    argv = list(sys.argv[1:] if argv is None else argv)
+    cut = argv.index("--") if "--" in argv else len(argv)
+    args, flags = p.parse_args(argv[:cut]), argv[cut + 1:]  # after --: the file's own flags
     from train.bench.evaluate import ise_rel_lqr
 
     with tempfile.TemporaryDirectory() as tmp:
@@ -108,7 +110,7 @@ def main(argv=None) -> int:
         t0 = time.perf_counter()
         subprocess.run([sys.executable, str(script), "--env-id", "ACLDBeam-v1",
                         "--total-timesteps", str(args.total_timesteps), "--seed",
-                        str(args.seed), "--no-cuda"], cwd=tmp, check=True,
+                        str(args.seed), "--no-cuda", *flags], cwd=tmp, check=True,
                        stdout=subprocess.DEVNULL)
         wall = time.perf_counter() - t0
         import pickle
@@ -118,7 +120,8 @@ def main(argv=None) -> int:
 
         actor = _Actor(pickle.loads(saved.read_bytes()), ObserveModes(ACLDBeamEnv()).slots)
     rel = ise_rel_lqr(actor, "ACLDBeam-v1")
-    out = {"seed": args.seed, "total_timesteps": args.total_timesteps, "wall_seconds": wall,
+    out = {"seed": args.seed, "total_timesteps": args.total_timesteps, "flags": flags,
+           "wall_seconds": wall,
            "ise_rel_lqr": {str(k): float(v) for k, v in rel.items()}}
     print(json.dumps(out, indent=1))
     if args.json is not None:

@@ -94,27 +94,39 @@ def batched_ise(policy, env_id: str = DEFAULT_ENV_ID, episodes: dict | None = No
         venv = gym.make_vec(env_id, num_envs=len(seeds), load_case=case)
         obs.append(venv.reset(seed=[int(s) for s in seeds])[0])
         venvs.append(venv)
-    sizes = np.cumsum([len(s) for s in episodes.values()])[:-1]
     dt = venvs[0].unwrapped.dt
-    n = sum(len(s) for s in episodes.values())
-    ise = np.zeros(n)
+    ise, _ = _side_by_side(policy, venvs, obs, lambda r, info: info["tip_deflection"] ** 2 * dt)
+    sizes = np.cumsum([len(s) for s in episodes.values()])[:-1]
+    return {
+        case: float(part.mean()) for case, part in zip(episodes, np.split(ise, sizes), strict=True)
+    }
+
+
+def _side_by_side(policy, venvs: list, obs: list, value) -> tuple[np.ndarray, np.ndarray]:
+    """Run one episode in every sub-env of ``venvs`` (already reset, first observations
+    ``obs``), side by side: the deterministic ``policy.predict`` once per step on all of
+    them, each sub-env counted until it ends. Returns the sum over each sub-env's steps of
+    ``value(reward, info)`` and its step count (arrays in the order of ``venvs``); closes
+    the vector envs."""
+    sizes = np.cumsum([venv.num_envs for venv in venvs])[:-1]
+    n = sum(venv.num_envs for venv in venvs)
+    total, steps = np.zeros(n), np.zeros(n)
     alive = np.ones(n, dtype=bool)
     while alive.any():
         act, _ = policy.predict(np.concatenate(obs), deterministic=True)
         act = np.asarray(act, dtype=np.float64).reshape(-1, 1)
-        obs, y, done = [], [], []
+        obs, got, done = [], [], []
         for venv, a in zip(venvs, np.split(act, sizes), strict=True):
-            o, _, term, trunc, info = venv.step(a)
+            o, r, term, trunc, info = venv.step(a)
             obs.append(o)
-            y.append(info["tip_deflection"])
+            got.append(value(r, info))
             done.append(term | trunc)
-        ise += np.where(alive, np.concatenate(y) ** 2 * dt, 0.0)
+        total += np.where(alive, np.concatenate(got), 0.0)
+        steps += alive
         alive &= ~np.concatenate(done)
     for venv in venvs:
         venv.close()
-    return {
-        case: float(part.mean()) for case, part in zip(episodes, np.split(ise, sizes), strict=True)
-    }
+    return total, steps
 
 
 #: First random-load seed of the validation loads (checkpoint selection,
@@ -150,16 +162,7 @@ def validation_rollout(policy, env_id: str = DEFAULT_ENV_ID, seeds=None) -> tupl
     venv = gym.make_vec(env_id, num_envs=len(seeds), load_case="random",
                         reward_scale="passive")
     obs, _ = venv.reset(seed=seeds)
-    ret = np.zeros(len(seeds))
-    steps = np.zeros(len(seeds))
-    alive = np.ones(len(seeds), dtype=bool)
-    while alive.any():
-        act, _ = policy.predict(obs, deterministic=True)
-        obs, r, term, trunc, _ = venv.step(np.asarray(act, dtype=np.float64).reshape(-1, 1))
-        ret += np.where(alive, r, 0.0)
-        steps += alive
-        alive &= ~(term | trunc)
-    venv.close()
+    ret, steps = _side_by_side(policy, [venv], [obs], lambda r, info: r)
     return float(np.mean(-ret / steps)), int(steps.sum())
 
 

@@ -36,7 +36,7 @@ __all__ = ["UnitAction", "ObserveModes", "WhitenObservation", "whitening", "chec
            "MAX_HEADROOM"]
 
 
-class UnitAction(gym.ActionWrapper):
+class UnitAction(gym.ActionWrapper, gym.utils.RecordConstructorArgs):
     r"""Actions ``a`` in [-1, 1] for an env whose action is a voltage in [-v_max, v_max]:
     ``V = k v_max a`` with the ``headroom`` k (default 1), computed in float64, so the
     round trip :meth:`reverse_action` of :meth:`action` is exact for every float32 action
@@ -56,7 +56,8 @@ class UnitAction(gym.ActionWrapper):
     """
 
     def __init__(self, env: gym.Env, headroom: float = 1.0):
-        super().__init__(env)
+        gym.utils.RecordConstructorArgs.__init__(self, headroom=headroom)
+        gym.ActionWrapper.__init__(self, env)
         box = env.action_space
         if not (isinstance(box, spaces.Box) and box.shape == (1,)
                 and np.all(box.low == -box.high) and np.all(box.high > 0)):
@@ -91,7 +92,7 @@ def check_headroom(headroom, name: str = "headroom") -> float:
                          f"range over the actuator's), got {headroom!r}") from None
 
 
-class ObserveModes(gym.ObservationWrapper):
+class ObserveModes(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
     r"""The ``"estimate"`` observation (``obs_mode="estimate"``, the default) restricted to
     the first ``modes`` modes of the design model and the tip: the slots of
     :func:`acld_gym.envs.step.estimate_slots`, then any appended entries (``log c`` of
@@ -109,7 +110,8 @@ class ObserveModes(gym.ObservationWrapper):
     """
 
     def __init__(self, env: gym.Env, modes: int = 2):
-        super().__init__(env)
+        gym.utils.RecordConstructorArgs.__init__(self, modes=modes)
+        gym.ObservationWrapper.__init__(self, env)
         config = getattr(env.unwrapped, "config", None)
         if config is None or config.obs_mode != "estimate":
             raise ValueError("env: ObserveModes needs an ACLDBeam env with obs_mode="
@@ -128,14 +130,16 @@ class ObserveModes(gym.ObservationWrapper):
         return np.asarray(observation, dtype=np.float32)[..., self.slots]
 
 
-class WhitenObservation(gym.ObservationWrapper):
+class WhitenObservation(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
     r"""The observation ``z`` as ``[T^T z_{:d}, z_{d:}]``: a fixed matrix T (d x d) on its
     first d entries, the last ``passthrough`` (e.g. the appended log reward scale) as they
     are. T is given (e.g. :func:`whitening`), not learned while the wrapper runs, so the
     wrapped env stays a fixed MDP."""
 
     def __init__(self, env: gym.Env, transform, passthrough: int = 0):
-        super().__init__(env)
+        gym.utils.RecordConstructorArgs.__init__(self, transform=transform,
+                                                 passthrough=passthrough)
+        gym.ObservationWrapper.__init__(self, env)
         n = env.observation_space.shape[0]
         if isinstance(passthrough, bool) or not isinstance(passthrough, (int, np.integer)) \
                 or not 0 <= passthrough < n:

@@ -124,3 +124,25 @@ def test_whitening_makes_the_second_moment_isotropic():
     assert np.allclose(m, np.eye(6), atol=1e-9)
     with pytest.raises(ValueError, match="directions must be a finite"):
         whitening(np.array([np.nan, 1.0])[None])
+
+
+def test_wrapped_made_envs_keep_a_recreatable_spec():
+    """Like Gymnasium's own wrappers, each records its arguments in ``env.spec``, so
+    ``gym.make(env.spec)`` rebuilds the same wrapped env (and ``check_env`` runs on a made
+    env): the same observations for the same seed and actions."""
+    T = np.diag(np.arange(1.0, 6.0))
+    made = WhitenObservation(ObserveModes(UnitAction(
+        gym.make("ACLDBeam-v1", load_case=2, episode_length=0.05), headroom=2.0), modes=2), T)
+    names = [(w.name, w.kwargs) for w in made.spec.additional_wrappers]
+    assert [n for n, _ in names] == ["UnitAction", "ObserveModes", "WhitenObservation"]
+    assert names[0][1] == {"headroom": 2.0} and names[1][1] == {"modes": 2}
+    again = gym.make(made.spec)
+    u, _ = made.reset(seed=3)
+    v, _ = again.reset(seed=3)
+    assert np.array_equal(u, v)
+    for a in (0.3, -1.0):
+        u, *_ = made.step(np.array([a], np.float32))
+        v, *_ = again.step(np.array([a], np.float32))
+        assert np.array_equal(u, v)
+    check_env(ObserveModes(UnitAction(gym.make("ACLDBeam-v1", episode_length=0.05)), modes=1),
+              skip_render_check=True)

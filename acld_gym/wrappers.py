@@ -104,9 +104,11 @@ class ObserveModes(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
     Nyquist frequency; the Kalman filter sees mode 4 at about a tenth) are small and
     dominated by the sensor noise and by the policy's own voltage, so normalizing each entry
     (``NormalizeObservation``, ``VecNormalize``) magnifies them, and a policy that feeds
-    back on them chatters. What a policy loses by not seeing them was not measured; the
-    wrapper is a training aid, off unless applied. Evaluate a policy trained through this
-    wrapper through it too (or apply the same slots).
+    back on them chatters. Mode 2 (155 Hz, 6.5 samples a period) can be too much as well:
+    CleanRL's single-file PPO with ``modes=2`` ended at 1.15-2.63x LQR's ISE on case 1 over
+    five seeds, and at 0.92-1.17x with ``modes=1`` (docs/training.md). What a policy loses by not seeing the higher modes was not measured;
+    the wrapper is a training aid, off unless applied. Evaluate a policy trained through
+    this wrapper through it too (or apply the same slots).
     """
 
     def __init__(self, env: gym.Env, modes: int = 2):

@@ -106,9 +106,10 @@ class ObserveModes(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
     (``NormalizeObservation``, ``VecNormalize``) magnifies them, and a policy that feeds
     back on them chatters. Mode 2 (155 Hz, 6.5 samples a period) can be too much as well:
     CleanRL's single-file PPO with ``modes=2`` ended at 1.15-2.63x LQR's ISE on case 1 over
-    five seeds, and at 0.92-1.17x with ``modes=1`` (docs/training.md). What a policy loses by not seeing the higher modes was not measured;
-    the wrapper is a training aid, off unless applied. Evaluate a policy trained through
-    this wrapper through it too (or apply the same slots).
+    five seeds, and at 0.92-1.17x with ``modes=1`` (docs/training.md). What a policy
+    loses by not seeing the higher modes was not measured; the wrapper is a training aid,
+    off unless applied. Evaluate a policy trained through this wrapper through it too (or
+    apply the same slots).
     """
 
     def __init__(self, env: gym.Env, modes: int = 2):

@@ -96,18 +96,15 @@ def batched_ise(policy, env_id: str = DEFAULT_ENV_ID, episodes: dict | None = No
         venvs.append(venv)
     dt = venvs[0].unwrapped.dt
     ise, _ = _side_by_side(policy, venvs, obs, lambda r, info: info["tip_deflection"] ** 2 * dt)
-    sizes = np.cumsum([len(s) for s in episodes.values()])[:-1]
-    return {
-        case: float(part.mean()) for case, part in zip(episodes, np.split(ise, sizes), strict=True)
-    }
+    return {case: float(part.mean()) for case, part in zip(episodes, ise, strict=True)}
 
 
-def _side_by_side(policy, venvs: list, obs: list, value) -> tuple[np.ndarray, np.ndarray]:
+def _side_by_side(policy, venvs: list, obs: list, value) -> tuple[list, list]:
     """Run one episode in every sub-env of ``venvs`` (already reset, first observations
     ``obs``), side by side: the deterministic ``policy.predict`` once per step on all of
-    them, each sub-env counted until it ends. Returns the sum over each sub-env's steps of
-    ``value(reward, info)`` and its step count (arrays in the order of ``venvs``); closes
-    the vector envs."""
+    them, each sub-env counted until it ends. Returns, one array per vector env, the sum over
+    each sub-env's steps of ``value(reward, info)`` and its step count; closes the vector
+    envs."""
     sizes = np.cumsum([venv.num_envs for venv in venvs])[:-1]
     n = sum(venv.num_envs for venv in venvs)
     total, steps = np.zeros(n), np.zeros(n)
@@ -126,7 +123,7 @@ def _side_by_side(policy, venvs: list, obs: list, value) -> tuple[np.ndarray, np
         alive &= ~np.concatenate(done)
     for venv in venvs:
         venv.close()
-    return total, steps
+    return np.split(total, sizes), np.split(steps, sizes)
 
 
 #: First random-load seed of the validation loads (checkpoint selection,
@@ -162,7 +159,7 @@ def validation_rollout(policy, env_id: str = DEFAULT_ENV_ID, seeds=None) -> tupl
     venv = gym.make_vec(env_id, num_envs=len(seeds), load_case="random",
                         reward_scale="passive")
     obs, _ = venv.reset(seed=seeds)
-    ret, steps = _side_by_side(policy, [venv], [obs], lambda r, info: r)
+    (ret,), (steps,) = _side_by_side(policy, [venv], [obs], lambda r, info: r)
     return float(np.mean(-ret / steps)), int(steps.sum())
 
 

@@ -39,9 +39,10 @@ class _linear_schedule:  # noqa: N801  (an SB3 schedule: progress remaining 1 ->
 def _resolve_policy_kwargs(kwargs: dict) -> dict:
     """YAML-friendly keyword arguments: ``policy_kwargs.activation_fn`` given by name
     (``"tanh"``); ``policy: SplitCriticPolicy`` names :class:`SplitCriticPolicy`;
-    ``learning_rate`` / ``clip_range`` as ``{linear: [start, end]}``, a schedule linear in
-    the progress from ``start`` to ``end``."""
-    for key in ("learning_rate", "clip_range"):
+    ``learning_rate`` / ``clip_range`` / ``ent_coef`` as ``{linear: [start, end]}``, a
+    schedule linear in the progress from ``start`` to ``end`` (``ent_coef``'s is applied by
+    :func:`train_sb3`, once per rollout: :func:`ent_coef_schedule`)."""
+    for key in ("learning_rate", "clip_range", "ent_coef"):
         value = kwargs.get(key)
         if isinstance(value, dict):
             if set(value) != {"linear"} or len(value["linear"]) != 2:
@@ -61,6 +62,17 @@ def _resolve_policy_kwargs(kwargs: dict) -> dict:
     return kwargs
 
 
+def ent_coef_schedule(model_kwargs: dict) -> tuple[dict, _linear_schedule | None]:
+    """Split a scheduled ``ent_coef`` off resolved keyword arguments: the arguments with
+    ``ent_coef`` at its start value, and the schedule (None if ``ent_coef`` is a number).
+    Only an on-policy algorithm reads its ``ent_coef`` anew at every update (SB3's PPO:
+    ``loss = ... + ent_coef * entropy_loss``), so a schedule is for PPO only."""
+    sched = model_kwargs.get("ent_coef")
+    if not isinstance(sched, _linear_schedule):
+        return model_kwargs, None
+    return {**model_kwargs, "ent_coef": sched(1.0)}, sched
+
+
 def fold_whitening(model, transform: np.ndarray) -> None:
     """Fold the whitening ``u = T^T z`` into the actor's first layer (``W u = (W T^T) z``),
     so that the trained actor takes the raw observation (and exports as a plain SB3
@@ -76,7 +88,10 @@ def make_model(cfg: TrainConfig, venv, seed: int, **kwargs):
     """The (untrained) SB3 model of ``cfg`` on ``venv``: the config's keyword arguments
     (schedules and policy names resolved, :func:`_resolve_policy_kwargs`), CPU, seeded;
     ``kwargs`` add to them."""
-    model_kwargs = _resolve_policy_kwargs(dict(cfg.model))
+    model_kwargs, ent_sched = ent_coef_schedule(_resolve_policy_kwargs(dict(cfg.model)))
+    if ent_sched is not None and cfg.algo != "ppo":
+        raise ValueError(f"model.ent_coef: a schedule {{linear: [start, end]}} is for ppo "
+                         f"only, got one for {cfg.algo}")
     policy = model_kwargs.pop("policy")
     if policy is AsymmetricSACPolicy:  # its critic takes the applied action (the env's map)
         pk = dict(model_kwargs.get("policy_kwargs") or {})
@@ -153,6 +168,7 @@ def train_sb3(
     torch.set_num_threads(1)
     venv = make_vec_env(cfg, seed, env_id)
     model = make_model(cfg, venv, seed)
+    _, ent_sched = ent_coef_schedule(_resolve_policy_kwargs(dict(cfg.model)))
     vmap = VoltageMap(cfg.residual, cfg.mesh, cfg.action_headroom)
     distilled = None
     if cfg.distill is not None:
@@ -208,7 +224,12 @@ def train_sb3(
         def _on_training_start(self) -> None:
             self._on_step()
 
-    model.learn(max(cfg.timesteps - offset, 1), callback=Curve())
+        def _on_rollout_end(self) -> None:  # before the update of this rollout
+            if ent_sched is not None:  # the last rollout may overshoot the budget
+                model.ent_coef = ent_sched(max(1.0 - self.num_timesteps / budget, 0.0))
+
+    budget = max(cfg.timesteps - offset, 1)
+    model.learn(budget, callback=Curve())
     steps = offset + int(model.num_timesteps)
     record = {
         "steps": steps,

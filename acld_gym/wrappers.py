@@ -121,12 +121,19 @@ class ObserveModes(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
                              "'estimate'")
         if isinstance(modes, bool) or not isinstance(modes, (int, np.integer)):
             raise ValueError(f"modes must be an integer, got {modes!r}")
-        n = env.observation_space.shape[0]
-        extra = int(bool(config.observe_reward_scale))
-        from acld_gym.envs.step import estimate_slots
+        from acld_gym.envs.step import estimate_slots, observation_size
 
+        # the layout's owner (acld_gym.envs.step) says where the modes are and how many
+        nom = env.unwrapped.nom
+        base = observation_size(nom, config.obs_mode)
+        n = base + int(bool(config.observe_reward_scale))
+        if env.observation_space.shape != (n,):
+            raise ValueError(f"env: ObserveModes needs the ACLDBeam env's own observation of "
+                             f"{n} entries, got shape {env.observation_space.shape} (wrap it "
+                             f"before any wrapper that changes the observation)")
         self.modes = int(modes)
-        self.slots = np.r_[estimate_slots(n - 1 - extra, self.modes), np.arange(n - extra, n)]
+        self.slots = np.r_[estimate_slots(nom.design.reduced.order, self.modes),
+                           np.arange(base, n)]
         self.observation_space = spaces.Box(-np.inf, np.inf, (len(self.slots),), np.float32)
 
     def observation(self, observation):

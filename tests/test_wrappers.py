@@ -92,6 +92,15 @@ def test_observe_modes_rejects_bad_input(kwargs, modes, match):
         ObserveModes(ACLDBeamEnv(load_case=1, **kwargs), modes)
 
 
+def test_observe_modes_rejects_an_observation_already_changed():
+    """The slots come from the env's layout, so an observation an inner wrapper reshaped
+    is refused by name, not sliced blindly."""
+    inner = ObserveModes(ACLDBeamEnv(load_case=1), 3)
+    with pytest.raises(ValueError, match=r"env: ObserveModes needs the ACLDBeam env's own "
+                                         r"observation of 9 entries, got shape \(7,\)"):
+        ObserveModes(inner, 2)
+
+
 def test_estimate_slots_is_the_layout():
     assert estimate_slots(8, 2).tolist() == [0, 1, 2, 3, 8]
     assert estimate_slots(6, 3).tolist() == [0, 1, 2, 3, 4, 5, 6]

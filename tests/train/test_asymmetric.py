@@ -72,3 +72,32 @@ def test_env_kwargs_are_validated_by_the_env_config():
         TrainConfig.from_dict({**base, "env_kwargs": {"observe_reward_scale": True}})
     with pytest.raises(ValueError, match="env_kwargs: unexpected keyword"):
         TrainConfig.from_dict({**base, "env_kwargs": {"reward_scael": "passive"}})
+
+
+def _sac_config(**policy_kwargs):
+    from train.config import TrainConfig
+
+    data = yaml.safe_load(open("train/benchmark/sac.yaml"))
+    data.update(n_envs=2)
+    model = data["model"]
+    data["model"] = {**model, "buffer_size": 1000, "policy_kwargs": {**model["policy_kwargs"],
+                                                                     **policy_kwargs}}
+    return TrainConfig(**data)
+
+
+def test_make_model_gives_the_sac_critic_the_configs_action_headroom():
+    """The SAC critic reads the applied action, so it gets the env's action map: the
+    config's ``action_headroom`` (3 in the recipe), once; a second, different value is
+    refused by name."""
+    from train.bench.sb3_train import make_model, make_vec_env
+
+    cfg = _sac_config()
+    venv = make_vec_env(cfg, 0, "ACLDBeam-v1")
+    try:
+        model = make_model(cfg, venv, 0)
+        assert cfg.action_headroom == 3.0 and model.policy.action_headroom == 3.0
+        with pytest.raises(ValueError, match=r"model.policy_kwargs.action_headroom 2.0 "
+                                             r"differs from action_headroom 3.0"):
+            make_model(_sac_config(action_headroom=2.0), venv, 0)
+    finally:
+        venv.close()

@@ -306,6 +306,10 @@ class AsymmetricSACPolicy(SACPolicy):
     critic then saw too little of the action's effect to tell its slope in a, and the
     actor's gain drifted up until the policy degraded."""
 
+    #: The policy takes the env's ``action_headroom`` as a keyword (its critic reads the
+    #: applied action): :func:`train.bench.sb3_train.make_model` passes the config's.
+    takes_action_headroom = True
+
     def __init__(self, *args, action_headroom: float = 1.0, offset_scale: float | None = None,
                  mean_clip: float | None = None, log_std_min: float | None = None, **kwargs):
         from acld_gym.wrappers import check_headroom

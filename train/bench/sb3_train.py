@@ -93,7 +93,7 @@ def make_model(cfg: TrainConfig, venv, seed: int, **kwargs):
         raise ValueError(f"model.ent_coef: a schedule {{linear: [start, end]}} is for ppo "
                          f"only, got one for {cfg.algo}")
     policy = model_kwargs.pop("policy")
-    if policy is AsymmetricSACPolicy:  # its critic takes the applied action (the env's map)
+    if getattr(policy, "takes_action_headroom", False):  # it needs the env's action map
         pk = dict(model_kwargs.get("policy_kwargs") or {})
         if pk.get("action_headroom", cfg.action_headroom) != cfg.action_headroom:
             raise ValueError(f"model.policy_kwargs.action_headroom "

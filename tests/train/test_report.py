@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from train.bench.report import BEGIN, GOALS, main, markdown, replace_block
+from train.bench.report import BEGIN, GOALS, curves_figure, main, markdown, replace_block
 
 RESULTS = Path("train/benchmark/results-v1.json")
 PAGE = Path("docs/training.md")
@@ -45,3 +45,31 @@ def test_write_replaces_only_the_block(tmp_path, capsys):
         main([str(RESULTS), "--write", str(page)])
     assert e.value.code == 2 and "expected one" in capsys.readouterr().err
     assert page.read_text() == "no markers\n"  # left intact
+
+
+def test_the_figure_marks_each_reported_result_at_its_budget():
+    """A hollow diamond per algorithm and case at (budget, reported IQM): the selected
+    checkpoint's for SAC (select:), which need not be the curve's last point."""
+    import matplotlib.pyplot as plt
+
+    summary = json.loads(RESULTS.read_text())
+    fig = curves_figure(summary)
+    try:
+        for ax, case in zip(fig.axes, ("1", "2", "3", "random"), strict=True):
+            marks = {(x, y) for line in ax.get_lines() if line.get_marker() == "D"
+                     for x, y in zip(line.get_xdata(), line.get_ydata(), strict=True)}
+            for a in summary["algorithms"].values():
+                assert (a["budget"], a["ise_rel_lqr"][case]["iqm"]) in marks
+        sac = summary["algorithms"]["sac"]
+        assert sac["curve"][-1]["1"]["iqm"] != sac["ise_rel_lqr"]["1"]["iqm"]  # selected
+    finally:
+        plt.close(fig)
+
+
+def test_plot_writes_the_figure_and_refuses_a_directory(tmp_path, capsys):
+    assert main([str(RESULTS), "--plot", str(tmp_path / "f.png")]) == 0
+    assert (tmp_path / "f.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "wrote the learning curves" in capsys.readouterr().out
+    with pytest.raises(SystemExit) as e:
+        main([str(RESULTS), "--plot", str(tmp_path)])
+    assert e.value.code == 2 and "--plot" in capsys.readouterr().err

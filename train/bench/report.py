@@ -12,7 +12,7 @@ from acld_gym.util.atomic import save_figure
 from .evaluate import CASES
 from .trials import REFERENCES
 
-__all__ = ["GOALS", "goals_of", "summarize", "markdown", "plot_curves"]
+__all__ = ["GOALS", "goals_of", "summarize", "markdown", "curves_figure", "plot_curves"]
 
 
 #: The goals (issue 20), each a function of every seed's ISE / LQR ``rel`` (seeds x
@@ -150,7 +150,20 @@ def markdown(summary: dict) -> str:
 
 
 def plot_curves(summary: dict, path: Path) -> Path:
-    """IQM ISE / LQR vs env steps per case with 95 % bands and the reference levels."""
+    """The figure of :func:`curves_figure`, written to ``path`` (atomically)."""
+    import matplotlib.pyplot as plt
+
+    fig = curves_figure(summary)
+    try:
+        return save_figure(fig, path, dpi=110)
+    finally:
+        plt.close(fig)
+
+
+def curves_figure(summary: dict):
+    """IQM ISE / LQR vs env steps per case with 95 % bands and the reference levels; a
+    hollow diamond at the budget marks the reported IQM, which is the selected checkpoint's
+    when the config selects one (``select:``), not the last point of the curve."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -171,6 +184,9 @@ def plot_curves(summary: dict, path: Path) -> Path:
             hi = np.array([p[str(case)]["ci_high"] for p in a["curve"]])
             (line,) = ax.plot(steps, mid, marker=".", lw=1.2, label=name)
             ax.fill_between(steps, lo, hi, color=line.get_color(), alpha=0.2, lw=0)
+            # the reported result: the final policy, or the selected checkpoint (select:)
+            ax.plot([a["budget"]], [a["ise_rel_lqr"][str(case)]["iqm"]], marker="D", ms=6,
+                    mfc="none", color=line.get_color(), ls="none")
         for ref, (color, ls) in styles.items():
             if ref in summary["references"]:
                 ax.axhline(
@@ -186,13 +202,12 @@ def plot_curves(summary: dict, path: Path) -> Path:
         ax.set_xlabel("env steps")
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("ISE / ISE$_{LQR}$ (IQM over seeds, 95 % CI)")
+    axes[0].plot([], [], marker="D", mfc="none", color="k", ls="none",
+                 label="reported (final or selected checkpoint)")
     axes[0].legend(fontsize=7)
     fig.suptitle(f"Teacher-free RL on {summary['env_id']}", fontsize=10)
     fig.tight_layout()
-    try:
-        return save_figure(fig, path, dpi=110)
-    finally:
-        plt.close(fig)
+    return fig
 
 
 #: The markers around the generated tables in a Markdown page (``--write``).
@@ -212,26 +227,37 @@ def replace_block(text: str, tables: str, src: str, dst: str) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """``python -m train.bench.report RESULTS.json [--write PAGE.md]``: the benchmark's
-    tables (:func:`markdown`) from a committed results file, printed or written between the
-    markers of a page (atomically)."""
+    """``python -m train.bench.report RESULTS.json [--write PAGE.md] [--plot FIG.png]``: the
+    benchmark's tables (:func:`markdown`) from a committed results file, printed or written
+    between the markers of a page (atomically); ``--plot`` also draws its learning curves
+    (:func:`plot_curves`)."""
     import argparse
     import json
 
-    from acld_gym.util.atomic import write_text
+    from acld_gym.util.atomic import check_writable, write_text
 
     p = argparse.ArgumentParser(prog="python -m train.bench.report", description=main.__doc__)
     p.add_argument("results", type=Path, help="a results.json of python -m train.benchmark")
     p.add_argument("--write", type=Path, default=None, metavar="PAGE",
                    help="replace the generated block of this Markdown page")
+    p.add_argument("--plot", type=Path, default=None, metavar="FIG",
+                   help="also write the learning curves to this image")
     args = p.parse_args(argv)
     try:
         summary = json.loads(args.results.read_text())
         tables = markdown(summary)
     except (OSError, ValueError, KeyError, TypeError) as exc:
         p.error(f"results: {args.results} is not a benchmark results file ({exc})")
+    if args.plot is not None:
+        try:
+            check_writable(args.plot, "--plot")
+        except (OSError, ValueError) as exc:
+            p.error(str(exc))
+        plot_curves(summary, args.plot)
+        print(f"wrote the learning curves of {args.results} to {args.plot}")
     if args.write is None:
-        print(tables, end="")
+        if args.plot is None:
+            print(tables, end="")
         return 0
     try:
         text = replace_block(args.write.read_text(), tables, str(args.results), str(args.write))

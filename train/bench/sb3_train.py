@@ -36,6 +36,13 @@ class _linear_schedule:  # noqa: N801  (an SB3 schedule: progress remaining 1 ->
         return self.end + (self.start - self.end) * progress_remaining
 
 
+def _schedule(key: str, value: dict) -> _linear_schedule:
+    """The schedule of a ``{linear: [start, end]}`` value of the model key ``key``."""
+    if set(value) != {"linear"} or len(value["linear"]) != 2:
+        raise ValueError(f"{key}: a number or {{linear: [start, end]}}, got {value!r}")
+    return _linear_schedule(*map(float, value["linear"]))
+
+
 def _resolve_policy_kwargs(kwargs: dict) -> dict:
     """YAML-friendly keyword arguments: ``policy_kwargs.activation_fn`` given by name
     (``"tanh"``); ``policy: SplitCriticPolicy`` names :class:`SplitCriticPolicy`;
@@ -43,11 +50,8 @@ def _resolve_policy_kwargs(kwargs: dict) -> dict:
     schedule linear in the progress from ``start`` to ``end`` (``ent_coef``'s is applied by
     :func:`train_sb3`, once per rollout: :func:`ent_coef_schedule`)."""
     for key in ("learning_rate", "clip_range", "ent_coef"):
-        value = kwargs.get(key)
-        if isinstance(value, dict):
-            if set(value) != {"linear"} or len(value["linear"]) != 2:
-                raise ValueError(f"{key}: a number or {{linear: [start, end]}}, got {value!r}")
-            kwargs = {**kwargs, key: _linear_schedule(*map(float, value["linear"]))}
+        if isinstance(kwargs.get(key), dict):
+            kwargs = {**kwargs, key: _schedule(key, kwargs[key])}
 
     named = {"SplitCriticPolicy": SplitCriticPolicy,
              "AsymmetricCriticPolicy": AsymmetricCriticPolicy,
@@ -62,15 +66,14 @@ def _resolve_policy_kwargs(kwargs: dict) -> dict:
     return kwargs
 
 
-def ent_coef_schedule(model_kwargs: dict) -> tuple[dict, _linear_schedule | None]:
-    """Split a scheduled ``ent_coef`` off resolved keyword arguments: the arguments with
-    ``ent_coef`` at its start value, and the schedule (None if ``ent_coef`` is a number).
-    Only an on-policy algorithm reads its ``ent_coef`` anew at every update (SB3's PPO:
-    ``loss = ... + ent_coef * entropy_loss``), so a schedule is for PPO only."""
-    sched = model_kwargs.get("ent_coef")
-    if not isinstance(sched, _linear_schedule):
-        return model_kwargs, None
-    return {**model_kwargs, "ent_coef": sched(1.0)}, sched
+def ent_coef_schedule(cfg: TrainConfig) -> _linear_schedule | None:
+    """The schedule of ``cfg``'s ``model.ent_coef`` if it is ``{linear: [start, end]}``,
+    else None. Only an on-policy algorithm reads its ``ent_coef`` anew at every update
+    (SB3's PPO: ``loss = ... + ent_coef * entropy_loss``), so a schedule is for PPO only:
+    :func:`make_model` starts the model at its start value, :func:`train_sb3` sets it
+    before each update."""
+    value = cfg.model.get("ent_coef")
+    return _schedule("ent_coef", value) if isinstance(value, dict) else None
 
 
 def fold_whitening(model, transform: np.ndarray) -> None:
@@ -88,10 +91,13 @@ def make_model(cfg: TrainConfig, venv, seed: int, **kwargs):
     """The (untrained) SB3 model of ``cfg`` on ``venv``: the config's keyword arguments
     (schedules and policy names resolved, :func:`_resolve_policy_kwargs`), CPU, seeded;
     ``kwargs`` add to them."""
-    model_kwargs, ent_sched = ent_coef_schedule(_resolve_policy_kwargs(dict(cfg.model)))
-    if ent_sched is not None and cfg.algo != "ppo":
-        raise ValueError(f"model.ent_coef: a schedule {{linear: [start, end]}} is for ppo "
-                         f"only, got one for {cfg.algo}")
+    model_kwargs = _resolve_policy_kwargs(dict(cfg.model))
+    ent_sched = ent_coef_schedule(cfg)
+    if ent_sched is not None:
+        if cfg.algo != "ppo":
+            raise ValueError(f"model.ent_coef: a schedule {{linear: [start, end]}} is for "
+                             f"ppo only, got one for {cfg.algo}")
+        model_kwargs["ent_coef"] = ent_sched(1.0)
     policy = model_kwargs.pop("policy")
     if getattr(policy, "takes_action_headroom", False):  # it needs the env's action map
         pk = dict(model_kwargs.get("policy_kwargs") or {})
@@ -168,7 +174,7 @@ def train_sb3(
     torch.set_num_threads(1)
     venv = make_vec_env(cfg, seed, env_id)
     model = make_model(cfg, venv, seed)
-    _, ent_sched = ent_coef_schedule(_resolve_policy_kwargs(dict(cfg.model)))
+    ent_sched = ent_coef_schedule(cfg)
     vmap = VoltageMap(cfg.residual, cfg.mesh, cfg.action_headroom)
     distilled = None
     if cfg.distill is not None:

@@ -1,0 +1,109 @@
+"""The training objective as PPO sees it: smoothed by its own exploration noise.
+
+PPO's gSDE explores with noise on the actor's gains, ``a = (W_u + eps)' u`` with
+``eps ~ N(0, diag sigma^2)`` in the whitened coordinates ``u = T' z``, so what it optimizes is
+the smoothed cost :math:`J_\\sigma(W) = E_\\epsilon J(W + T \\epsilon)`, not the cost
+:math:`J(W)` of the deterministic law it is evaluated with. This script trains the PPO recipe
+(``python -m train ppo --seed S``, the same run), reads its final ``sigma`` and whitening ``T``,
+and prints :math:`J_\\sigma` of the trained law and of the shipped random-search law
+(``train/agents/vrs``) at fractions of that ``sigma``, on the same validation loads and the
+same noise draws for both (common random numbers; one gain draw per episode, where gSDE draws
+one per 64-step rollout). ``J`` is :func:`train.bench.evaluate.validation_cost`'s (the env's
+reward per load over the passive beam's). Not a test; takes about 2 min::
+
+    python benchmarks/smoothed_objective.py --seed 0
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+import numpy as np
+
+
+def linear_law(agent) -> tuple[np.ndarray, float]:
+    """``(W, b)`` of an agent whose actor is one linear layer on the observation, optionally
+    clipped to [-1, 1] (``vrs``, ``ppo``): the voltage is ``120 clip(W' z + b, -1, 1)`` [V]
+    (the env clips an unclipped actor at +/-120 V)."""
+    kinds = [op["op"] for op in agent.actor.ops]
+    if kinds not in (["linear"], ["linear", "clip"]) or (
+            kinds[-1] == "clip" and (agent.actor.ops[1]["low"], agent.actor.ops[1]["high"])
+            != (-1.0, 1.0)):
+        raise ValueError(f"agent: expected an actor [linear] or [linear, clip(-1, 1)], got "
+                         f"{agent.actor.ops}")
+    return (np.asarray(agent.actor.arrays["W0"], float).ravel(),
+            float(np.asarray(agent.actor.arrays["b0"]).ravel()[0]))
+
+
+class _PerEpisodeLaw:
+    """``predict`` of the law ``120 clip(W_n' z + b)`` with gains ``W`` (n, d), one row per
+    sub-env of the vector env it runs in."""
+
+    def __init__(self, W: np.ndarray, b: float):
+        self.W, self.b = np.atleast_2d(W), b
+
+    def predict(self, obs, state=None, episode_start=None, deterministic=True):
+        a = np.einsum("ni,ni->n", np.asarray(obs, float), self.W) + self.b
+        return 120.0 * np.clip(a, -1.0, 1.0)[:, None], state
+
+
+def gain_noise_cost(W, b, dW, seeds, env_id: str = "ACLDBeam-v1") -> float:
+    """:func:`train.bench.evaluate.validation_cost` of the law ``(W + dW_n, b)`` on the
+    random loads of ``seeds``, with the gain perturbation ``dW`` (n, d) of episode n."""
+    import gymnasium as gym
+
+    from train.bench.evaluate import _side_by_side
+
+    seeds = [int(s) for s in seeds]
+    dW = np.asarray(dW, float)
+    if dW.shape != (len(seeds), np.size(W)):
+        raise ValueError(f"dW: expected shape {(len(seeds), np.size(W))}, got {dW.shape}")
+    venv = gym.make_vec(env_id, num_envs=len(seeds), load_case="random",
+                        reward_scale="passive")
+    obs, _ = venv.reset(seed=seeds)
+    (ret,), (steps,) = _side_by_side(_PerEpisodeLaw(np.ravel(W)[None] + dW, b), [venv], [obs],
+                                     lambda r, info: r)
+    return float(np.mean(-ret / steps))
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--seed", type=int, default=0, help="the PPO recipe's seed")
+    p.add_argument("--loads", type=int, default=256, help="validation loads")
+    p.add_argument("--draws", type=int, default=4, help="noise draws per load")
+    p.add_argument("--scales", type=float, nargs="+", default=[1.0, 0.5, 0.25],
+                   help="fractions of the trained sigma")
+    args = p.parse_args(argv)
+    from train.agent import TrainedAgent
+    from train.bench.evaluate import validation_seeds
+    from train.bench.sb3_train import train_sb3
+    from train.config import load_config
+
+    pol, record = train_sb3(load_config("ppo"), args.seed, "ACLDBeam-v1")
+    T = np.asarray(record["transform"], float)
+    sigma = np.exp(pol.model.policy.log_std.detach().numpy().ravel())
+    layer = pol.model.policy.action_net  # whitening folded in: the gains on z
+    laws = {f"ppo seed {args.seed}": (layer.weight.detach().numpy().ravel().astype(float),
+                                      float(layer.bias.detach().numpy()[0])),
+            "vrs (shipped)": linear_law(TrainedAgent.load("train/agents/vrs"))}
+    seeds = validation_seeds(args.loads)
+    rng = np.random.default_rng(12345)
+    eps = rng.normal(size=(args.draws, len(seeds), sigma.size)) * sigma
+    print(f"PPO's final gSDE sigma (whitened gains): {np.array2string(sigma, precision=3)}")
+    print(f"J_sigma on {args.loads} validation loads x {args.draws} gain draws (lower is "
+          f"better; 1 = passive)\n")
+    print("| sigma | " + " | ".join(laws) + " |")
+    print("|---|" + "---|" * len(laws))
+    zero = np.zeros((len(seeds), sigma.size))
+    for scale in [0.0, *args.scales]:
+        row = []
+        for W, b in laws.values():
+            draws = [zero] if scale == 0 else [scale * e @ T.T for e in eps]  # T eps per load
+            row.append(np.mean([gain_noise_cost(W, b, dW, seeds) for dW in draws]))
+        print(f"| {scale:g} x trained | " + " | ".join(f"{j:.4f}" for j in row) + " |")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

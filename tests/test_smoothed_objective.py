@@ -1,0 +1,50 @@
+"""``benchmarks/smoothed_objective.py``: its per-episode linear law is the shipped agent's
+(the same validation cost with no gain noise), the gain perturbation is per episode (an
+episode whose gains are zeroed costs the passive beam's 1 on its load), and agents that are not
+one linear law, or perturbations of the wrong shape, are refused."""
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from train.agent import TrainedAgent
+from train.bench.evaluate import validation_cost, validation_seeds
+
+_PATH = Path(__file__).resolve().parents[1] / "benchmarks" / "smoothed_objective.py"
+_spec = importlib.util.spec_from_file_location("smoothed_objective", _PATH)
+so = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(so)
+
+AGENTS = Path(__file__).resolve().parents[1] / "train" / "agents"
+
+
+@pytest.mark.parametrize("name", ["vrs", "ppo"])
+def test_law_without_noise_is_the_agents_validation_cost(name):
+    agent = TrainedAgent.load(AGENTS / name)
+    W, b = so.linear_law(agent)
+    seeds = validation_seeds(8)
+    zero = np.zeros((len(seeds), W.size))
+    assert so.gain_noise_cost(W, b, zero, seeds) == pytest.approx(
+        validation_cost(agent, seeds=seeds), rel=1e-9)
+
+
+def test_gain_noise_is_per_episode():
+    W, _ = so.linear_law(TrainedAgent.load(AGENTS / "vrs"))
+    seeds = validation_seeds(4)
+    dW = np.zeros((len(seeds), W.size))
+    per_load = [so.gain_noise_cost(W, 0.0, dW[:1], [s]) for s in seeds]
+    assert so.gain_noise_cost(W, 0.0, dW, seeds) == pytest.approx(np.mean(per_load), rel=1e-9)
+    dW[0] = -W  # episode 0 without control: the passive beam, cost 1 on its load
+    assert so.gain_noise_cost(W, 0.0, dW, seeds) == pytest.approx(
+        np.mean([1.0, *per_load[1:]]), rel=1e-9)
+    assert min(per_load) < 0.9  # so the passive episode did change the mean
+
+
+def test_refuses_what_it_cannot_read():
+    with pytest.raises(ValueError, match="agent: expected an actor"):
+        so.linear_law(TrainedAgent.load(AGENTS / "sac"))  # linear, clip, tanh
+    W, b = so.linear_law(TrainedAgent.load(AGENTS / "vrs"))
+    with pytest.raises(ValueError, match=r"dW: expected shape \(2, 9\)"):
+        so.gain_noise_cost(W, b, np.zeros((3, 9)), validation_seeds(2))

@@ -50,21 +50,15 @@ class _PerEpisodeLaw:
 
 def gain_noise_cost(W, b, dW, seeds, env_id: str = "ACLDBeam-v1") -> float:
     """:func:`train.bench.evaluate.validation_cost` of the law ``(W + dW_n, b)`` on the
-    random loads of ``seeds``, with the gain perturbation ``dW`` (n, d) of episode n."""
-    import gymnasium as gym
-
-    from train.bench.evaluate import _side_by_side
+    random loads of ``seeds``, with the gain perturbation ``dW`` (n, d) of episode n (the
+    episodes run side by side, sub-env n on load n)."""
+    from train.bench.evaluate import validation_cost
 
     seeds = [int(s) for s in seeds]
     dW = np.asarray(dW, float)
     if dW.shape != (len(seeds), np.size(W)):
         raise ValueError(f"dW: expected shape {(len(seeds), np.size(W))}, got {dW.shape}")
-    venv = gym.make_vec(env_id, num_envs=len(seeds), load_case="random",
-                        reward_scale="passive")
-    obs, _ = venv.reset(seed=seeds)
-    (ret,), (steps,) = _side_by_side(_PerEpisodeLaw(np.ravel(W)[None] + dW, b), [venv], [obs],
-                                     lambda r, info: r)
-    return float(np.mean(-ret / steps))
+    return validation_cost(_PerEpisodeLaw(np.ravel(W)[None] + dW, b), env_id, seeds)
 
 
 def main(argv=None) -> int:

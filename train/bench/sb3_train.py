@@ -46,10 +46,10 @@ def _schedule(key: str, value: dict) -> _linear_schedule:
 def _resolve_policy_kwargs(kwargs: dict) -> dict:
     """YAML-friendly keyword arguments: ``policy_kwargs.activation_fn`` given by name
     (``"tanh"``); ``policy: SplitCriticPolicy`` names :class:`SplitCriticPolicy`;
-    ``learning_rate`` / ``clip_range`` / ``ent_coef`` as ``{linear: [start, end]}``, a
-    schedule linear in the progress from ``start`` to ``end`` (``ent_coef``'s is applied by
-    :func:`train_sb3`, once per rollout: :func:`ent_coef_schedule`)."""
-    for key in ("learning_rate", "clip_range", "ent_coef"):
+    ``learning_rate`` / ``clip_range`` as ``{linear: [start, end]}``, a schedule linear in
+    the progress from ``start`` to ``end`` (``ent_coef``'s, which SB3 takes as a number, is
+    :func:`ent_coef_schedule`'s, applied by :func:`train_sb3` once per rollout)."""
+    for key in ("learning_rate", "clip_range"):
         if isinstance(kwargs.get(key), dict):
             kwargs = {**kwargs, key: _schedule(key, kwargs[key])}
 

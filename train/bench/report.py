@@ -163,48 +163,77 @@ def plot_curves(summary: dict, path: Path) -> Path:
 def curves_figure(summary: dict):
     """IQM ISE / LQR vs env steps per case with 95 % bands and the reference levels; a
     hollow diamond at the budget marks the reported IQM, which is the selected checkpoint's
-    when the config selects one (``select:``), not the last point of the curve."""
+    when the config selects one (``select:``), not the last point of the curve.
+
+    The top row shows whole runs on a log ISE axis (the passive beam is ~4x LQR); the bottom
+    row zooms on the end of training, from a tenth of the smallest budget on, where the
+    algorithms differ by a few per cent of LQR."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import FuncFormatter, LogLocator
 
-    fig, axes = plt.subplots(1, 4, figsize=(17, 4.2), sharex=False)
+    fig, grid = plt.subplots(2, 4, figsize=(17, 7.6), sharex=False,
+                             gridspec_kw={"height_ratios": [1, 1]})
     styles = {
         "lqr": ("k", "--"),
         "smc": ("tab:gray", ":"),
         "mpc": ("tab:purple", "-."),
-        "bound": ("tab:green", "--"),
+        "bound": ("tab:brown", "--"),
     }
-    for ax, case in zip(axes, CASES, strict=True):
-        for name, a in summary["algorithms"].items():
-            steps = np.array([p["steps"] for p in a["curve"]], dtype=float)
-            mid = np.array([p[str(case)]["iqm"] for p in a["curve"]])
-            lo = np.array([p[str(case)]["ci_low"] for p in a["curve"]])
-            hi = np.array([p[str(case)]["ci_high"] for p in a["curve"]])
-            (line,) = ax.plot(steps, mid, marker=".", lw=1.2, label=name)
-            ax.fill_between(steps, lo, hi, color=line.get_color(), alpha=0.2, lw=0)
-            # the reported result: the final policy, or the selected checkpoint (select:)
-            ax.plot([a["budget"]], [a["ise_rel_lqr"][str(case)]["iqm"]], marker="D", ms=6,
-                    mfc="none", color=line.get_color(), ls="none")
-        for ref, (color, ls) in styles.items():
-            if ref in summary["references"]:
-                ax.axhline(
-                    summary["references"][ref][str(case)],
-                    color=color,
-                    ls=ls,
-                    lw=1,
-                    label=ref.upper() if ref != "bound" else "bound",
-                )
-        ax.set_xscale("symlog", linthresh=1e4)  # step 0 (the initial actor) included
-        ax.set_xlim(left=0)
-        ax.set_title(f"load case {case}" if case != "random" else "held-out random loads")
-        ax.set_xlabel("env steps")
-        ax.grid(alpha=0.3)
-    axes[0].set_ylabel("ISE / ISE$_{LQR}$ (IQM over seeds, 95 % CI)")
-    axes[0].plot([], [], marker="D", mfc="none", color="k", ls="none",
-                 label="reported (final or selected checkpoint)")
-    axes[0].legend(fontsize=7)
+    algos = summary["algorithms"]
+    zoom_from = 0.1 * min(a["budget"] for a in algos.values())
+    for row, axes in enumerate(grid):
+        for ax, case in zip(axes, CASES, strict=True):
+            key = str(case)
+            near = []  # the values in the zoom window, for its y limits
+            for name, a in algos.items():
+                steps = np.array([p["steps"] for p in a["curve"]], dtype=float)
+                mid = np.array([p[key]["iqm"] for p in a["curve"]])
+                lo = np.array([p[key]["ci_low"] for p in a["curve"]])
+                hi = np.array([p[key]["ci_high"] for p in a["curve"]])
+                (line,) = ax.plot(steps, mid, marker=".", lw=1.2, label=name)
+                ax.fill_between(steps, lo, hi, color=line.get_color(), alpha=0.2, lw=0)
+                # the reported result: the final policy, or the selected checkpoint (select:)
+                rep = a["ise_rel_lqr"][key]
+                ax.plot([a["budget"]], [rep["iqm"]], marker="D", ms=6, mfc="none",
+                        color=line.get_color(), ls="none")
+                near += [*mid[steps >= zoom_from], rep["ci_low"], rep["ci_high"]]
+            for ref, (color, ls) in styles.items():
+                if ref in summary["references"]:
+                    level = summary["references"][ref][key]
+                    ax.axhline(level, color=color, ls=ls, lw=1,
+                               label=ref.upper() if ref != "bound" else "bound")
+                    if ref in ("lqr", "smc"):
+                        near.append(level)
+            ax.grid(alpha=0.3, which="both")
+            if row == 0:
+                ax.set_xscale("symlog", linthresh=1e4)  # step 0 (the initial actor) included
+                ax.set_xlim(left=0)
+                ax.set_yscale("log")
+                ax.yaxis.set_minor_locator(LogLocator(subs=(2, 3, 5)))
+                for axis_fmt in (ax.yaxis.set_major_formatter, ax.yaxis.set_minor_formatter):
+                    axis_fmt(FuncFormatter(lambda v, _: f"{v:g}"))
+                ax.set_title(f"load case {case}" if case != "random"
+                             else "held-out random loads")
+            else:
+                ax.set_xscale("log")
+                ax.set_xlim(zoom_from, 1.3 * max(a["budget"] for a in algos.values()))
+                lo_y, hi_y = min(near), min(max(near), 1.1)
+                pad = 0.08 * (hi_y - lo_y)
+                ax.set_ylim(lo_y - pad, hi_y + pad)
+                bound = summary["references"].get("bound", {}).get(key)
+                if bound is not None and bound < lo_y - pad:
+                    ax.set_title(f"zoom (bound {bound:.3f}, below)", fontsize=9)
+                else:
+                    ax.set_title("zoom on the end of training", fontsize=9)
+                ax.set_xlabel("env steps")
+    grid[0][0].set_ylabel("ISE / ISE$_{LQR}$ (IQM over seeds, 95 % CI)")
+    grid[1][0].set_ylabel("ISE / ISE$_{LQR}$, zoomed")
+    grid[0][0].plot([], [], marker="D", mfc="none", color="k", ls="none",
+                    label="reported (final or selected checkpoint)")
+    grid[0][0].legend(fontsize=7)
     fig.suptitle(f"Teacher-free RL on {summary['env_id']}", fontsize=10)
     fig.tight_layout()
     return fig

@@ -61,6 +61,12 @@ def test_the_figure_marks_each_reported_result_at_its_budget():
                      for x, y in zip(line.get_xdata(), line.get_ydata(), strict=True)}
             for a in summary["algorithms"].values():
                 assert (a["budget"], a["ise_rel_lqr"][case]["iqm"]) in marks
+        for ax, case in zip(fig.axes[4:], ("1", "2", "3", "random"), strict=True):
+            lo, hi = ax.get_ylim()  # the zoom holds LQR's level and every reported IQM
+            assert lo < 1.0 < hi and ax.get_yscale() == "linear"
+            for a in summary["algorithms"].values():
+                assert lo < a["ise_rel_lqr"][case]["iqm"] < hi
+        assert all(ax.get_yscale() == "log" for ax in fig.axes[:4])
         sac = summary["algorithms"]["sac"]
         assert sac["curve"][-1]["1"]["iqm"] != sac["ise_rel_lqr"]["1"]["iqm"]  # selected
     finally:

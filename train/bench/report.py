@@ -220,7 +220,8 @@ def curves_figure(summary: dict):
             else:
                 ax.set_xscale("log")
                 ax.set_xlim(zoom_from, 1.3 * max(a["budget"] for a in algos.values()))
-                lo_y, hi_y = min(near), min(max(near), 1.1)
+                lo_y = min(near)
+                hi_y = min(max(near), max(1.1, 1.1 * lo_y))  # > lo_y even when all exceed 1.1
                 pad = 0.08 * (hi_y - lo_y)
                 ax.set_ylim(lo_y - pad, hi_y + pad)
                 bound = summary["references"].get("bound", {}).get(key)

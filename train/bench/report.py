@@ -220,6 +220,9 @@ def curves_figure(summary: dict):
             else:
                 ax.set_xscale("log")
                 ax.set_xlim(zoom_from, 1.3 * max(a["budget"] for a in algos.values()))
+                ax.xaxis.set_minor_locator(LogLocator(subs=(2, 5)))
+                for axis_fmt in (ax.xaxis.set_major_formatter, ax.xaxis.set_minor_formatter):
+                    axis_fmt(FuncFormatter(lambda v, _: f"{v / 1e6:g}M"))
                 lo_y = min(near)
                 hi_y = min(max(near), max(1.1, 1.1 * lo_y))  # > lo_y even when all exceed 1.1
                 pad = 0.08 * (hi_y - lo_y)

@@ -22,18 +22,17 @@ import sys
 import numpy as np
 
 
-def linear_law(agent) -> tuple[np.ndarray, float]:
-    """``(W, b)`` of an agent whose actor is one linear layer on the observation, optionally
-    clipped to [-1, 1] (``vrs``, ``ppo``): the voltage is ``120 clip(W' z + b, -1, 1)`` [V]
-    (the env clips an unclipped actor at +/-120 V)."""
-    kinds = [op["op"] for op in agent.actor.ops]
+def linear_law(actor) -> tuple[np.ndarray, float]:
+    """``(W, b)`` of an :class:`train.agent.ActorProgram` that is one linear layer on the
+    observation, optionally clipped to [-1, 1] (``vrs``'s, or :func:`train.agent.export_sb3`
+    of the PPO recipe's model): the voltage is ``120 clip(W' z + b, -1, 1)`` [V] (the env
+    clips an unclipped actor at +/-120 V)."""
+    kinds = [op["op"] for op in actor.ops]
     if kinds not in (["linear"], ["linear", "clip"]) or (
-            kinds[-1] == "clip" and (agent.actor.ops[1]["low"], agent.actor.ops[1]["high"])
-            != (-1.0, 1.0)):
-        raise ValueError(f"agent: expected an actor [linear] or [linear, clip(-1, 1)], got "
-                         f"{agent.actor.ops}")
-    return (np.asarray(agent.actor.arrays["W0"], float).ravel(),
-            float(np.asarray(agent.actor.arrays["b0"]).ravel()[0]))
+            kinds[-1] == "clip" and (actor.ops[1]["low"], actor.ops[1]["high"]) != (-1.0, 1.0)):
+        raise ValueError(f"actor: expected [linear] or [linear, clip(-1, 1)], got {actor.ops}")
+    return (np.asarray(actor.arrays["W0"], float).ravel(),
+            float(np.asarray(actor.arrays["b0"]).ravel()[0]))
 
 
 class _PerEpisodeLaw:
@@ -69,7 +68,7 @@ def main(argv=None) -> int:
     p.add_argument("--scales", type=float, nargs="+", default=[1.0, 0.5, 0.25],
                    help="fractions of the trained sigma")
     args = p.parse_args(argv)
-    from train.agent import TrainedAgent
+    from train.agent import TrainedAgent, export_sb3
     from train.bench.evaluate import validation_seeds
     from train.bench.sb3_train import train_sb3
     from train.config import load_config
@@ -77,10 +76,8 @@ def main(argv=None) -> int:
     pol, record = train_sb3(load_config("ppo"), args.seed, "ACLDBeam-v1")
     T = np.asarray(record["transform"], float)
     sigma = np.exp(pol.model.policy.log_std.detach().numpy().ravel())
-    layer = pol.model.policy.action_net  # whitening folded in: the gains on z
-    laws = {f"ppo seed {args.seed}": (layer.weight.detach().numpy().ravel().astype(float),
-                                      float(layer.bias.detach().numpy()[0])),
-            "vrs (shipped)": linear_law(TrainedAgent.load("train/agents/vrs"))}
+    laws = {f"ppo seed {args.seed}": linear_law(export_sb3(pol.model)),  # T folded in: on z
+            "vrs (shipped)": linear_law(TrainedAgent.load("train/agents/vrs").actor)}
     seeds = validation_seeds(args.loads)
     rng = np.random.default_rng(12345)
     eps = rng.normal(size=(args.draws, len(seeds), sigma.size)) * sigma

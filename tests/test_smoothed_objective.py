@@ -23,7 +23,7 @@ AGENTS = Path(__file__).resolve().parents[1] / "train" / "agents"
 @pytest.mark.parametrize("name", ["vrs", "ppo"])
 def test_law_without_noise_is_the_agents_validation_cost(name):
     agent = TrainedAgent.load(AGENTS / name)
-    W, b = so.linear_law(agent)
+    W, b = so.linear_law(agent.actor)
     seeds = validation_seeds(8)
     zero = np.zeros((len(seeds), W.size))
     assert so.gain_noise_cost(W, b, zero, seeds) == pytest.approx(
@@ -31,7 +31,7 @@ def test_law_without_noise_is_the_agents_validation_cost(name):
 
 
 def test_gain_noise_is_per_episode():
-    W, _ = so.linear_law(TrainedAgent.load(AGENTS / "vrs"))
+    W, _ = so.linear_law(TrainedAgent.load(AGENTS / "vrs").actor)
     seeds = validation_seeds(4)
     dW = np.zeros((len(seeds), W.size))
     per_load = [so.gain_noise_cost(W, 0.0, dW[:1], [s]) for s in seeds]
@@ -43,8 +43,8 @@ def test_gain_noise_is_per_episode():
 
 
 def test_refuses_what_it_cannot_read():
-    with pytest.raises(ValueError, match="agent: expected an actor"):
-        so.linear_law(TrainedAgent.load(AGENTS / "sac"))  # linear, clip, tanh
-    W, b = so.linear_law(TrainedAgent.load(AGENTS / "vrs"))
+    with pytest.raises(ValueError, match="actor: expected"):
+        so.linear_law(TrainedAgent.load(AGENTS / "sac").actor)  # linear, clip, tanh
+    W, b = so.linear_law(TrainedAgent.load(AGENTS / "vrs").actor)
     with pytest.raises(ValueError, match=r"dW: expected shape \(2, 9\)"):
         so.gain_noise_cost(W, b, np.zeros((3, 9)), validation_seeds(2))

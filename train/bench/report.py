@@ -160,6 +160,42 @@ def plot_curves(summary: dict, path: Path) -> Path:
         plt.close(fig)
 
 
+#: Colour and line style of each reference level in the learning-curve figure.
+_REF_STYLES = {
+    "lqr": ("k", "--"),
+    "smc": ("tab:gray", ":"),
+    "mpc": ("tab:purple", "-."),
+    "bound": ("tab:brown", "--"),
+}
+
+
+def _draw_case(ax, summary: dict, key: str, zoom_from: float) -> list[float]:
+    """One case's curves, 95 % bands, reported diamonds and reference levels on ``ax``; returns
+    the values the zoom must hold (curve points from ``zoom_from`` env steps on, the reported
+    CIs, LQR's and SMC's levels)."""
+    near = []
+    for name, a in summary["algorithms"].items():
+        steps = np.array([p["steps"] for p in a["curve"]], dtype=float)
+        mid = np.array([p[key]["iqm"] for p in a["curve"]])
+        lo = np.array([p[key]["ci_low"] for p in a["curve"]])
+        hi = np.array([p[key]["ci_high"] for p in a["curve"]])
+        (line,) = ax.plot(steps, mid, marker=".", lw=1.2, label=name)
+        ax.fill_between(steps, lo, hi, color=line.get_color(), alpha=0.2, lw=0)
+        # the reported result: the final policy, or the selected checkpoint (select:)
+        rep = a["ise_rel_lqr"][key]
+        ax.plot([a["budget"]], [rep["iqm"]], marker="D", ms=6, mfc="none",
+                color=line.get_color(), ls="none")
+        near += [*mid[steps >= zoom_from], rep["ci_low"], rep["ci_high"]]
+    for ref, (color, ls) in _REF_STYLES.items():
+        if ref in summary["references"]:
+            level = summary["references"][ref][key]
+            ax.axhline(level, color=color, ls=ls, lw=1,
+                       label=ref.upper() if ref != "bound" else "bound")
+            if ref in ("lqr", "smc"):
+                near.append(level)
+    return near
+
+
 def curves_figure(summary: dict):
     """IQM ISE / LQR vs env steps per case with 95 % bands and the reference levels; a
     hollow diamond at the budget marks the reported IQM, which is the selected checkpoint's
@@ -174,39 +210,13 @@ def curves_figure(summary: dict):
     import matplotlib.pyplot as plt
     from matplotlib.ticker import FuncFormatter, LogLocator
 
-    fig, grid = plt.subplots(2, 4, figsize=(17, 7.6), sharex=False,
-                             gridspec_kw={"height_ratios": [1, 1]})
-    styles = {
-        "lqr": ("k", "--"),
-        "smc": ("tab:gray", ":"),
-        "mpc": ("tab:purple", "-."),
-        "bound": ("tab:brown", "--"),
-    }
+    fig, grid = plt.subplots(2, 4, figsize=(17, 7.6))
     algos = summary["algorithms"]
     zoom_from = 0.1 * min(a["budget"] for a in algos.values())
     for row, axes in enumerate(grid):
         for ax, case in zip(axes, CASES, strict=True):
             key = str(case)
-            near = []  # the values in the zoom window, for its y limits
-            for name, a in algos.items():
-                steps = np.array([p["steps"] for p in a["curve"]], dtype=float)
-                mid = np.array([p[key]["iqm"] for p in a["curve"]])
-                lo = np.array([p[key]["ci_low"] for p in a["curve"]])
-                hi = np.array([p[key]["ci_high"] for p in a["curve"]])
-                (line,) = ax.plot(steps, mid, marker=".", lw=1.2, label=name)
-                ax.fill_between(steps, lo, hi, color=line.get_color(), alpha=0.2, lw=0)
-                # the reported result: the final policy, or the selected checkpoint (select:)
-                rep = a["ise_rel_lqr"][key]
-                ax.plot([a["budget"]], [rep["iqm"]], marker="D", ms=6, mfc="none",
-                        color=line.get_color(), ls="none")
-                near += [*mid[steps >= zoom_from], rep["ci_low"], rep["ci_high"]]
-            for ref, (color, ls) in styles.items():
-                if ref in summary["references"]:
-                    level = summary["references"][ref][key]
-                    ax.axhline(level, color=color, ls=ls, lw=1,
-                               label=ref.upper() if ref != "bound" else "bound")
-                    if ref in ("lqr", "smc"):
-                        near.append(level)
+            near = _draw_case(ax, summary, key, zoom_from)
             ax.grid(alpha=0.3, which="both")
             if row == 0:
                 ax.set_xscale("symlog", linthresh=1e4)  # step 0 (the initial actor) included

@@ -1,9 +1,10 @@
 """The one training configuration: a YAML file per recipe under ``train/benchmark/``
-(``ppo.yaml``, ``sac.yaml``, ``vrs.yaml``, the ablations, the opt-in DAgger starts),
-validated into a :class:`TrainConfig`. ``python -m train`` and ``python -m
-train.benchmark`` read the same files, build the same env (:func:`train.vec.make_vec_env`),
-train with the same function (:func:`train.bench.algos.train_algo`) and evaluate with the
-same evaluator (:mod:`train.bench.evaluate`)."""
+(``ppo.yaml``, ``sac.yaml``, ``vrs.yaml``, the ablations -- ``base: ppo`` and what they
+change (:func:`read_config`) --, the opt-in DAgger starts), validated into a
+:class:`TrainConfig`. ``python -m train`` and ``python -m train.benchmark`` read the same
+files, build the same env (:func:`train.vec.make_vec_env`), train with the same function
+(:func:`train.bench.algos.train_algo`) and evaluate with the same evaluator
+(:mod:`train.bench.evaluate`)."""
 
 from __future__ import annotations
 
@@ -387,17 +388,52 @@ def config_path(spec: str | Path) -> Path:
     return path
 
 
-def read_config(spec: str | Path) -> tuple[str, dict]:
-    """``(name, mapping)`` of a config (:func:`config_path`), validated; the mapping is the
-    file's own (what a trial records and ``--resume`` compares). ``ValueError`` naming the
-    file and the key on a malformed file or a bad value."""
-    path = config_path(spec)
+def _read_yaml(path: Path) -> dict:
+    """The mapping of one YAML file; ``ValueError`` naming the file and the place."""
     try:
         data = yaml.safe_load(path.read_text()) or {}
     except yaml.YAMLError as exc:
         where = getattr(exc, "problem_mark", None)
         at = f" (line {where.line + 1}, column {where.column + 1})" if where else ""
         raise ValueError(f"{path}: not valid YAML{at}: {getattr(exc, 'problem', exc)}") from None
+    if not isinstance(data, dict):
+        raise ValueError(f"{path}: expected a mapping of settings, got {type(data).__name__}")
+    return data
+
+
+def _merged(base: dict, changes: dict) -> dict:
+    """``base`` with ``changes`` applied key by key, nested mappings merged the same way."""
+    out = dict(base)
+    for key, value in changes.items():
+        if isinstance(value, dict) and isinstance(out.get(key), dict):
+            value = _merged(out[key], value)
+        out[key] = value
+    return out
+
+
+def _resolve(path: Path, seen: tuple[Path, ...] = ()) -> dict:
+    """The mapping of a config file with its ``base:`` (a recipe name or a YAML path, itself
+    resolved) applied: the base's settings, then the file's own on top of them."""
+    data = _read_yaml(path)
+    if "base" not in data:
+        return data
+    base = data.pop("base")
+    if not isinstance(base, str):
+        raise ValueError(f"{path}: base: expected a config name or path, got {base!r}")
+    base_path = config_path(base)
+    if base_path.resolve() in seen:
+        raise ValueError(f"{path}: base: {base!r} leads back to itself")
+    return _merged(_resolve(base_path, (*seen, path.resolve())), data)
+
+
+def read_config(spec: str | Path) -> tuple[str, dict]:
+    """``(name, mapping)`` of a config (:func:`config_path`), validated; the mapping is the
+    file's own with its ``base:`` applied, if it names one (an ablation is ``base: ppo`` and
+    the settings it changes; nested mappings such as ``model`` merge key by key). It is what
+    a trial records and ``--resume`` compares. ``ValueError`` naming the file and the key on
+    a malformed file or a bad value."""
+    path = config_path(spec)
+    data = _resolve(path)
     try:
         TrainConfig.from_dict(data)
     except (TypeError, ValueError) as exc:

@@ -110,3 +110,38 @@ def test_parse_load_case_accepts_the_cases(value, expected):
 def test_parse_load_case_names_the_choices(value):
     with pytest.raises(ValueError, match="1, 2, 3 or 'random'"):
         parse_load_case(value)
+
+
+def test_base_applies_the_recipe_under_a_files_own_settings(tmp_path):
+    """``base:`` names a recipe; the file's settings go on top, nested mappings key by key."""
+    _, ppo = read_config("ppo")
+    _, ablation = read_config("ablation_ppo_lambda_095")
+    assert ablation == {**ppo, "model": {**ppo["model"], "gae_lambda": 0.95}}
+    (tmp_path / "a.yaml").write_text("base: ppo\ntimesteps: 10\n"
+                                     "model: {policy_kwargs: {log_std_init: -2.0}}\n")
+    _, data = read_config(tmp_path / "a.yaml")
+    assert data["timesteps"] == 10 and "base" not in data
+    assert data["model"]["policy_kwargs"] == {**ppo["model"]["policy_kwargs"],
+                                              "log_std_init": -2.0}
+    assert data["model"]["n_steps"] == ppo["model"]["n_steps"]
+    (tmp_path / "b.yaml").write_text(f"base: {tmp_path / 'a.yaml'}\nn_envs: 8\n")
+    _, chained = read_config(tmp_path / "b.yaml")
+    assert chained == {**data, "n_envs": 8}
+
+
+@pytest.mark.parametrize("text, match", [
+    ("base: 3\n", r"base: expected a config name or path, got 3"),
+    ("base: no_such_recipe\n", r"no_such_recipe.*does not exist"),
+    ("base: ppo\ntimesteps: -5\n", r"c.yaml: timesteps must be an integer"),
+])
+def test_base_errors_name_the_file_and_the_problem(tmp_path, text, match):
+    (tmp_path / "c.yaml").write_text(text)
+    with pytest.raises((ValueError, FileNotFoundError), match=match):
+        read_config(tmp_path / "c.yaml")
+
+
+def test_base_refuses_a_cycle(tmp_path):
+    (tmp_path / "x.yaml").write_text(f"base: {tmp_path / 'y.yaml'}\n")
+    (tmp_path / "y.yaml").write_text(f"base: {tmp_path / 'x.yaml'}\n")
+    with pytest.raises(ValueError, match="leads back to itself"):
+        read_config(tmp_path / "x.yaml")

@@ -25,6 +25,7 @@ __all__ = [
     "CONFIG_DIR",
     "TrainConfig",
     "SelectConfig",
+    "AverageConfig",
     "algo_class",
     "config_path",
     "read_config",
@@ -84,8 +85,39 @@ class SelectConfig:
         check_int("select.start", self.start, 0, 10**12)
 
 
+@dataclass(frozen=True)
+class AverageConfig:
+    r"""Weight averaging of the policy (``TrainConfig.average``), as stochastic weight
+    averaging (Izmailov et al. 2018) and the Polyak-averaged iterates of stochastic
+    approximation: from env step ``start`` on, the policy's parameters at the end of
+    every rollout (PPO: each rollout; SAC: each vector step, between its gradient steps)
+    enter a running average :math:`\bar\theta`, uniform
+    (:math:`\bar\theta \mathrel{+}= (\theta - \bar\theta) / n`) or, with ``halflife``
+    :math:`h`, exponential in env steps (:math:`w = 1 - 2^{-\Delta t / h}`). The learning
+    curve, the checks of ``select`` and the returned policy are the averaged one's from
+    ``start`` on. Every floating-point parameter of the SB3 policy is averaged (actor and
+    critic); the agent is its deterministic actor.
+
+    Attributes
+    ----------
+    start : int
+        Env steps before the first parameters enter the average.
+    halflife : int or None
+        Env steps over which an iterate's weight halves; None: the uniform average.
+    """
+
+    start: int
+    halflife: int | None = None
+
+    def __post_init__(self):
+        check_int("average.start", self.start, 0, 10**12)
+        if self.halflife is not None:
+            check_int("average.halflife", self.halflife, 1, 10**12)
+
+
 def _section(cls, data: dict, name: str):
-    """The dataclass ``cls`` of a config's mapping ``name`` (``distill``, ``select``);
+    """The dataclass ``cls`` of a config's mapping ``name`` (``distill``, ``select``,
+    ``average``);
     ``ValueError`` naming ``name`` and its unknown or missing keys."""
     known = {f.name for f in fields(cls)}
     required = {f.name for f in fields(cls)
@@ -180,6 +212,9 @@ class TrainConfig:
         SB3 algorithms: checkpoint selection on validation loads (:class:`SelectConfig`'s
         fields, e.g. ``{episodes: 32, every: 50000, start: 300000}``); None (default): the
         final policy.
+    average : dict or None
+        SB3 algorithms: weight averaging of the policy (:class:`AverageConfig`'s fields,
+        e.g. ``{start: 1000000}``); None (default): the iterates as trained.
     """
 
     algo: str
@@ -198,6 +233,7 @@ class TrainConfig:
     shaping: float | None = None
     distill: dict | None = None
     select: dict | None = None
+    average: dict | None = None
 
     def __post_init__(self):
         if self.algo not in ALGOS:
@@ -273,9 +309,13 @@ class TrainConfig:
             if self.normalize.get("norm_obs", False):
                 raise ValueError("select needs norm_obs: false (the chosen parameters would "
                                  "meet the final observation statistics)")
+        if self.average is not None:
+            if not isinstance(self.average, dict):
+                raise ValueError(f"average must be a mapping or null, got {self.average!r}")
+            _ = self.average_config  # validates the fields
         if not sb3 and (self.residual or self.shaping is not None or self.distill
-                        or self.select is not None):
-            raise ValueError("residual, shaping, distill and select are for the SB3 "
+                        or self.select is not None or self.average is not None):
+            raise ValueError("residual, shaping, distill, select and average are for the SB3 "
                              "algorithms")
         if sb3:
             self._check_sb3()
@@ -339,6 +379,13 @@ class TrainConfig:
         if self.select is None:
             return None
         return _section(SelectConfig, self.select, "select")
+
+    @property
+    def average_config(self) -> AverageConfig | None:
+        """The :class:`AverageConfig` of ``average`` (None if off)."""
+        if self.average is None:
+            return None
+        return _section(AverageConfig, self.average, "average")
 
     @property
     def teacher(self) -> str | None:

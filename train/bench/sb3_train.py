@@ -5,6 +5,9 @@ env of :func:`train.vec.make_vec_env`, from scratch on the env's observation and
 
 from __future__ import annotations
 
+import copy
+from contextlib import contextmanager
+
 import numpy as np
 import torch
 import torch.nn as nn
@@ -25,7 +28,7 @@ from .sb3_policies import (
     SplitCriticPolicy,
 )
 
-__all__ = ["fold_whitening", "make_model", "train_sb3"]
+__all__ = ["Averaging", "Selection", "fold_whitening", "make_model", "train_sb3"]
 
 
 class _linear_schedule:  # noqa: N801  (an SB3 schedule: progress remaining 1 -> 0)
@@ -136,8 +139,6 @@ class Selection:
         return self.next is not None and steps >= self.next
 
     def check(self, steps: int, model, snapshot) -> None:
-        import copy
-
         from . import evaluate
 
         cost, env_steps = evaluate.validation_rollout(snapshot(), self.env_id, self.seeds)
@@ -157,6 +158,61 @@ class Selection:
         model.policy.load_state_dict(state)
         return {"episodes": self.config.episodes, "history": self.history,
                 "steps": chosen, "cost": cost, "validation_env_steps": self.env_steps}
+
+
+class Averaging:
+    """Weight averaging of :class:`train.config.AverageConfig` (``cfg.average``; inert if
+    None): :meth:`update` folds the SB3 policy's floating-point parameters into the running
+    average (in float64) once ``steps`` reaches ``start``; :meth:`applied` is a context in
+    which the model's policy holds the average (its own parameters restored on exit), and
+    :meth:`apply` loads the average for good. Before the first update both leave the model
+    as it is."""
+
+    def __init__(self, cfg: TrainConfig):
+        self.config = cfg.average_config
+        self.mean: dict | None = None
+        self.count = 0
+        self.last = 0
+
+    def update(self, steps: int, model) -> None:
+        if self.config is None or steps < self.config.start:
+            return
+        params = {k: v.detach().to(torch.float64, copy=True)
+                  for k, v in model.policy.state_dict().items() if v.is_floating_point()}
+        self.count += 1
+        if self.mean is None:
+            self.mean = params
+        else:
+            half = self.config.halflife
+            w = 1.0 / self.count if half is None else 1.0 - 0.5 ** ((steps - self.last) / half)
+            for k, v in params.items():
+                self.mean[k] += w * (v - self.mean[k])
+        self.last = int(steps)
+
+    def _load(self, model) -> None:
+        state = model.policy.state_dict()
+        model.policy.load_state_dict(
+            {**state, **{k: v.to(state[k].dtype) for k, v in self.mean.items()}})
+
+    @contextmanager
+    def applied(self, model):
+        if self.mean is None:
+            yield
+            return
+        saved = copy.deepcopy(model.policy.state_dict())
+        self._load(model)
+        try:
+            yield
+        finally:
+            model.policy.load_state_dict(saved)
+
+    def apply(self, model) -> dict | None:
+        """Load the average into the model; the record (start, halflife, iterates)."""
+        if self.mean is None:
+            return None
+        self._load(model)
+        return {"start": self.config.start, "halflife": self.config.halflife,
+                "iterates": self.count}
 
 
 def train_sb3(
@@ -193,8 +249,6 @@ def train_sb3(
     def snapshot() -> SB3Policy:
         norm = None
         if cfg.normalize.get("norm_obs", False):
-            import copy
-
             norm = copy.deepcopy(venv)
             norm.venv = None
             norm.training = False
@@ -217,31 +271,37 @@ def train_sb3(
         white.set_transform(transform)
 
     select = Selection(cfg, env_id)
+    average = Averaging(cfg)
 
     class Curve(BaseCallback):
         def _on_step(self) -> bool:
             steps = offset + int(self.num_timesteps)
             if callback is not None and schedule.due(steps):
-                callback(steps, snapshot())
+                with average.applied(model):
+                    callback(steps, snapshot())
             if select.due(steps):
-                select.check(steps, model, snapshot)
+                with average.applied(model):
+                    select.check(steps, model, snapshot)
             return True
 
         def _on_training_start(self) -> None:
             self._on_step()
 
         def _on_rollout_end(self) -> None:  # before the update of this rollout
+            average.update(offset + int(self.num_timesteps), model)
             if ent_sched is not None:  # the last rollout may overshoot the budget
                 model.ent_coef = ent_sched(max(1.0 - self.num_timesteps / budget, 0.0))
 
     budget = max(cfg.timesteps - offset, 1)
     model.learn(budget, callback=Curve())
     steps = offset + int(model.num_timesteps)
+    averaged = average.apply(model)  # from here on the model is the averaged policy
     record = {
         "steps": steps,
         "whiten_steps": offset,
         "transform": None if transform is None else transform.tolist(),
         "distill": distilled,
+        "average": averaged,
         "select": select.finish(steps, model, snapshot),
     }
     if transform is not None:  # u = T' z into the actor's first layer: a plain SB3 actor on z

@@ -80,7 +80,7 @@ def test_vrs_takes_no_sb3_options():
         TrainConfig(algo="vrs", timesteps=10, env_kwargs={"reward_scale": "passive"})
     with pytest.raises(ValueError, match="action_headroom is for the SB3"):
         TrainConfig(algo="vrs", timesteps=10, action_headroom=2.0)
-    with pytest.raises(ValueError, match="select are for the SB3"):
+    with pytest.raises(ValueError, match="select and average are for the SB3"):
         TrainConfig(algo="vrs", timesteps=10, select={"episodes": 2, "every": 10})
 
 

@@ -62,8 +62,8 @@ class SelectConfig:
     (:func:`train.bench.evaluate.validation_cost`: 1 for the passive beam); the run
     returns the best-scoring policy. Its env steps are not counted in the budget (they
     train nothing; the run records them); its time is in the training wall time. The
-    learning curve follows the policy being trained, the final evaluation is the returned
-    one's.
+    learning curve follows the policy being trained (the average, with ``average``), the
+    final evaluation is the returned one's.
 
     Attributes
     ----------

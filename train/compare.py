@@ -182,10 +182,10 @@ def learning_curves_figure(agents: dict):
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from matplotlib.ticker import FuncFormatter
 
     from .agent import CURVE_FILE
     from .bench.evaluate import lqr_ise
+    from .bench.report import ratio_log_axis
 
     curves = {}
     for name, agent in agents.items():
@@ -204,9 +204,7 @@ def learning_curves_figure(agents: dict):
                     [float(r["ise"]) / lqr[case] for r in sub], marker=".", lw=1, label=name)
         ax.axhline(1.0, color="k", ls="--", lw=1, label="LQR")
         ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
-        ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ratio_log_axis(ax)
         ax.set_title(f"load case {case}")
         ax.set_xlabel("training env steps")
         ax.grid(alpha=0.3, which="both")

@@ -129,6 +129,17 @@ def _section(cls, data: dict, name: str):
     return cls(**data)
 
 
+def _distill_config_class():
+    from .distill import DistillConfig  # train.distill imports this module
+
+    return DistillConfig
+
+
+#: The sub-mappings of a :class:`TrainConfig` and (a function giving) the dataclass of each.
+_SECTIONS = {"distill": _distill_config_class, "select": lambda: SelectConfig,
+             "average": lambda: AverageConfig}
+
+
 def algo_class(algo: str):
     """The stable-baselines3 / sb3-contrib class of ``algo`` (:data:`SB3_ALGOS`)."""
     if algo not in SB3_ALGOS:
@@ -295,24 +306,17 @@ class TrainConfig:
                              "linear actor)")
         if self.shaping is not None:
             check_real("shaping", self.shaping, 0.0, 1e6, low_open=True)
-        if self.distill is not None:
-            if not isinstance(self.distill, dict):
-                raise ValueError(f"distill must be a mapping or null, got {self.distill!r}")
-            _ = self.distill_config  # validates the fields
-            if self.residual is not None:
-                raise ValueError("distill needs residual: null (the action's sign is the "
-                                 f"voltage's), got residual {self.residual!r}")
-        if self.select is not None:
-            if not isinstance(self.select, dict):
-                raise ValueError(f"select must be a mapping or null, got {self.select!r}")
-            _ = self.select_config  # validates the fields
-            if self.normalize.get("norm_obs", False):
-                raise ValueError("select needs norm_obs: false (the chosen parameters would "
-                                 "meet the final observation statistics)")
-        if self.average is not None:
-            if not isinstance(self.average, dict):
-                raise ValueError(f"average must be a mapping or null, got {self.average!r}")
-            _ = self.average_config  # validates the fields
+        for name in _SECTIONS:  # the sub-mappings, each validated by its dataclass
+            value = getattr(self, name)
+            if value is not None and not isinstance(value, dict):
+                raise ValueError(f"{name} must be a mapping or null, got {value!r}")
+            _ = self._section_config(name)
+        if self.distill is not None and self.residual is not None:
+            raise ValueError("distill needs residual: null (the action's sign is the "
+                             f"voltage's), got residual {self.residual!r}")
+        if self.select is not None and self.normalize.get("norm_obs", False):
+            raise ValueError("select needs norm_obs: false (the chosen parameters would "
+                             "meet the final observation statistics)")
         if not sb3 and (self.residual or self.shaping is not None or self.distill
                         or self.select is not None or self.average is not None):
             raise ValueError("residual, shaping, distill, select and average are for the SB3 "
@@ -364,28 +368,25 @@ class TrainConfig:
         """Discount factor of the algorithm (SB3's default 0.99 if not set)."""
         return float(self.model.get("gamma", 0.99))
 
+    def _section_config(self, name: str):
+        """The dataclass of the sub-mapping ``name`` (:data:`_SECTIONS`), None if off."""
+        value = getattr(self, name)
+        return None if value is None else _section(_SECTIONS[name](), value, name)
+
     @property
     def distill_config(self):
         """The :class:`train.distill.DistillConfig` of ``distill`` (None if off)."""
-        from .distill import DistillConfig
-
-        if self.distill is None:
-            return None
-        return _section(DistillConfig, self.distill, "distill")
+        return self._section_config("distill")
 
     @property
     def select_config(self) -> SelectConfig | None:
         """The :class:`SelectConfig` of ``select`` (None if off)."""
-        if self.select is None:
-            return None
-        return _section(SelectConfig, self.select, "select")
+        return self._section_config("select")
 
     @property
     def average_config(self) -> AverageConfig | None:
         """The :class:`AverageConfig` of ``average`` (None if off)."""
-        if self.average is None:
-            return None
-        return _section(AverageConfig, self.average, "average")
+        return self._section_config("average")
 
     @property
     def teacher(self) -> str | None:

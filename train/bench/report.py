@@ -12,7 +12,8 @@ from acld_gym.util.atomic import save_figure
 from .evaluate import CASES
 from .trials import REFERENCES
 
-__all__ = ["GOALS", "goals_of", "summarize", "markdown", "curves_figure", "plot_curves"]
+__all__ = ["GOALS", "goals_of", "summarize", "markdown", "ratio_log_axis", "curves_figure",
+           "plot_curves"]
 
 
 #: The goals (issue 20), each a function of every seed's ISE / LQR ``rel`` (seeds x
@@ -160,6 +161,19 @@ def plot_curves(summary: dict, path: Path) -> Path:
         plt.close(fig)
 
 
+def ratio_log_axis(ax, subs: tuple[float, ...] | None = None) -> None:
+    """A logarithmic y axis of ratios (ISE / LQR) labelled in plain numbers (0.9, 2, 3)
+    on its major and minor ticks; ``subs``: the minor ticks' multiples of each decade
+    (matplotlib's default if None)."""
+    from matplotlib.ticker import FuncFormatter, LogLocator
+
+    ax.set_yscale("log")
+    if subs is not None:
+        ax.yaxis.set_minor_locator(LogLocator(subs=subs))
+    for axis_fmt in (ax.yaxis.set_major_formatter, ax.yaxis.set_minor_formatter):
+        axis_fmt(FuncFormatter(lambda v, _: f"{v:g}"))
+
+
 #: Colour and line style of each reference level in the learning-curve figure.
 _REF_STYLES = {
     "lqr": ("k", "--"),
@@ -221,10 +235,7 @@ def curves_figure(summary: dict):
             if row == 0:
                 ax.set_xscale("symlog", linthresh=1e4)  # step 0 (the initial actor) included
                 ax.set_xlim(left=0)
-                ax.set_yscale("log")
-                ax.yaxis.set_minor_locator(LogLocator(subs=(2, 3, 5)))
-                for axis_fmt in (ax.yaxis.set_major_formatter, ax.yaxis.set_minor_formatter):
-                    axis_fmt(FuncFormatter(lambda v, _: f"{v:g}"))
+                ratio_log_axis(ax, subs=(2, 3, 5))
                 ax.set_title(f"load case {case}" if case != "random"
                              else "held-out random loads")
             else:

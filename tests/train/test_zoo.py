@@ -29,15 +29,49 @@ def test_zoo_file_is_the_benchmark_recipe(algo):
     model = {k: v for k, v in bench["model"].items() if k not in ZOO_ONLY}
     assert {k: zoo[k] for k in model} == model
     lr = bench["model"]["learning_rate"]
-    if isinstance(lr, dict):  # rl-zoo3's "lin_<start>" decays linearly to 0
-        assert lr["linear"][1] == 0 and zoo["learning_rate"].startswith("lin_")
+    if isinstance(lr, dict) and lr["linear"][1] == 0:  # rl-zoo3's "lin_<start>": to 0
+        assert zoo["learning_rate"].startswith("lin_")
         assert float(zoo["learning_rate"][4:]) == lr["linear"][0]
+    elif isinstance(lr, dict):  # any other end: the callback train.zoo.LinearLearningRate
+        start, end = lr["linear"]
+        assert zoo["learning_rate"] == start
+        assert {"train.zoo.LinearLearningRate": {"start": start, "end": end}} in zoo["callback"]
     else:
         assert zoo["learning_rate"] == lr
     kwargs = eval(zoo["policy_kwargs"])  # rl-zoo3 evaluates the string the same way
     if headroom != 1.0:
         assert kwargs.pop("action_headroom") == headroom
     assert kwargs == bench["model"]["policy_kwargs"]
+
+
+def test_zoo_learning_rate_callback_gives_the_model_its_schedule():
+    """rl-zoo3 builds the callback from the file, and the model trains at its rates."""
+    from rl_zoo3.utils import get_callback_list
+    from stable_baselines3 import SAC
+
+    from train.zoo import LinearLearningRate
+
+    hp = yaml.safe_load(open("train/zoo/sac.yml"))["ACLDBeam-v1"]
+    (callback,) = [c for c in get_callback_list(hp) if isinstance(c, LinearLearningRate)]
+    # as rl-zoo3 gives it, a constant (its start), from which the callback takes over
+    model = SAC("MlpPolicy", "Pendulum-v1", learning_rate=hp["learning_rate"],
+                learning_starts=0, batch_size=8, seed=0)
+    assert model.actor.optimizer.param_groups[0]["lr"] == hp["learning_rate"]
+    model.learn(400, callback=callback)
+    start, end = callback.schedule(1.0), callback.schedule(0.0)
+    assert (start, end) == (1e-3, 5e-4)
+    for optimizer in (model.actor.optimizer, model.critic.optimizer):
+        # the last update at progress remaining 1/400 (SB3 counts it before the update)
+        assert optimizer.param_groups[0]["lr"] == pytest.approx(end, abs=2e-6)
+
+
+@pytest.mark.parametrize("start, end", [(0.0, 1e-4), (-1e-3, 0.0), (1e-3, -1e-4), ("1e-3", 0.0)])
+def test_zoo_learning_rate_callback_rejects_bad_rates(start, end):
+    from train.zoo import LinearLearningRate
+
+    name = "start" if start != 1e-3 else "end"
+    with pytest.raises(ValueError, match=name):
+        LinearLearningRate(start, end)
 
 
 @pytest.mark.slow

@@ -28,10 +28,13 @@ from .sb3_policies import (
     SplitCriticPolicy,
 )
 
-__all__ = ["Averaging", "Selection", "fold_whitening", "make_model", "train_sb3"]
+__all__ = ["Averaging", "LinearSchedule", "Selection", "fold_whitening", "make_model", "train_sb3"]
 
 
-class _linear_schedule:  # noqa: N801  (an SB3 schedule: progress remaining 1 -> 0)
+class LinearSchedule:
+    """An SB3 schedule (of the progress remaining, 1 -> 0) linear from ``start`` to ``end``:
+    the value of ``{linear: [start, end]}`` in a config."""
+
     def __init__(self, start: float, end: float):
         self.start, self.end = start, end
 
@@ -39,11 +42,11 @@ class _linear_schedule:  # noqa: N801  (an SB3 schedule: progress remaining 1 ->
         return self.end + (self.start - self.end) * progress_remaining
 
 
-def _schedule(key: str, value: dict) -> _linear_schedule:
+def _schedule(key: str, value: dict) -> LinearSchedule:
     """The schedule of a ``{linear: [start, end]}`` value of the model key ``key``."""
     if set(value) != {"linear"} or len(value["linear"]) != 2:
         raise ValueError(f"{key}: a number or {{linear: [start, end]}}, got {value!r}")
-    return _linear_schedule(*map(float, value["linear"]))
+    return LinearSchedule(*map(float, value["linear"]))
 
 
 def _resolve_policy_kwargs(kwargs: dict) -> dict:
@@ -69,7 +72,7 @@ def _resolve_policy_kwargs(kwargs: dict) -> dict:
     return kwargs
 
 
-def ent_coef_schedule(cfg: TrainConfig) -> _linear_schedule | None:
+def ent_coef_schedule(cfg: TrainConfig) -> LinearSchedule | None:
     """The schedule of ``cfg``'s ``model.ent_coef`` if it is ``{linear: [start, end]}``,
     else None. Only an on-policy algorithm reads its ``ent_coef`` anew at every update
     (SB3's PPO: ``loss = ... + ent_coef * entropy_loss``), so a schedule is for PPO only:

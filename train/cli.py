@@ -128,8 +128,9 @@ def main(argv: list[str] | None = None) -> int:
     cfg = TrainConfig.from_dict(data)
     command = "python -m train " + " ".join(shlex.quote(a) for a in
                                             (sys.argv[1:] if argv is None else argv))
-    print(f"training {cfg.algo.upper()} ({name}, {cfg.training}) for {cfg.timesteps} env "
-          f"steps, seed {args.seed}", flush=True)
+    runs = f" ({cfg.restarts} runs of {cfg.timesteps})" if cfg.restarts > 1 else ""
+    print(f"training {cfg.algo.upper()} ({name}, {cfg.training}) for {cfg.budget} env "
+          f"steps{runs}, seed {args.seed}", flush=True)
     rec, policy = run_trial(name, data, args.seed, args.env_id, args.random_episodes,
                             command=command)
     save_agent(policy, rec, out)

@@ -226,6 +226,12 @@ class TrainConfig:
     average : dict or None
         SB3 algorithms: weight averaging of the policy (:class:`AverageConfig`'s fields,
         e.g. ``{start: 1000000}``); None (default): the iterates as trained.
+    restarts : int
+        SB3 algorithms with ``select``: independent runs of ``timesteps`` each from fresh
+        initialisations (the first with the trial's seed, the others with seeds derived
+        from it, :func:`train.bench.algos.restart_seeds`); the trial returns the run whose
+        chosen check has the lowest validation cost (the same validation loads for all).
+        The budget is ``restarts * timesteps`` (:attr:`budget`). Default 1: one run.
     """
 
     algo: str
@@ -245,12 +251,19 @@ class TrainConfig:
     distill: dict | None = None
     select: dict | None = None
     average: dict | None = None
+    restarts: int = 1
+
+    @property
+    def budget(self) -> int:
+        """Env steps of training in all: ``restarts * timesteps``."""
+        return self.restarts * self.timesteps
 
     def __post_init__(self):
         if self.algo not in ALGOS:
             raise ValueError(f"algo must be one of {list(ALGOS)}, got {self.algo!r}")
         for name in ("timesteps", "n_envs", "eval_points"):
             check_int(name, getattr(self, name), 1, 10**12)
+        check_int("restarts", self.restarts, 1, 64)
         if not isinstance(self.loads, dict) or not self.loads or any(
             isinstance(w, bool) or not (isinstance(w, (int, float)) and w > 0)
             for w in self.loads.values()
@@ -321,6 +334,9 @@ class TrainConfig:
                         or self.select is not None or self.average is not None):
             raise ValueError("residual, shaping, distill, select and average are for the SB3 "
                              "algorithms")
+        if self.restarts > 1 and self.select is None:
+            raise ValueError(f"restarts: {self.restarts} runs need select: (the choice between "
+                             "them is on the validation loads); got select: null")
         if sb3:
             self._check_sb3()
 

@@ -5,12 +5,30 @@ from __future__ import annotations
 import time
 from typing import Any
 
+import numpy as np
+
 from ..config import TrainConfig
 from .evaluate import CurveCallback
 from .sb3_train import train_sb3
 from .search import train_random_search
 
-__all__ = ["train_algo"]
+__all__ = ["restart_seeds", "train_algo"]
+
+
+def restart_seeds(seed: int, restarts: int) -> list[int]:
+    """The seeds of a trial's ``restarts`` runs: ``seed`` itself first (one run is the
+    plain recipe), then 32-bit seeds drawn from ``numpy.random.SeedSequence((seed, k))``,
+    which no other trial's seed list shares by construction (``seed + k`` would make
+    seed 0's second run seed 1's first)."""
+    derived = [int(np.random.SeedSequence((seed, k)).generate_state(1)[0])
+               for k in range(1, restarts)]
+    return [int(seed), *derived]
+
+
+def _train_once(cfg: TrainConfig, seed: int, env_id: str, timed) -> tuple[Any, dict]:
+    if cfg.algo == "vrs":
+        return train_random_search(cfg, seed, env_id, timed)
+    return train_sb3(cfg, seed, env_id, timed)
 
 
 def train_algo(
@@ -22,23 +40,42 @@ def train_algo(
     """Train ``cfg`` with ``seed`` on ``env_id``; returns ``(policy, record)`` with
     ``record["train_seconds"]`` and ``record["train_cpu_seconds"]`` (wall and CPU time
     of training, evaluations excluded; on a shared machine the CPU time is the fairer
-    measure)."""
+    measure).
+
+    With ``cfg.restarts`` > 1 the runs follow one another (seeds :func:`restart_seeds`),
+    the learning curve of run k at steps offset by ``k * cfg.timesteps``; the policy and
+    record returned are those of the run whose selected check has the lowest validation
+    cost, with ``record["steps"]`` all runs' steps and ``record["restarts"]`` each run's
+    seed, chosen step and cost."""
     spent = [0.0, 0.0]
     last = [-1]
+    offset = [0]
 
     def timed(steps, policy):  # evaluation time is not training time
-        last[0] = steps
+        last[0] = offset[0] + steps
         t0, c0 = time.perf_counter(), time.process_time()
         if callback is not None:
-            callback(steps, policy)
+            callback(last[0], policy)
         spent[0] += time.perf_counter() - t0
         spent[1] += time.process_time() - c0
 
     t0, c0 = time.perf_counter(), time.process_time()
-    if cfg.algo == "vrs":
-        policy, record = train_random_search(cfg, seed, env_id, timed)
+    runs = []
+    for run_seed in restart_seeds(seed, cfg.restarts):
+        policy, record = _train_once(cfg, run_seed, env_id, timed)
+        offset[0] += record["steps"]
+        runs.append((policy, record, run_seed))
+    if len(runs) == 1:
+        policy, record = runs[0][:2]
     else:
-        policy, record = train_sb3(cfg, seed, env_id, timed)
+        best = min(range(len(runs)), key=lambda k: runs[k][1]["select"]["cost"])
+        policy, record = runs[best][:2]
+        record["steps"] = offset[0]
+        record["restarts"] = {
+            "chosen": best,
+            "runs": [{"seed": s, "steps": r["select"]["steps"], "cost": r["select"]["cost"]}
+                     for _, r, s in runs],
+        }
     record["train_seconds"] = time.perf_counter() - t0 - spent[0]
     record["train_cpu_seconds"] = time.process_time() - c0 - spent[1]
     if callback is not None and record["steps"] > last[0]:

@@ -73,7 +73,7 @@ def run_trial(
         "random_episodes": int(random_episodes),
         "command": command or f"python -m train.benchmark --config {name} --seeds {seed} "
         f"--env-id {env_id}",
-        "budget": cfg.timesteps,
+        "budget": cfg.budget,
         "steps": int(record.get("steps", 0)),
         "train_seconds": float(record["train_seconds"]),
         "train_cpu_seconds": float(record.get("train_cpu_seconds", np.nan)),

@@ -1,0 +1,94 @@
+"""Independent restarts of a run (``TrainConfig.restarts``): the first run is the recipe's
+own, the others have seeds of their own, and the trial returns the run whose selected check
+has the lowest validation cost, with the budget and the learning curve of all runs."""
+
+import pytest
+import yaml
+
+from train.bench import algos, evaluate
+from train.bench.algos import restart_seeds, train_algo
+from train.config import TrainConfig
+
+
+def _cfg(restarts=2, select=True, timesteps=100):
+    return TrainConfig(algo="sac", timesteps=timesteps, model={"policy": "MlpPolicy"},
+                       features=None, normalize={}, restarts=restarts,
+                       select={"episodes": 2, "every": 50, "start": 0} if select else None)
+
+
+def test_restart_seeds_start_with_the_trial_seed_and_are_shared_by_no_other_trial():
+    assert restart_seeds(7, 1) == [7]
+    lists = {seed: restart_seeds(seed, 4) for seed in range(50)}
+    assert all(s[0] == seed and len(set(s)) == 4 for seed, s in lists.items())
+    every = [x for s in lists.values() for x in s]
+    assert len(set(every)) == len(every)  # seed + k would give seed 0's run 2 to seed 1
+    assert all(isinstance(x, int) and 0 <= x < 2**32 for x in every)
+    assert restart_seeds(7, 3) == restart_seeds(7, 3) and restart_seeds(7, 2) == \
+        restart_seeds(7, 3)[:2]
+
+
+def test_budget_counts_every_run():
+    assert _cfg(restarts=3, timesteps=100).budget == 300 and _cfg(restarts=1).budget == 100
+
+
+@pytest.mark.parametrize("restarts, word", [(0, "restarts"), (True, "restarts"),
+                                            (2.0, "restarts"), (65, "restarts")])
+def test_bad_restarts_are_named(restarts, word):
+    with pytest.raises(ValueError, match=word):
+        _cfg(restarts=restarts)
+
+
+def test_restarts_need_selection():
+    with pytest.raises(ValueError, match="restarts: 2 runs need select"):
+        _cfg(restarts=2, select=False)
+    assert _cfg(restarts=1, select=False).restarts == 1
+
+
+def test_the_run_with_the_lowest_validation_cost_is_returned(monkeypatch):
+    cfg = _cfg(restarts=3)
+    seeds = restart_seeds(5, 3)
+    costs = dict(zip(seeds, (0.7, 0.5, 0.6), strict=True))  # the second run is the best
+    calls = []
+
+    def fake_train(cfg_, seed, env_id, timed):
+        calls.append(seed)
+        timed(0, f"policy-{seed}")
+        timed(cfg_.timesteps, f"policy-{seed}")
+        return f"policy-{seed}", {"steps": cfg_.timesteps,
+                                  "select": {"steps": 50, "cost": costs[seed]}}
+
+    monkeypatch.setattr(algos, "train_sb3", fake_train)
+    curve = []
+    policy, record = train_algo(cfg, 5, "ACLDBeam-v1", lambda s, p: curve.append((s, p)))
+    assert calls == seeds and policy == f"policy-{seeds[1]}"
+    assert record["steps"] == 300 and record["select"]["cost"] == 0.5
+    assert record["restarts"] == {"chosen": 1, "runs": [
+        {"seed": s, "steps": 50, "cost": costs[s]} for s in seeds]}
+    # each run's curve after the runs before it (the curve follows the policies trained)
+    assert [s for s, _ in curve] == [0, 100, 100, 200, 200, 300]
+    assert curve[1] == (100, f"policy-{seeds[0]}") and curve[-1] == (300, f"policy-{seeds[2]}")
+
+
+def test_one_run_is_the_plain_recipe(monkeypatch):
+    seen = []
+    monkeypatch.setattr(algos, "train_sb3", lambda cfg, seed, env_id, timed: (
+        seen.append(seed) or "p", {"steps": cfg.timesteps, "select": {"steps": 0, "cost": 1}}))
+    policy, record = train_algo(_cfg(restarts=1), 11, "ACLDBeam-v1")
+    assert seen == [11] and policy == "p" and "restarts" not in record
+
+
+def test_two_tiny_sac_runs_return_the_better_one():
+    """Real runs: the returned policy scores its run's chosen validation cost again, and
+    that cost is the lower of the two runs'."""
+    data = yaml.safe_load(open("train/benchmark/sac.yaml"))
+    data.update(timesteps=600, n_envs=4, eval_points=1, whiten_steps=128, restarts=2,
+                select={"episodes": 2, "every": 200, "start": 0})
+    data["model"] = {**data["model"], "learning_starts": 200, "buffer_size": 2000,
+                     "batch_size": 64}
+    policy, record = train_algo(TrainConfig.from_dict(data), 0, "ACLDBeam-v1")
+    runs = record["restarts"]["runs"]
+    assert [r["seed"] for r in runs] == restart_seeds(0, 2) and record["steps"] >= 1200
+    assert record["select"]["cost"] == min(r["cost"] for r in runs)
+    assert runs[0]["cost"] != runs[1]["cost"]  # independent runs
+    again = evaluate.validation_cost(policy, "ACLDBeam-v1", evaluate.validation_seeds(2))
+    assert again == pytest.approx(record["select"]["cost"], rel=1e-5)

@@ -66,7 +66,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="further config files (e.g. the ablations); alone, only these run")
     p.add_argument("--seeds", nargs="+", type=int, default=[0, 1, 2, 3, 4])
     p.add_argument("--timesteps", type=int, default=None,
-                   help="override every config's env-step budget (quick checks)")
+                   help="override every config's env steps per run (quick checks)")
     p.add_argument("--eval-points", type=int, default=None,
                    help="override the learning-curve evaluations per run")
     p.add_argument("--env-id", default=DEFAULT_ENV_ID, help=f"(default {DEFAULT_ENV_ID})")

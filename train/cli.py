@@ -58,7 +58,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="another config file of the same algorithm (default: the recipe)")
     p.add_argument("--seed", type=_seed, default=0, help=f"seed in [0, {MAX_SEED}] (default 0)")
     p.add_argument("--timesteps", type=_positive_int, default=None,
-                   help="env-step budget (default: the config's timesteps)")
+                   help="env steps per run (default: the config's timesteps)")
     p.add_argument("--n-envs", type=_positive_int, default=None,
                    help="sub-envs of the batched env (default: the config's)")
     p.add_argument("--load-case", type=_load_case_arg, default=None,

@@ -60,22 +60,20 @@ def train_algo(
         spent[1] += time.process_time() - c0
 
     t0, c0 = time.perf_counter(), time.process_time()
-    runs = []
-    for run_seed in restart_seeds(seed, cfg.restarts):
-        policy, record = _train_once(cfg, run_seed, env_id, timed)
-        offset[0] += record["steps"]
-        runs.append((policy, record, run_seed))
-    if len(runs) == 1:
-        policy, record = runs[0][:2]
-    else:
-        best = min(range(len(runs)), key=lambda k: runs[k][1]["select"]["cost"])
-        policy, record = runs[best][:2]
+    best, runs = None, []  # only the best run so far is kept alive (its model, its buffer)
+    for k, run_seed in enumerate(restart_seeds(seed, cfg.restarts)):
+        run = (k, *_train_once(cfg, run_seed, env_id, timed))
+        offset[0] += run[2]["steps"]
+        if cfg.restarts > 1:
+            sel = run[2]["select"]
+            runs.append({"seed": run_seed, "steps": sel["steps"], "cost": sel["cost"]})
+        if best is None or (runs and runs[-1]["cost"] < runs[best[0]]["cost"]):
+            best = run  # the first of equal costs is kept
+        run = None
+    chosen, policy, record = best
+    if runs:
         record["steps"] = offset[0]
-        record["restarts"] = {
-            "chosen": best,
-            "runs": [{"seed": s, "steps": r["select"]["steps"], "cost": r["select"]["cost"]}
-                     for _, r, s in runs],
-        }
+        record["restarts"] = {"chosen": chosen, "runs": runs}
     record["train_seconds"] = time.perf_counter() - t0 - spent[0]
     record["train_cpu_seconds"] = time.process_time() - c0 - spent[1]
     if callback is not None and record["steps"] > last[0]:

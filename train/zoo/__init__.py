@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from stable_baselines3.common.callbacks import BaseCallback
 
+from acld_gym.util.validate import check_real
 from train.bench.sb3_train import LinearSchedule
 
 __all__ = ["LinearLearningRate"]
@@ -37,11 +38,8 @@ class LinearLearningRate(BaseCallback):
 
     def __init__(self, start: float, end: float, verbose: int = 0):
         super().__init__(verbose)
-        for name, value, least in (("start", start, "positive"), ("end", end, "at least 0")):
-            ok = isinstance(value, (int, float)) and (value > 0 if name == "start" else value >= 0)
-            if not ok:
-                raise ValueError(f"{name}: expected a learning rate {least}, got {value!r}")
-        self.schedule = LinearSchedule(float(start), float(end))
+        self.schedule = LinearSchedule(check_real("start", start, 0.0, low_open=True),
+                                       check_real("end", end, 0.0))
 
     def _on_training_start(self) -> None:
         self.model.lr_schedule = self.schedule

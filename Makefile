@@ -44,8 +44,8 @@ studies: $(STAMP)
 agents: $(STAMP)
 	$(BIN)/python -m train.benchmark --algos vrs ppo sac --seeds 0 1 2 3 4 --resume --out runs/benchmark/v1
 	$(BIN)/python -m train.ship runs/benchmark/v1/agents/vrs-s0 vrs
-	$(BIN)/python -m train.ship runs/benchmark/v1/agents/ppo-s1 ppo
-	$(BIN)/python -m train.ship runs/benchmark/v1/agents/sac-s0 sac
+	$(BIN)/python -m train.ship runs/benchmark/v1 ppo --best ppo
+	$(BIN)/python -m train.ship runs/benchmark/v1 sac --best sac
 
 ## Lint + the test suite (slow tests excluded; see test-slow) + the documentation site.
 test: $(STAMP)

@@ -1,6 +1,7 @@
 """Independent restarts of a run (``TrainConfig.restarts``): the first run is the recipe's
 own, the others have seeds of their own, and the trial returns the run whose selected check
-has the lowest validation cost, with the budget and the learning curve of all runs."""
+has the lowest validation cost, with the budget of all runs and the learning curve of the
+run returned (each run's curve kept beside its cost)."""
 
 import pytest
 import yaml
@@ -58,15 +59,36 @@ def test_the_run_with_the_lowest_validation_cost_is_returned(monkeypatch):
                                   "select": {"steps": 50, "cost": costs[seed]}}
 
     monkeypatch.setattr(algos, "train_sb3", fake_train)
-    curve = []
-    policy, record = train_algo(cfg, 5, "ACLDBeam-v1", lambda s, p: curve.append((s, p)))
+    seen = []
+
+    def on_eval(steps, policy):
+        seen.append((steps, policy))
+        return {"policy": policy, "n": len(seen)}
+
+    policy, record = train_algo(cfg, 5, "ACLDBeam-v1", on_eval)
     assert calls == seeds and policy == f"policy-{seeds[1]}"
     assert record["steps"] == 300 and record["select"]["cost"] == 0.5
-    assert record["restarts"] == {"chosen": 1, "runs": [
-        {"seed": s, "steps": 50, "cost": costs[s]} for s in seeds]}
-    # each run's curve after the runs before it (the curve follows the policies trained)
-    assert [s for s, _ in curve] == [0, 100, 100, 200, 200, 300]
-    assert curve[1] == (100, f"policy-{seeds[0]}") and curve[-1] == (300, f"policy-{seeds[2]}")
+    runs = record["restarts"]["runs"]
+    assert record["restarts"]["chosen"] == 1
+    assert [{k: r[k] for k in ("seed", "steps", "cost")} for r in runs] == [
+        {"seed": s, "steps": 50, "cost": costs[s]} for s in seeds]
+    # every run is evaluated from its own step 0; each run's curve is its own policies'
+    assert [s for s, _ in seen] == [0, 100] * 3
+    for r in runs:
+        assert [(p["steps"], p["policy"]) for p in r["curve"]] == [
+            (0, f"policy-{r['seed']}"), (100, f"policy-{r['seed']}")]
+    # the trial's curve is the returned run's: it ends at that run's policy, not the last run's
+    assert record["curve"] == runs[1]["curve"] and record["curve"][-1]["n"] == 4
+
+
+def test_a_run_whose_curve_stops_short_gets_a_last_point(monkeypatch):
+    monkeypatch.setattr(algos, "train_sb3", lambda cfg, seed, env_id, timed: (
+        timed(0, "p0"), ("p", {"steps": cfg.timesteps}))[1])
+    policy, record = train_algo(_cfg(restarts=1, select=False), 3, "ACLDBeam-v1",
+                                lambda s, p: {"policy": p})
+    assert record["curve"] == [{"steps": 0, "policy": "p0"}, {"steps": 100, "policy": "p"}]
+    _, record = train_algo(_cfg(restarts=1, select=False), 3, "ACLDBeam-v1")
+    assert record["curve"] == []  # no callback, no curve
 
 
 def test_one_run_is_the_plain_recipe(monkeypatch):

@@ -42,40 +42,47 @@ def train_algo(
     of training, evaluations excluded; on a shared machine the CPU time is the fairer
     measure).
 
-    With ``cfg.restarts`` > 1 the runs follow one another (seeds :func:`restart_seeds`),
-    the learning curve of run k at steps offset by ``k * cfg.timesteps``; the policy and
-    record returned are those of the run whose selected check has the lowest validation
-    cost, with ``record["steps"]`` all runs' steps and ``record["restarts"]`` each run's
-    seed, chosen step and cost."""
+    ``callback(steps, policy)`` evaluates the policy a run has at ``steps`` env steps of
+    that run; its value (a mapping, or None) is a point of the learning curve, and
+    ``record["curve"]`` is the list of ``{"steps": steps, **point}``, ending at the run's
+    last step (where a run selects a checkpoint, the policy returned is that check's).
+
+    With ``cfg.restarts`` > 1 the runs follow one another (seeds :func:`restart_seeds`);
+    the policy and record returned are those of the run whose selected check has the
+    lowest validation cost, with ``record["steps"]`` all runs' steps, ``record["curve"]``
+    the returned run's curve (its steps count from the start of that run: the curve is
+    the training of the policy returned; the budget spent is ``record["steps"]``) and
+    ``record["restarts"]`` each run's seed, chosen step, cost and curve."""
     spent = [0.0, 0.0]
-    last = [-1]
-    offset = [0]
+    curve: list = []  # the current run's
 
     def timed(steps, policy):  # evaluation time is not training time
-        last[0] = offset[0] + steps
         t0, c0 = time.perf_counter(), time.process_time()
         if callback is not None:
-            callback(last[0], policy)
+            curve.append({"steps": int(steps), **(callback(steps, policy) or {})})
         spent[0] += time.perf_counter() - t0
         spent[1] += time.process_time() - c0
 
     t0, c0 = time.perf_counter(), time.process_time()
-    best, runs = None, []  # only the best run so far is kept alive (its model, its buffer)
+    best, runs, total = None, [], 0  # only the best run so far is kept alive (model, buffer)
     for k, run_seed in enumerate(restart_seeds(seed, cfg.restarts)):
-        run = (k, *_train_once(cfg, run_seed, env_id, timed))
-        offset[0] += run[2]["steps"]
+        curve = []
+        policy, record = _train_once(cfg, run_seed, env_id, timed)
+        if callback is not None and (not curve or record["steps"] > curve[-1]["steps"]):
+            timed(record["steps"], policy)  # the curve reaches the run's last step
+        record["curve"] = curve
+        total += record["steps"]
         if cfg.restarts > 1:
-            sel = run[2]["select"]
-            runs.append({"seed": run_seed, "steps": sel["steps"], "cost": sel["cost"]})
+            sel = record["select"]
+            runs.append({"seed": run_seed, "steps": sel["steps"], "cost": sel["cost"],
+                         "curve": curve})
         if best is None or (runs and runs[-1]["cost"] < runs[best[0]]["cost"]):
-            best = run  # the first of equal costs is kept
-        run = None
+            best = (k, policy, record)  # the first of equal costs is kept
+        policy = record = None
     chosen, policy, record = best
     if runs:
-        record["steps"] = offset[0]
+        record["steps"] = total
         record["restarts"] = {"chosen": chosen, "runs": runs}
     record["train_seconds"] = time.perf_counter() - t0 - spent[0]
     record["train_cpu_seconds"] = time.process_time() - c0 - spent[1]
-    if callback is not None and record["steps"] > last[0]:
-        callback(record["steps"], policy)  # the learning curve ends at the final policy
     return policy, record

@@ -19,7 +19,7 @@ Two evaluators:
 from __future__ import annotations
 
 import json
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -50,8 +50,9 @@ __all__ = [
 ]
 
 DEFAULT_ENV_ID = acld_gym.ENV_ID
-#: Learning-curve callback of a training run: ``callback(env_steps, policy)``.
-CurveCallback = Callable[[int, Any], None]
+#: Learning-curve callback of a training run: ``callback(env_steps, policy)`` returns the
+#: curve's point there (a mapping, or None): :func:`train.bench.algos.train_algo`.
+CurveCallback = Callable[[int, Any], Mapping | None]
 #: Evaluation cases, in table order (every named load case).
 CASES: tuple = LOAD_CASES
 

@@ -42,7 +42,8 @@ def run_trial(
     command: str | None = None,
 ) -> tuple[dict, object]:
     """Train one (config, seed) and evaluate it; returns ``(record, policy)``: the trial's
-    record (JSON-able: the learning curve, mean ISE per case at each evaluation, batched;
+    record (JSON-able: the learning curve, mean ISE per case at each evaluation, batched --
+    with restarts, the returned run's, ``train_algo``;
     the final ISE per case, single-env rollouts; the training wall time, evaluations
     excluded; the command) and the final policy. With ``out``, the policy is saved as an
     agent in :func:`agent_dir`."""
@@ -54,11 +55,10 @@ def run_trial(
     torch.set_num_threads(1)
     cfg = TrainConfig.from_dict(config)
     episodes = eval_episodes(random_episodes)
-    curve = []
 
-    def on_eval(steps: int, policy) -> None:
+    def on_eval(steps: int, policy) -> dict:
         ise = batched_ise(policy, env_id, episodes)
-        curve.append({"steps": int(steps), "ise": {str(c): v for c, v in ise.items()}})
+        return {"ise": {str(c): v for c, v in ise.items()}}
 
     t0 = time.perf_counter()
     policy, record = train_algo(cfg, seed, env_id, on_eval)
@@ -79,9 +79,10 @@ def run_trial(
         "train_cpu_seconds": float(record.get("train_cpu_seconds", np.nan)),
         "wall_seconds": wall,
         "final_ise": {str(c): v for c, v in final.items()},
-        "curve": curve,
+        "curve": record["curve"],
         "record": {
-            k: v for k, v in record.items() if k not in ("train_seconds", "train_cpu_seconds")
+            k: v for k, v in record.items()
+            if k not in ("train_seconds", "train_cpu_seconds", "curve")
         },
     }
     if out is not None:

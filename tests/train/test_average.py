@@ -97,7 +97,7 @@ def test_a_run_returns_the_average_of_its_iterates(monkeypatch):
 
     monkeypatch.setattr(sb3_train.Averaging, "update", spy)
     data = yaml.safe_load(open("train/benchmark/sac.yaml"))
-    data.update(timesteps=600, n_envs=4, eval_points=1, whiten_steps=128, select=None,
+    data.update(timesteps=600, n_envs=4, eval_points=1, whiten_steps=128, select=None, restarts=1,
                 average={"start": 300})
     data["model"] = {**data["model"], "learning_starts": 200, "buffer_size": 2000,
                      "batch_size": 64}

@@ -31,6 +31,16 @@ def test_committed_results_hold_every_seed_and_the_goals():
             assert all(0 < s[c] < 10 for c in ("1", "2", "3", "random"))
 
 
+def test_a_restarted_recipe_shows_its_runs_and_the_returned_runs_curve():
+    """SAC's recipe is two runs per seed (restarts: 2): the budget counts both, the table
+    says so, and the curve is the returned run's, ending at one run's steps."""
+    summary = json.loads(RESULTS.read_text())
+    sac = summary["algorithms"]["sac"]
+    assert sac["restarts"] == 2 and sac["budget"] == 2 * sac["curve"][-1]["steps"]
+    assert f"| sac (sac) | {sac['budget']:,} (2 runs) |" in markdown(summary)
+    assert "(1 runs)" not in markdown(summary)
+
+
 def test_write_replaces_only_the_block(tmp_path, capsys):
     page = tmp_path / "page.md"
     begin = BEGIN.format(src=RESULTS, dst=page)

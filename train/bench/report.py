@@ -68,6 +68,7 @@ def summarize(records: list[dict], refs: dict) -> dict:
         out["algorithms"][name] = {
             "algo": runs[0]["algo"],
             "budget": runs[0]["budget"],
+            "restarts": int(runs[0]["config"].get("restarts", 1)),  # runs per seed
             "seeds": [r["seed"] for r in runs],
             "ise_rel_lqr": stats,
             "goals": goals,
@@ -93,6 +94,13 @@ def summarize(records: list[dict], refs: dict) -> dict:
     return out
 
 
+def budget(a: dict) -> str:
+    """An algorithm's budget per seed as the table prints it: ``4,000,000 (2 runs)`` when
+    each seed is several runs (``restarts:``)."""
+    runs = a.get("restarts", 1)
+    return f"{a['budget']:,}" + (f" ({runs} runs)" if runs > 1 else "")
+
+
 def markdown(summary: dict) -> str:
     """The summary as markdown: the IQM table, the goals and the per-seed table."""
 
@@ -112,7 +120,7 @@ def markdown(summary: dict) -> str:
     for name, a in summary["algorithms"].items():
         t, cpu = a["train_seconds"], a["train_cpu_seconds"]
         lines.append(
-            f"| {name} ({a['algo']}) | {a['budget']:,} | {len(a['seeds'])} | "
+            f"| {name} ({a['algo']}) | {budget(a)} | {len(a['seeds'])} | "
             + " | ".join(cell(a["ise_rel_lqr"][str(c)]) for c in CASES)
             + f" | {t['iqm']:.0f} / {cpu['iqm']:.0f}; {t['max']:.0f} / {cpu['max']:.0f} |"
         )
@@ -213,7 +221,9 @@ def _draw_case(ax, summary: dict, key: str, zoom_from: float) -> list[float]:
 def curves_figure(summary: dict):
     """IQM ISE / LQR vs env steps per case with 95 % bands and the reference levels; a
     hollow diamond at the budget marks the reported IQM, which is the selected checkpoint's
-    when the config selects one (``select:``), not the last point of the curve.
+    when the config selects one (``select:``), not the last point of the curve. With
+    ``restarts:`` the curve is the returned run's (steps of that run) and the budget, where
+    the diamond sits, counts every run.
 
     The top row shows whole runs on a log ISE axis (the passive beam is ~4x LQR); the bottom
     row zooms on the end of training, from a tenth of the smallest budget on, where the

@@ -7,23 +7,14 @@ import pytest
 import torch
 import yaml
 
+from tests.train.tiny_sb3 import LinearModel as _Model
+from tests.train.tiny_sb3 import tiny_sac
 from train.bench.sb3_train import Averaging
 from train.config import TrainConfig
 
 
 def _cfg(**average):
-    return TrainConfig(algo="sac", timesteps=10, model={"policy": "MlpPolicy"},
-                       features=None, normalize={}, average=average or None)
-
-
-class _Model:
-    def __init__(self):
-        self.policy = torch.nn.Linear(2, 1)
-
-    def set(self, value: float) -> None:
-        with torch.no_grad():
-            self.policy.weight.fill_(value)
-            self.policy.bias.fill_(-value)
+    return tiny_sac(average=average or None)
 
 
 def test_uniform_average_from_start():

@@ -6,15 +6,15 @@ run returned (each run's curve kept beside its cost)."""
 import pytest
 import yaml
 
+from tests.train.tiny_sb3 import tiny_sac
 from train.bench import algos, evaluate
 from train.bench.algos import restart_seeds, train_algo
 from train.config import TrainConfig
 
 
 def _cfg(restarts=2, select=True, timesteps=100):
-    return TrainConfig(algo="sac", timesteps=timesteps, model={"policy": "MlpPolicy"},
-                       features=None, normalize={}, restarts=restarts,
-                       select={"episodes": 2, "every": 50, "start": 0} if select else None)
+    return tiny_sac(timesteps, restarts=restarts,
+                    select={"episodes": 2, "every": 50, "start": 0} if select else None)
 
 
 def test_restart_seeds_start_with_the_trial_seed_and_are_shared_by_no_other_trial():

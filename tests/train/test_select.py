@@ -8,6 +8,8 @@ import torch
 import yaml
 
 from baselines.policies import LQRPolicy, PassivePolicy
+from tests.train.tiny_sb3 import LinearModel as _Model
+from tests.train.tiny_sb3 import tiny_sac
 from train.bench import evaluate
 from train.bench.sb3_train import Selection
 from train.compare import HELDOUT_SEEDS
@@ -38,13 +40,7 @@ def test_validation_cost_is_one_for_the_passive_beam(design_env):
 
 
 def _cfg(**select):
-    return TrainConfig(algo="sac", timesteps=10, model={"policy": "MlpPolicy"},
-                       features=None, normalize={}, select=select or None)
-
-
-class _Model:
-    def __init__(self):
-        self.policy = torch.nn.Linear(2, 1)
+    return tiny_sac(select=select or None)
 
 
 def test_selection_keeps_the_best_check_and_restores_it(monkeypatch):

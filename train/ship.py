@@ -34,7 +34,12 @@ def best_seed(out: str | Path, config: str) -> int:
     if config not in algos:
         raise ValueError(f"config {config!r} is not in {str(path)!r}; it has "
                          f"{sorted(algos)}")
-    per_seed = algos[config]["per_seed"]
+    per_seed = algos[config].get("per_seed")
+    keys = ("seed", *THESIS_CASES)
+    if not per_seed or not all(isinstance(r, dict) and all(k in r for k in keys)
+                               for r in per_seed):
+        raise ValueError(f"{str(path)!r}: config {config!r} needs per_seed rows with "
+                         f"{list(keys)}")
     means = [sum(float(r[c]) for c in THESIS_CASES) / len(THESIS_CASES) for r in per_seed]
     return int(per_seed[means.index(min(means))]["seed"])
 

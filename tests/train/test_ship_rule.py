@@ -49,6 +49,10 @@ def test_bad_inputs_are_named(tmp_path):
     shutil.copy(RESULTS, tmp_path / "results.json")
     with pytest.raises(ValueError, match="config 'nope' is not in"):
         best_seed(tmp_path, "nope")
+    bad = _results(tmp_path / "bad", [{"seed": 0, "1": 0.9, "2": 0.9}])  # no case 3
+    with pytest.raises(ValueError, match=r"needs per_seed rows with \['seed', '1', '2', '3'\]"):
+        best_seed(bad, "x")
+    assert best_seed(tmp_path, "sac") == 1  # a well-formed file still reads
 
 
 def test_cli_ships_the_best_seed(tmp_path, capsys):

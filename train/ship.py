@@ -11,6 +11,7 @@ import json
 import sys
 from pathlib import Path
 
+from acld_gym.physics.loads import THESIS_CASES
 from acld_gym.util.atomic import write_text
 
 from .agent import CURVE_FILE, META_FILE, MODEL_FILE, POLICY_FILE, STATS_FILE, TrainedAgent
@@ -18,8 +19,9 @@ from .compare import AGENTS_DIR
 
 __all__ = ["best_seed", "ship", "main"]
 
-#: The cases the shipping rule looks at: the thesis's (the held-out random loads take no part).
-THESIS_CASES = ("1", "2", "3")
+#: The cases the shipping rule looks at, as results.json keys them: the thesis's (the held-out
+#: random loads take no part).
+RULE_CASES = tuple(str(c) for c in THESIS_CASES)
 
 
 def best_seed(out: str | Path, config: str) -> int:
@@ -35,12 +37,12 @@ def best_seed(out: str | Path, config: str) -> int:
         raise ValueError(f"config {config!r} is not in {str(path)!r}; it has "
                          f"{sorted(algos)}")
     per_seed = algos[config].get("per_seed")
-    keys = ("seed", *THESIS_CASES)
+    keys = ("seed", *RULE_CASES)
     if not per_seed or not all(isinstance(r, dict) and all(k in r for k in keys)
                                for r in per_seed):
         raise ValueError(f"{str(path)!r}: config {config!r} needs per_seed rows with "
                          f"{list(keys)}")
-    means = [sum(float(r[c]) for c in THESIS_CASES) / len(THESIS_CASES) for r in per_seed]
+    means = [sum(float(r[c]) for c in RULE_CASES) / len(RULE_CASES) for r in per_seed]
     return int(per_seed[means.index(min(means))]["seed"])
 
 

@@ -15,6 +15,7 @@ from functools import lru_cache
 import numpy as np
 
 from acld_gym.design.discrete import SampledSystem, discretize
+from acld_gym.design.feedback import THESIS_LQR_WEIGHT, discrete_lqr_gain
 from acld_gym.design.observer import (
     MODEL_STD,
     DiscreteObserver,
@@ -67,6 +68,13 @@ class NominalDesign:
     def modes(self) -> np.ndarray:
         """Damped natural frequencies of the nominal truth plant [rad/s], ascending."""
         return self.design.truth.natural_frequencies()
+
+    def lqr_gain(self, weight: float = THESIS_LQR_WEIGHT) -> np.ndarray:
+        r"""The discrete LQR gain K (1, k) on the sampled reduced model, V = -K x_r, with the
+        thesis's weights :math:`Q = w\,S_R^T S_R`, R = 1 (eqs. 65-67; ``weight`` = w)."""
+        K, _ = discrete_lqr_gain(self.reduced.Ad, self.reduced.Bd,
+                                 self.design.state_weight(weight), np.eye(1))
+        return K
 
     def observer(self, kind: str) -> DiscreteObserver:
         """The sampled observer ``"kalman"`` or ``"thesis"``."""

@@ -26,7 +26,7 @@ from acld_gym.envs.checks import check_actions
 from acld_gym.envs.config import EnvConfig
 from acld_gym.envs.episode import fixed_plant, passive_plant
 from acld_gym.envs.loadcode import LoadCodes
-from acld_gym.envs.scale import PassiveCost
+from acld_gym.envs.scale import LQRCost, PassiveCost
 from acld_gym.envs.step import (
     INFO_KEYS,
     OBS_HIST,
@@ -115,8 +115,11 @@ class BatchStep:
         #: The reward scale c of each env's episode (:mod:`acld_gym.envs.scale`; ones
         #: unless ``reward_scale``): every reward is divided by it.
         self.reward_scale = np.ones(N)
-        self.passive_cost = (PassiveCost(passive_plant(nom, c), nom.output, self.steps, c.y_ref)
-                             if c.reward_scale == "passive" else None)
+        #: The reward scale's cost on a list of loads (None without ``reward_scale``).
+        self.scale_cost = (
+            PassiveCost(passive_plant(nom, c), nom.output, self.steps, c.y_ref)
+            if c.reward_scale == "passive" else
+            LQRCost(c, self.steps) if c.reward_scale == "lqr" else None)
         #: The configuration's plant (the nominal one, shifted to its temperature, with its
         #: amplifier); an episode's own when drawn (param_noise, temperature_range).
         self.base_plant = fixed_plant(nom, c)
@@ -191,8 +194,8 @@ class BatchStep:
                 self.GT_env[i] = self.fused_matrix(plant).T if plant is not self.base_plant \
                     else self.GT
             self.plants[i] = plant
-        if self.passive_cost is not None:
-            self.reward_scale[rows] = self.passive_cost([loads[j] for j in range(len(rows))])
+        if self.scale_cost is not None:
+            self.reward_scale[rows] = self.scale_cost([loads[j] for j in range(len(rows))])
         if self.compiled and self.codes.version != self._codes_version:
             self.core.set_loads(self.codes.comp, self.codes.ncomp, self.codes.pool)
             self._codes_version = self.codes.version
@@ -240,7 +243,7 @@ class BatchStep:
         """A compiled vector step's 5-tuple with the reward scale applied (the reward divided
         by :attr:`reward_scale`, ``info["reward_scale"]``, log c appended to the
         observation): ``res`` itself without ``reward_scale``."""
-        if self.passive_cost is None:
+        if self.scale_cost is None:
             return res
         obs, reward, terminated, truncated, info = res
         self.scale_info(info)
@@ -248,7 +251,7 @@ class BatchStep:
 
     def scaled_one(self, res):
         """:meth:`scaled` for the compiled ``step_one`` of env 0 (None stays None)."""
-        if res is None or self.passive_cost is None:
+        if res is None or self.scale_cost is None:
             return res
         obs, reward, terminated, truncated, info = res
         s = float(self.reward_scale[0])
@@ -260,7 +263,7 @@ class BatchStep:
     def scale_info(self, info: dict, rows=None) -> None:
         """Add ``info["reward_scale"]`` (and its mask) of ``rows`` (default all) to a vector
         info, with ``reward_scale`` set."""
-        if self.passive_cost is not None:
+        if self.scale_cost is not None:
             s = self.reward_scale if rows is None else self.reward_scale[rows]
             info["reward_scale"] = s.copy()
             info["_reward_scale"] = np.ones(s.shape, dtype=bool)
@@ -294,7 +297,7 @@ class BatchStep:
         y = self.OUT[:, lay.out_y].copy()
         volts = v if lay.out_voltage is None else self.OUT[:, lay.out_voltage].copy()
         reward, r_y, r_v = reward_terms(y, volts, c.y_ref, c.lam, V_LIMIT)
-        if self.passive_cost is not None:
+        if self.scale_cost is not None:
             reward = reward / self.reward_scale
         return StepResult(obs=self.observations(), reward=reward, reward_deflection=r_y,
                           reward_voltage=r_v,

@@ -100,8 +100,9 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
     tip deflection [m] at the end of the step and ``V`` the patch voltage at the end of
     the step (``info["voltage"]``: the clipped action unless the actuator options are set).
     The two terms are ``info["reward_deflection"]`` and ``info["reward_voltage"]``.
-    With ``reward_scale="passive"`` (a training aid, off by default) the reward is divided
-    by the episode's passive cost c, ``info["reward_scale"]``; the terms stay unscaled.
+    With ``reward_scale="passive"`` or ``"lqr"`` (training aids, off by default) the reward
+    is divided by the episode's passive, or LQR's, cost c, ``info["reward_scale"]``; the
+    terms stay unscaled.
 
     ## Starting State
 
@@ -165,7 +166,10 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
     | ``temperature_range`` | None | (low, high) [°C]: a temperature per episode, uniform |
     | ``reward_scale`` | None | ``"passive"``: each reward of an episode divided by c, the |
     | | | passive beam's mean step cost on the episode's load (``info["reward_scale"]``; |
-    | | | ``acld_gym.envs.scale``); the passive policy's return is then exactly -T |
+    | | | ``acld_gym.envs.scale``); the passive policy's return is then exactly -T. |
+    | | | ``"lqr"``: divided by LQR's mean step cost on the load (a noise-free episode |
+    | | | of this configuration under the thesis's LQR law): the return is -T times |
+    | | | the episode's cost relative to LQR's |
     | ``observe_reward_scale`` | False | append log c to the observation as its last entry |
     | | | (privileged, for a critic; n + 1 entries); needs ``reward_scale`` |
     | ``env_id`` | ``"ACLDBeam-v1"`` | the registered id of the configuration (fingerprint) |
@@ -205,7 +209,8 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
       accepted, and the actuator (``actuator_delay``, ``amplifier_bandwidth``,
       ``slew_rate``), temperature (``temperature``, ``temperature_range``) and reward
       scale (``reward_scale``, ``observe_reward_scale``) options exist, all off by
-      default: v1's dynamics, rewards and observations are unchanged.
+      default: v1's dynamics, rewards and observations are unchanged. acld-gym 0.7.0 adds
+      ``reward_scale="lqr"`` (off by default).
     * v0: the thesis configuration (``acld_gym.envs.presets.PRESETS["ACLDBeam-v0"]``):
       the thesis's 38-state mesh, its 6-state design model and observers, the same
       dynamics, reward, spaces and episode. It differs from v1 with ``mesh="thesis"`` in
@@ -308,7 +313,7 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
                 "clipped": False, "tip_load": float(b.tip_loads()[0]), "time": 0.0,
                 "xr_true": np.zeros(self.nom.design.reduced.order), "terminated_by": None,
                 "reward_deflection": 0.0, "reward_voltage": 0.0}
-        if b.passive_cost is not None:
+        if b.scale_cost is not None:
             info["reward_scale"] = float(b.reward_scale[0])
         return b.observations()[0], info
 
@@ -318,7 +323,7 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
         b = self._batch
         if b.core is None:
             return _no_fast_path
-        if b.passive_cost is None:
+        if b.scale_cost is None:
             return b.core.step_one
         step_one, scaled_one = b.core.step_one, b.scaled_one
         return lambda action: scaled_one(step_one(action))
@@ -348,7 +353,7 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
             w = self.np_random.normal(0.0, self.sensor_noise) if self.sensor_noise else 0.0
             inputs = np.append(f[0], w)[None]
         out = _single(b.advance(v, inputs), float(requested[0]), float(v[0]), k + 1, self.dt)
-        if b.passive_cost is not None:
+        if b.scale_cost is not None:
             out[4]["reward_scale"] = float(b.reward_scale[0])
         return out
 

@@ -113,9 +113,9 @@ class EnvConfig:
         None, "°C", "draw the temperature per episode, uniform in (low, high); None: "
                     "always temperature")
     reward_scale: str | None = _f(
-        None, "-", "None (the reward as defined) or 'passive': each reward of an episode "
-                   "divided by the passive beam's mean step cost on its load "
-                   "(acld_gym.envs.scale; info['reward_scale'])")
+        None, "-", "None (the reward as defined), 'passive' or 'lqr': each reward of an "
+                   "episode divided by the passive beam's, or LQR's, mean step cost on its "
+                   "load (acld_gym.envs.scale; info['reward_scale'])")
     observe_reward_scale: bool = _f(
         False, "-", "append log(reward scale) to the observation as its last entry: "
                     "privileged, for a critic only; needs reward_scale")

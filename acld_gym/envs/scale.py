@@ -13,6 +13,15 @@ not act at zero voltage) driven by that load. The passive policy's return is the
 nothing. Random loads differ in c by six decades (5e-6 .. 10 on ``ACLDBeam-v1``), so
 without the scale a few violent loads dominate every gradient and the critic's targets.
 
+With ``reward_scale="lqr"`` c is instead LQR's mean step cost on the episode's load: the
+unscaled cost (deflection and voltage terms, :func:`acld_gym.envs.step.reward_terms`) of a
+noise-free episode of the configuration's env (its plant, amplifier, delay and observer)
+under the thesis's LQR law, saturated at +/-120 V (:class:`LQRCost`). The return is then
+``-T`` times the episode's cost relative to LQR's -- the benchmark's ISE / LQR per
+episode, with the voltage term -- and exactly ``-T`` for the LQR policy without sensor
+noise. It costs one more (noise-free) episode per reset, batched over the loads reset
+together.
+
 c is known at reset (the load of an episode is drawn at reset), and is reported as
 ``info["reward_scale"]``; the reward terms ``info["reward_deflection"]`` and
 ``info["reward_voltage"]`` stay unscaled. Where the episode's plant is drawn
@@ -33,10 +42,10 @@ from acld_gym.design.discrete import SampledSystem
 from acld_gym.envs.step import load_schedule
 from acld_gym.physics.loads import TipLoad
 
-__all__ = ["REWARD_SCALES", "SCALE_FLOOR", "PassiveCost"]
+__all__ = ["REWARD_SCALES", "SCALE_FLOOR", "PassiveCost", "LQRCost"]
 
 #: Values of ``EnvConfig.reward_scale``.
-REWARD_SCALES = (None, "passive")
+REWARD_SCALES = (None, "passive", "lqr")
 
 #: Smallest reward scale c (a passive tip RMS of 1 nm at ``y_ref`` = 1 mm).
 SCALE_FLOOR = 1e-12
@@ -82,3 +91,47 @@ class PassiveCost:
                 acc += y * y
             out[a:a + len(part)] = acc / (self.steps * self.y_ref**2)
         return np.maximum(out, SCALE_FLOOR)
+
+
+
+class LQRCost:
+    """LQR's mean step cost c on given tip loads (``reward_scale="lqr"``; module docstring):
+    a noise-free episode of the configuration's env under the thesis's LQR law (the
+    reference of :class:`baselines.policies.LQRPolicy`), its unscaled cost over all T steps.
+
+    Parameters
+    ----------
+    config : the env's configuration (:class:`acld_gym.envs.config.EnvConfig`); the
+        episodes run on it without sensor noise, on its fixed plant (``param_noise`` and
+        ``temperature_range`` off), observed through its observer's estimate.
+    steps : T, steps per episode.
+    """
+
+    def __init__(self, config, steps: int):
+        self.config = config.replace(reward_scale=None, observe_reward_scale=False,
+                                     obs_mode="estimate", sensor_noise=0.0, param_noise=0.0,
+                                     temperature_range=None)
+        self.steps = int(steps)
+        nom = self.config.nominal()
+        gain = nom.lqr_gain()[0]
+        #: The law on the observation's reduced-state entries: V = -obs[:k] @ gain [V].
+        self.gain = gain * nom.xr_scale
+        self._batches: dict = {}  # a BatchStep per number of loads asked at once
+
+    def __call__(self, loads: list[TipLoad]) -> np.ndarray:
+        """c of each load in ``loads`` (len(loads),), at least :data:`SCALE_FLOOR`."""
+        from acld_gym.envs.batch import BatchStep  # the env's own step (batch imports us)
+        from acld_gym.physics.actuator import V_LIMIT
+
+        n = len(loads)
+        b = self._batches.get(n)
+        if b is None:
+            b = self._batches[n] = BatchStep(self.config, n, self.steps)
+        b.start_episodes(np.arange(n), list(loads), [None] * n, np.zeros((n, self.steps + 1)))
+        k = self.gain.shape[0]
+        obs, acc = b.observations(), np.zeros(n)
+        for _ in range(self.steps):
+            v = np.clip(-(obs[:, :k].astype(np.float64) @ self.gain), -V_LIMIT, V_LIMIT)
+            obs, reward, _, _, _ = b.vector_step(v.astype(np.float32))  # as an agent's action
+            acc -= reward
+        return np.maximum(acc / self.steps, SCALE_FLOOR)

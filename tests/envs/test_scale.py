@@ -112,3 +112,77 @@ def test_check_env_with_the_options():
 def test_bad_options_name_the_field(kwargs, match):
     with pytest.raises(ValueError, match=match):
         EnvConfig(**kwargs)
+
+
+# --- reward_scale="lqr": c is LQR's own cost --------------------------------------------------
+
+
+def _policy_episode(env, policy, seed):
+    """The scaled return and the unscaled step costs of ``policy`` on one episode."""
+    obs, info = env.reset(seed=seed)
+    total, cost, done = 0.0, [], False
+    while not done:
+        action, _ = policy.predict(obs[: env.observation_space.shape[0]])
+        obs, r, te, tr, info = env.step(action)
+        total += r
+        cost.append(-(info["reward_deflection"] + info["reward_voltage"]))
+        done = te or tr
+    return total, info["reward_scale"], np.asarray(cost)
+
+
+@pytest.mark.parametrize("case, changes", [
+    (1, {}),
+    (3, {}),
+    ("random", {"actuator_delay": 1, "amplifier_bandwidth": 2000.0}),  # the env's own chain
+    ("random", {"temperature": 35.0, "observer": "thesis"}),
+])
+def test_lqr_return_is_minus_steps_without_noise(case, changes):
+    """Closed form: c is LQR's mean step cost on the load, so the thesis LQR (the baseline
+    policy, run through the env) returns exactly -T on every load and plant option when the
+    sensor is noise-free."""
+    from baselines.policies import LQRPolicy
+
+    env = ACLDBeamEnv(load_case=case, reward_scale="lqr", sensor_noise=0.0, **changes)
+    lqr = LQRPolicy.for_env(env)
+    total, c, cost = _policy_episode(env, lqr, seed=5)
+    assert total == pytest.approx(-env.max_steps, rel=1e-9)
+    assert c == pytest.approx(cost.mean(), rel=1e-9)
+    assert np.abs(env.unwrapped.batch.scale_cost([env.unwrapped.batch.loads[0]])[0] - c) \
+        <= 1e-12 * c
+
+
+def test_lqr_scale_against_passive_and_with_sensor_noise():
+    """LQR's c is the passive c over LQR's gain on the load (the benchmark's passive / LQR
+    ratio: 3.73 on case 1, 1.54 on case 3, with noise); with the default sensor noise LQR's
+    scaled return stays within 1 % of -T."""
+    from baselines.policies import LQRPolicy
+
+    c = {}
+    for scale in ("passive", "lqr"):
+        env = ACLDBeamEnv(load_case=1, reward_scale=scale)
+        c[scale] = env.reset(seed=0)[1]["reward_scale"]
+    assert 3.2 < c["passive"] / c["lqr"] < 3.8
+    env = ACLDBeamEnv(load_case=1, reward_scale="lqr")
+    total, _, _ = _policy_episode(env, LQRPolicy.for_env(env), seed=3)
+    assert total == pytest.approx(-env.max_steps, rel=1e-2)
+
+
+def test_lqr_scale_vector_env_pickle_and_check_env():
+    import pickle
+
+    venv = gym.make_vec("ACLDBeam-v1", num_envs=3, load_case="random", episode_length=0.1,
+                        reward_scale="lqr", observe_reward_scale=True)
+    obs, info = venv.reset(seed=2)
+    single = [ACLDBeamEnv(load_case="random", episode_length=0.1, reward_scale="lqr")
+              .reset(seed=2)[1]["reward_scale"]]
+    assert np.allclose(obs[:, -1], np.log(info["reward_scale"]))
+    assert info["reward_scale"][0] == pytest.approx(single[0], rel=1e-9)
+    env = ACLDBeamEnv(load_case="random", episode_length=0.05, reward_scale="lqr",
+                      observe_reward_scale=True)
+    env.reset(seed=1)
+    clone = pickle.loads(pickle.dumps(env))
+    a = np.array([40.0], np.float32)
+    assert np.array_equal(env.step(a)[0], clone.step(a)[0])
+    assert clone.reset(seed=9)[1]["reward_scale"] == env.reset(seed=9)[1]["reward_scale"]
+    check_env(ACLDBeamEnv(load_case="random", episode_length=0.05, reward_scale="lqr"),
+              skip_render_check=True)

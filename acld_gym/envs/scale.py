@@ -17,8 +17,8 @@ With ``reward_scale="lqr"`` c is instead LQR's mean step cost on the episode's l
 unscaled cost (deflection and voltage terms, :func:`acld_gym.envs.step.reward_terms`) of a
 noise-free episode of the configuration's env (its plant, amplifier, delay and observer)
 under the thesis's LQR law, saturated at +/-120 V (:class:`LQRCost`). The return is then
-``-T`` times the episode's cost relative to LQR's -- the benchmark's ISE / LQR per
-episode, with the voltage term -- and exactly ``-T`` for the LQR policy without sensor
+``-T`` times the episode's cost relative to LQR's (the benchmark's ISE / LQR of one
+episode, with the voltage term), and exactly ``-T`` for the LQR policy without sensor
 noise. It costs one more (noise-free) episode per reset, batched over the loads reset
 together.
 
@@ -91,7 +91,6 @@ class PassiveCost:
                 acc += y * y
             out[a:a + len(part)] = acc / (self.steps * self.y_ref**2)
         return np.maximum(out, SCALE_FLOOR)
-
 
 
 class LQRCost:

@@ -122,7 +122,7 @@ def _policy_episode(env, policy, seed):
     obs, info = env.reset(seed=seed)
     total, cost, done = 0.0, [], False
     while not done:
-        action, _ = policy.predict(obs[: env.observation_space.shape[0]])
+        action, _ = policy.predict(obs)
         obs, r, te, tr, info = env.step(action)
         total += r
         cost.append(-(info["reward_deflection"] + info["reward_voltage"]))

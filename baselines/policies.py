@@ -107,9 +107,8 @@ class LQRPolicy(_Policy):
     def __init__(self, dt: float = 1e-3, weight: float = THESIS_LQR_WEIGHT, nom=None,
                  mesh: str = "converged"):
         super().__init__(dt, nom, mesh)
-        self.K = self.nom.lqr_gain(weight)
-        z = np.zeros_like(self.K[0])
-        self.law = Feedback(a=self.K[0], s=z, c=0.0, eps=1.0, name="lqr")
+        self.law = self.nom.lqr_law(weight)
+        self.K = self.law.a[None]
 
 
 class SMCPolicy(_Policy):

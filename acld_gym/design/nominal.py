@@ -15,7 +15,7 @@ from functools import lru_cache
 import numpy as np
 
 from acld_gym.design.discrete import SampledSystem, discretize
-from acld_gym.design.feedback import THESIS_LQR_WEIGHT, discrete_lqr_gain
+from acld_gym.design.feedback import THESIS_LQR_WEIGHT, Feedback, discrete_lqr_gain
 from acld_gym.design.observer import (
     MODEL_STD,
     DiscreteObserver,
@@ -75,6 +75,12 @@ class NominalDesign:
         K, _ = discrete_lqr_gain(self.reduced.Ad, self.reduced.Bd,
                                  self.design.state_weight(weight), np.eye(1))
         return K
+
+    def lqr_law(self, weight: float = THESIS_LQR_WEIGHT) -> Feedback:
+        """The sampled LQR as a voltage law on the reduced state, V = -K x_r
+        (:meth:`lqr_gain`): the LQR baseline's, and the ``"lqr"`` reward scale's."""
+        K = self.lqr_gain(weight)[0]
+        return Feedback(a=K, s=np.zeros_like(K), c=0.0, eps=1.0, name="lqr")
 
     def observer(self, kind: str) -> DiscreteObserver:
         """The sampled observer ``"kalman"`` or ``"thesis"``."""

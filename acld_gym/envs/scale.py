@@ -112,10 +112,13 @@ class LQRCost:
                                      temperature_range=None)
         self.steps = int(steps)
         nom = self.config.nominal()
-        gain = nom.lqr_gain()[0]
-        #: The law on the observation's reduced-state entries: V = -obs[:k] @ gain [V].
-        self.gain = gain * nom.xr_scale
-        self._batches: dict = {}  # a BatchStep per number of loads asked at once
+        #: The law (:meth:`acld_gym.design.nominal.NominalDesign.lqr_law`) on the reduced
+        #: state, decoded from the estimate observation as obs[:k] * xr_scale.
+        self.law = nom.lqr_law()
+        self.xr_scale = nom.xr_scale
+        # A BatchStep per power-of-two batch size (the loads padded up to it): at most
+        # log2(N) + 1 of them, whatever numbers of envs a vector env resets at once.
+        self._batches: dict = {}
 
     def __call__(self, loads: list[TipLoad]) -> np.ndarray:
         """c of each load in ``loads`` (len(loads),), at least :data:`SCALE_FLOOR`."""
@@ -123,14 +126,19 @@ class LQRCost:
         from acld_gym.physics.actuator import V_LIMIT
 
         n = len(loads)
-        b = self._batches.get(n)
+        if n == 0:
+            return np.empty(0)
+        size = 1 << (n - 1).bit_length()
+        b = self._batches.get(size)
         if b is None:
-            b = self._batches[n] = BatchStep(self.config, n, self.steps)
-        b.start_episodes(np.arange(n), list(loads), [None] * n, np.zeros((n, self.steps + 1)))
-        k = self.gain.shape[0]
-        obs, acc = b.observations(), np.zeros(n)
+            b = self._batches[size] = BatchStep(self.config, size, self.steps)
+        padded = list(loads) + [loads[-1]] * (size - n)
+        b.start_episodes(np.arange(size), padded, [None] * size,
+                         np.zeros((size, self.steps + 1)))
+        k = self.xr_scale.shape[0]
+        obs, acc = b.observations(), np.zeros(size)
         for _ in range(self.steps):
-            v = np.clip(-(obs[:, :k].astype(np.float64) @ self.gain), -V_LIMIT, V_LIMIT)
+            v = self.law.voltage(obs[:, :k].astype(np.float64) * self.xr_scale, V_LIMIT)
             obs, reward, _, _, _ = b.vector_step(v.astype(np.float32))  # as an agent's action
             acc -= reward
-        return np.maximum(acc / self.steps, SCALE_FLOOR)
+        return np.maximum(acc[:n] / self.steps, SCALE_FLOOR)

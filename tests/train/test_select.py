@@ -91,3 +91,24 @@ def test_a_run_returns_its_best_checkpoint(tmp_path):
     again = evaluate.validation_cost(policy, "ACLDBeam-v1", evaluate.validation_seeds(2))
     assert again == pytest.approx(sel["cost"], rel=1e-5)
     assert sel["validation_env_steps"] == len(costs) * 2 * 1000  # 2 episodes of 1000 steps
+
+
+def test_the_final_check_sees_the_final_policy():
+    """A check due at the last env step of the budget is left to ``finish``, after the last
+    gradient step: with the one check at the end, the run returns the policy of the same run
+    without selection (SB3 calls the step callback before the update of its rollout, so a
+    check there would see the policy one update short of the final one)."""
+    from train.bench.sb3_train import train_sb3
+
+    data = yaml.safe_load(open("train/benchmark/sac.yaml"))
+    data.update(timesteps=800, n_envs=4, eval_points=1, whiten_steps=128, restarts=1,
+                select=None)
+    data["model"] = {**data["model"], "learning_starts": 200, "buffer_size": 2000,
+                     "batch_size": 64}
+    plain, _ = train_sb3(TrainConfig.from_dict(data), 0, "ACLDBeam-v1")
+    data["select"] = {"episodes": 1, "every": 800, "start": 800}
+    chosen, record = train_sb3(TrainConfig.from_dict(data), 0, "ACLDBeam-v1")
+    assert [h["steps"] for h in record["select"]["history"]] == [800]
+    seeds = evaluate.validation_seeds(2)
+    assert evaluate.validation_cost(chosen, "ACLDBeam-v1", seeds) == \
+        evaluate.validation_cost(plain, "ACLDBeam-v1", seeds)

@@ -282,7 +282,9 @@ def train_sb3(
             if callback is not None and schedule.due(steps):
                 with average.applied(model):
                     callback(steps, snapshot())
-            if select.due(steps):
+            # a check due at the budget's end is finish()'s, after the last update: SB3
+            # calls this before the update of the rollout the step belongs to
+            if select.due(steps) and steps < offset + budget:
                 with average.applied(model):
                     select.check(steps, model, snapshot)
             return True

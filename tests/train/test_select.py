@@ -73,17 +73,23 @@ def test_selection_off_is_inert():
     assert torch.equal(model.policy.weight, before)
 
 
+def _tiny_recipe(**changes) -> TrainConfig:
+    """The SAC recipe (train/benchmark/sac.yaml) shrunk to 800 env steps on 4 sub-envs, with
+    ``changes``."""
+    data = yaml.safe_load(open("train/benchmark/sac.yaml"))
+    data.update(timesteps=800, n_envs=4, eval_points=1, whiten_steps=128, **changes)
+    data["model"] = {**data["model"], "learning_starts": 200, "buffer_size": 2000,
+                     "batch_size": 64}
+    return TrainConfig.from_dict(data)
+
+
 def test_a_run_returns_its_best_checkpoint(tmp_path):
     """A tiny SAC run of the recipe with selection: the returned (whitening-folded) policy
     scores the chosen check's validation cost again."""
     from train.bench.sb3_train import train_sb3
 
-    data = yaml.safe_load(open("train/benchmark/sac.yaml"))
-    data.update(timesteps=800, n_envs=4, eval_points=1, whiten_steps=128,
-                select={"episodes": 2, "every": 200, "start": 0})
-    data["model"] = {**data["model"], "learning_starts": 200, "buffer_size": 2000,
-                     "batch_size": 64}
-    policy, record = train_sb3(TrainConfig.from_dict(data), 0, "ACLDBeam-v1")
+    cfg = _tiny_recipe(select={"episodes": 2, "every": 200, "start": 0})
+    policy, record = train_sb3(cfg, 0, "ACLDBeam-v1")
     sel = record["select"]
     costs = [h["cost"] for h in sel["history"]]
     assert len(costs) >= 3 and sel["cost"] == min(costs)
@@ -100,14 +106,9 @@ def test_the_final_check_sees_the_final_policy():
     check there would see the policy one update short of the final one)."""
     from train.bench.sb3_train import train_sb3
 
-    data = yaml.safe_load(open("train/benchmark/sac.yaml"))
-    data.update(timesteps=800, n_envs=4, eval_points=1, whiten_steps=128, restarts=1,
-                select=None)
-    data["model"] = {**data["model"], "learning_starts": 200, "buffer_size": 2000,
-                     "batch_size": 64}
-    plain, _ = train_sb3(TrainConfig.from_dict(data), 0, "ACLDBeam-v1")
-    data["select"] = {"episodes": 1, "every": 800, "start": 800}
-    chosen, record = train_sb3(TrainConfig.from_dict(data), 0, "ACLDBeam-v1")
+    plain, _ = train_sb3(_tiny_recipe(restarts=1, select=None), 0, "ACLDBeam-v1")
+    cfg = _tiny_recipe(restarts=1, select={"episodes": 1, "every": 800, "start": 800})
+    chosen, record = train_sb3(cfg, 0, "ACLDBeam-v1")
     assert [h["steps"] for h in record["select"]["history"]] == [800]
     seeds = evaluate.validation_seeds(2)
     assert evaluate.validation_cost(chosen, "ACLDBeam-v1", seeds) == \

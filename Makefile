@@ -3,6 +3,8 @@ PY      ?= python3
 VENV    := .venv
 BIN     := $(VENV)/bin
 STAMP   := $(VENV)/.installed-stamp
+# The Python sources ruff lints and formats.
+PYSRC   := acld_gym baselines train tests benchmarks setup.py .ci
 
 .PHONY: install run studies test test-slow docs wheel-check lint format bench agents clean
 
@@ -47,9 +49,13 @@ agents: $(STAMP)
 	$(BIN)/python -m train.ship runs/benchmark/v1 ppo --best ppo
 	$(BIN)/python -m train.ship runs/benchmark/v1 sac --best sac
 
+## ruff: lint, and the format check (`make format` applies it).
+lint: $(STAMP)
+	$(BIN)/ruff check $(PYSRC)
+	$(BIN)/ruff format --check $(PYSRC)
+
 ## Lint + the test suite (slow tests excluded; see test-slow) + the documentation site.
-test: $(STAMP)
-	$(BIN)/ruff check acld_gym baselines train tests benchmarks
+test: lint
 	$(BIN)/python -m pytest -q
 	$(MAKE) docs
 
@@ -74,8 +80,8 @@ test-slow: $(STAMP)
 	$(BIN)/python -m pytest -q -m slow
 
 format: $(STAMP)
-	$(BIN)/ruff format acld_gym baselines train tests benchmarks
-	$(BIN)/ruff check --fix acld_gym baselines train tests benchmarks
+	$(BIN)/ruff check --fix $(PYSRC)
+	$(BIN)/ruff format $(PYSRC)
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_reproduce.py

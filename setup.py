@@ -8,6 +8,14 @@ a C compiler the install still succeeds and ``ACLDBeamEnv`` steps in numpy
 import numpy as np
 from setuptools import Extension, setup
 
-setup(ext_modules=[Extension("acld_gym.envs._stepcore", ["acld_gym/envs/_stepcore.c"],
-                             include_dirs=[np.get_include()], extra_compile_args=["-O3"],
-                             optional=True)])
+setup(
+    ext_modules=[
+        Extension(
+            "acld_gym.envs._stepcore",
+            ["acld_gym/envs/_stepcore.c"],
+            include_dirs=[np.get_include()],
+            extra_compile_args=["-O3"],
+            optional=True,
+        )
+    ]
+)

@@ -41,8 +41,10 @@ def check_envs() -> str:
     from acld_gym.envs.beam_env import COMPILED_STEP
 
     assert COMPILED_STEP or "--compiled" not in sys.argv, "the compiled step is missing"
-    return (f"gym.make of {len(PRESETS)} ids ({', '.join(PRESETS)}), acld-gym "
-            f"{acld_gym.__version__}, compiled step: {COMPILED_STEP}")
+    return (
+        f"gym.make of {len(PRESETS)} ids ({', '.join(PRESETS)}), acld-gym "
+        f"{acld_gym.__version__}, compiled step: {COMPILED_STEP}"
+    )
 
 
 def check_evaluate() -> str:
@@ -54,14 +56,22 @@ def check_evaluate() -> str:
         code = main(["--score-episodes", "5", "--quiet"])
     text = out.getvalue()
     assert code == 0, text
-    rows = {line.split()[0] for line in text.splitlines() if line.startswith("  ") and
-            line.split() and line.split()[0] in ("passive", "lqr", "smc", "mpc", "bound")}
+    rows = {
+        line.split()[0]
+        for line in text.splitlines()
+        if line.startswith("  ")
+        and line.split()
+        and line.split()[0] in ("passive", "lqr", "smc", "mpc", "bound")
+    }
     want = {"passive", "lqr", "smc", "bound"} | ({"mpc"} if mpc_available() else set())
     assert rows == want, (rows, text)
     skipped = [line for line in text.splitlines() if line.startswith("mpc skipped")]
     assert mpc_available() or (len(skipped) == 1 and "acld-gym[baselines]" in skipped[0]), text
-    return "python -m baselines.evaluate: " + ", ".join(sorted(rows)) + \
-        ("" if mpc_available() else f" ({skipped[0]})")
+    return (
+        "python -m baselines.evaluate: "
+        + ", ".join(sorted(rows))
+        + ("" if mpc_available() else f" ({skipped[0]})")
+    )
 
 
 def check_agents() -> str:

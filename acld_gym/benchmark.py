@@ -51,8 +51,10 @@ class EvaluationSet:
             raise ValueError("EvaluationSet.seeds must be distinct, and at least one")
         outside = [s for s in self.seeds if s not in RESERVED_SEEDS]
         if outside:
-            raise ValueError(f"EvaluationSet.seeds must lie in the reserved block "
-                             f"[{RESERVED_SEEDS.start}, {RESERVED_SEEDS.stop}), got {outside[:3]}")
+            raise ValueError(
+                f"EvaluationSet.seeds must lie in the reserved block "
+                f"[{RESERVED_SEEDS.start}, {RESERVED_SEEDS.stop}), got {outside[:3]}"
+            )
 
     @property
     def name(self) -> str:
@@ -85,6 +87,7 @@ TEST_SEEDS: dict[str, tuple[int, ...]] = {k: v.seeds for k, v in TEST_SETS.items
 def evaluation_set(env_id: str) -> EvaluationSet:
     """The test set of ``env_id`` (``ValueError`` naming the known ids)."""
     if env_id not in TEST_SETS:
-        raise ValueError(f"env_id: no published test set for {env_id!r}; known: "
-                         f"{sorted(TEST_SETS)}")
+        raise ValueError(
+            f"env_id: no published test set for {env_id!r}; known: {sorted(TEST_SETS)}"
+        )
     return TEST_SETS[env_id]

@@ -32,8 +32,14 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-__all__ = ["UnitAction", "ObserveModes", "WhitenObservation", "whitening", "check_headroom",
-           "MAX_HEADROOM"]
+__all__ = [
+    "UnitAction",
+    "ObserveModes",
+    "WhitenObservation",
+    "whitening",
+    "check_headroom",
+    "MAX_HEADROOM",
+]
 
 
 class UnitAction(gym.ActionWrapper, gym.utils.RecordConstructorArgs):
@@ -59,10 +65,16 @@ class UnitAction(gym.ActionWrapper, gym.utils.RecordConstructorArgs):
         gym.utils.RecordConstructorArgs.__init__(self, headroom=headroom)
         gym.ActionWrapper.__init__(self, env)
         box = env.action_space
-        if not (isinstance(box, spaces.Box) and box.shape == (1,)
-                and np.all(box.low == -box.high) and np.all(box.high > 0)):
-            raise ValueError(f"env: UnitAction needs a symmetric 1-D Box action space "
-                             f"(-v_max, v_max), got {box!r}")
+        if not (
+            isinstance(box, spaces.Box)
+            and box.shape == (1,)
+            and np.all(box.low == -box.high)
+            and np.all(box.high > 0)
+        ):
+            raise ValueError(
+                f"env: UnitAction needs a symmetric 1-D Box action space "
+                f"(-v_max, v_max), got {box!r}"
+            )
         self.headroom = check_headroom(headroom)
         self.v_max = float(box.high[0])
         self.action_space = spaces.Box(-1.0, 1.0, (1,), np.float32)
@@ -71,8 +83,9 @@ class UnitAction(gym.ActionWrapper, gym.utils.RecordConstructorArgs):
         return (self.headroom * self.v_max) * np.asarray(action, dtype=np.float64)
 
     def reverse_action(self, action):
-        return (np.asarray(action, dtype=np.float64)
-                / (self.headroom * self.v_max)).astype(np.float32)
+        return (np.asarray(action, dtype=np.float64) / (self.headroom * self.v_max)).astype(
+            np.float32
+        )
 
 
 #: Largest ``headroom`` of :class:`UnitAction` and the training configs (the limit at
@@ -88,8 +101,10 @@ def check_headroom(headroom, name: str = "headroom") -> float:
     try:
         return check_real(name, headroom, 1.0, MAX_HEADROOM)
     except ValueError:
-        raise ValueError(f"{name} must be a number in [1, {MAX_HEADROOM:g}] (the action "
-                         f"range over the actuator's), got {headroom!r}") from None
+        raise ValueError(
+            f"{name} must be a number in [1, {MAX_HEADROOM:g}] (the action "
+            f"range over the actuator's), got {headroom!r}"
+        ) from None
 
 
 class ObserveModes(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
@@ -117,8 +132,7 @@ class ObserveModes(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
         gym.ObservationWrapper.__init__(self, env)
         config = getattr(env.unwrapped, "config", None)
         if config is None or config.obs_mode != "estimate":
-            raise ValueError("env: ObserveModes needs an ACLDBeam env with obs_mode="
-                             "'estimate'")
+            raise ValueError("env: ObserveModes needs an ACLDBeam env with obs_mode='estimate'")
         if isinstance(modes, bool) or not isinstance(modes, (int, np.integer)):
             raise ValueError(f"modes must be an integer, got {modes!r}")
         from acld_gym.envs.step import estimate_slots, observation_size
@@ -128,12 +142,13 @@ class ObserveModes(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
         base = observation_size(nom, config.obs_mode)
         n = base + int(bool(config.observe_reward_scale))
         if env.observation_space.shape != (n,):
-            raise ValueError(f"env: ObserveModes needs the ACLDBeam env's own observation of "
-                             f"{n} entries, got shape {env.observation_space.shape} (wrap it "
-                             f"before any wrapper that changes the observation)")
+            raise ValueError(
+                f"env: ObserveModes needs the ACLDBeam env's own observation of "
+                f"{n} entries, got shape {env.observation_space.shape} (wrap it "
+                f"before any wrapper that changes the observation)"
+            )
         self.modes = int(modes)
-        self.slots = np.r_[estimate_slots(nom.design.reduced.order, self.modes),
-                           np.arange(base, n)]
+        self.slots = np.r_[estimate_slots(nom.design.reduced.order, self.modes), np.arange(base, n)]
         self.observation_space = spaces.Box(-np.inf, np.inf, (len(self.slots),), np.float32)
 
     def observation(self, observation):
@@ -147,24 +162,25 @@ class WhitenObservation(gym.ObservationWrapper, gym.utils.RecordConstructorArgs)
     wrapped env stays a fixed MDP."""
 
     def __init__(self, env: gym.Env, transform, passthrough: int = 0):
-        gym.utils.RecordConstructorArgs.__init__(self, transform=transform,
-                                                 passthrough=passthrough)
+        gym.utils.RecordConstructorArgs.__init__(self, transform=transform, passthrough=passthrough)
         gym.ObservationWrapper.__init__(self, env)
         n = env.observation_space.shape[0]
-        if isinstance(passthrough, bool) or not isinstance(passthrough, (int, np.integer)) \
-                or not 0 <= passthrough < n:
+        if (
+            isinstance(passthrough, bool)
+            or not isinstance(passthrough, (int, np.integer))
+            or not 0 <= passthrough < n
+        ):
             raise ValueError(f"passthrough must be an integer in [0, {n}), got {passthrough!r}")
         d = n - int(passthrough)
         T = np.asarray(transform, dtype=np.float64)
         if T.shape != (d, d) or not np.all(np.isfinite(T)):
-            raise ValueError(f"transform must be a finite ({d}, {d}) matrix, got shape "
-                             f"{T.shape}")
+            raise ValueError(f"transform must be a finite ({d}, {d}) matrix, got shape {T.shape}")
         self.transform, self.passthrough, self._d = T, int(passthrough), d
         self.observation_space = spaces.Box(-np.inf, np.inf, (n,), np.float32)
 
     def observation(self, observation):
         z = np.asarray(observation, dtype=np.float64)
-        return np.concatenate([z[:self._d] @ self.transform, z[self._d:]]).astype(np.float32)
+        return np.concatenate([z[: self._d] @ self.transform, z[self._d :]]).astype(np.float32)
 
 
 def whitening(directions: np.ndarray, ridge: float = 1e-3) -> np.ndarray:
@@ -173,10 +189,10 @@ def whitening(directions: np.ndarray, ridge: float = 1e-3) -> np.ndarray:
     (rows), so that the direction features of ``z @ T`` are isotropic on average."""
     u = np.asarray(directions, dtype=np.float64)
     if u.ndim != 2 or u.shape[0] < 1 or not np.all(np.isfinite(u)):
-        raise ValueError(f"directions must be a finite (n, d) array with n >= 1, got shape "
-                         f"{u.shape}")
+        raise ValueError(
+            f"directions must be a finite (n, d) array with n >= 1, got shape {u.shape}"
+        )
     sigma = u.T @ u / u.shape[0]
     lam, vec = np.linalg.eigh(sigma)
     lam = np.maximum(lam, 0.0) + ridge * lam.max()
     return (vec / np.sqrt(lam)) @ vec.T
-

@@ -46,14 +46,19 @@ def resolve_policy(spec: str, env_id: str, env_kwargs: dict | None = None):
     if spec in BASELINES:
         from . import policies
 
-        cls = {"passive": policies.PassivePolicy, "lqr": policies.LQRPolicy,
-               "smc": policies.SMCPolicy, "mpc": policies.MPCPolicy}[spec]
+        cls = {
+            "passive": policies.PassivePolicy,
+            "lqr": policies.LQRPolicy,
+            "smc": policies.SMCPolicy,
+            "mpc": policies.MPCPolicy,
+        }[spec]
         env = gym.make(env_id, **(env_kwargs or {}))
         return cls.for_env(env), spec
     path = Path(spec)
     if not path.is_dir():
-        raise ValueError(f"POLICY: expected one of {list(BASELINES)} or an agent directory, "
-                         f"got {spec!r}")
+        raise ValueError(
+            f"POLICY: expected one of {list(BASELINES)} or an agent directory, got {spec!r}"
+        )
     from train.agent import TrainedAgent
 
     return TrainedAgent.load(path, path.name), path.name
@@ -71,18 +76,32 @@ def _finite(obj):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="python -m baselines.analyze", description=__doc__,
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("policy", metavar="POLICY", nargs="+",
-                   help=f"one of {', '.join(BASELINES)}, or an agent directory")
-    p.add_argument("--env-id", default=acld_gym.ENV_ID, choices=sorted(TEST_SETS),
-                   help=f"the env (default {acld_gym.ENV_ID})")
+    p = argparse.ArgumentParser(
+        prog="python -m baselines.analyze",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument(
+        "policy",
+        metavar="POLICY",
+        nargs="+",
+        help=f"one of {', '.join(BASELINES)}, or an agent directory",
+    )
+    p.add_argument(
+        "--env-id",
+        default=acld_gym.ENV_ID,
+        choices=sorted(TEST_SETS),
+        help=f"the env (default {acld_gym.ENV_ID})",
+    )
     p.add_argument("--json", metavar="PATH", help="write the record as JSON")
     p.add_argument("--plots", metavar="DIR", help="write the compliance figures to DIR")
     p.add_argument("--markdown", metavar="PATH", help="write the comparison tables as markdown")
-    p.add_argument("--score-episodes", type=arg_type(int, 0, 100_000), default=None,
-                   help="score on the first N test episodes only (0: no score; default: "
-                        "the whole test set)")
+    p.add_argument(
+        "--score-episodes",
+        type=arg_type(int, 0, 100_000),
+        default=None,
+        help="score on the first N test episodes only (0: no score; default: the whole test set)",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress line")
     return p
 
@@ -98,8 +117,9 @@ def main(argv: list[str] | None = None) -> int:
             check_directory(args.plots, "--plots")
         n = len(TEST_SETS[args.env_id].seeds)
         if args.score_episodes is not None and args.score_episodes > n:
-            raise ValueError(f"--score-episodes: the test set has {n} episodes, got "
-                             f"{args.score_episodes}")
+            raise ValueError(
+                f"--score-episodes: the test set has {n} episodes, got {args.score_episodes}"
+            )
         policies = [resolve_policy(spec, args.env_id) for spec in args.policy]
     except (OSError, ValueError) as exc:
         parser.error(str(exc))
@@ -109,12 +129,20 @@ def main(argv: list[str] | None = None) -> int:
     refs = None
     if args.score_episodes != 0:
         test = TEST_SETS[args.env_id]
-        refs = references(test if args.score_episodes is None else
-                          test.first(args.score_episodes), quiet=args.quiet)
+        refs = references(
+            test if args.score_episodes is None else test.first(args.score_episodes),
+            quiet=args.quiet,
+        )
     results = []
     for policy, name in policies:
-        result = analyze(policy, args.env_id, name=name, score_episodes=args.score_episodes,
-                         refs=refs, quiet=args.quiet)
+        result = analyze(
+            policy,
+            args.env_id,
+            name=name,
+            score_episodes=args.score_episodes,
+            refs=refs,
+            quiet=args.quiet,
+        )
         print(format_analysis(result) + "\n")
         if args.plots:
             print(f"wrote {plot_compliance(result, Path(args.plots) / f'compliance_{name}.png')}")

@@ -56,9 +56,21 @@ from acld_gym.design.discrete import (
 from acld_gym.physics.actuator import V_LIMIT
 from acld_gym.physics.loads import TipLoad
 
-__all__ = ["ATOL", "BoundSolution", "KKTCheck", "METHODS", "RTOL", "SlewCertificate",
-           "clairvoyant_bound", "convolution_matrix", "free_response", "impulse_response",
-           "kkt_check", "reversed_gram", "slew_certificate"]
+__all__ = [
+    "ATOL",
+    "BoundSolution",
+    "KKTCheck",
+    "METHODS",
+    "RTOL",
+    "SlewCertificate",
+    "clairvoyant_bound",
+    "convolution_matrix",
+    "free_response",
+    "impulse_response",
+    "kkt_check",
+    "reversed_gram",
+    "slew_certificate",
+]
 
 #: Solvers accepted by :func:`clairvoyant_bound`.
 METHODS = ("pdas", "bvls")
@@ -91,8 +103,9 @@ class BoundSolution:
 # --- the linear model of an episode --------------------------------------------------------
 
 
-def free_response(plant: SampledSystem, tip_index: int | np.ndarray, load: TipLoad,
-                  n_steps: int) -> np.ndarray:
+def free_response(
+    plant: SampledSystem, tip_index: int | np.ndarray, load: TipLoad, n_steps: int
+) -> np.ndarray:
     r"""Tip deflection [m] without control at t = dt..N dt, from rest.
 
     The same sampled load as the environment (:meth:`SampledSystem.load_samples`,
@@ -190,24 +203,33 @@ class KKTCheck:
 def _kkt(h: np.ndarray, y: np.ndarray, v: np.ndarray, bound: float) -> KKTCheck:
     n = h.size
     r = y + np.convolve(h, v)[:n]  # direct sums (no FFT round-off in the certificate)
-    g = np.correlate(r, h, "full")[n - 1:]  # G^T r
+    g = np.correlate(r, h, "full")[n - 1 :]  # G^T r
     # A voltage scaled back and forth may miss its bound by an ulp: count it as at the bound.
     edge = bound * (1.0 - 1e-12)
     at_lo, at_hi = v <= -edge, v >= edge
     viol = np.where(at_lo, np.maximum(-g, 0.0), np.where(at_hi, np.maximum(g, 0.0), np.abs(g)))
-    return KKTCheck(objective=0.5 * float(r @ r), free_objective=0.5 * float(y @ y),
-                    gap=float(np.sum(g * v + bound * np.abs(g))), violation=viol,
-                    feasible=bool(np.all(np.abs(v) <= bound * (1.0 + 1e-12))))
+    return KKTCheck(
+        objective=0.5 * float(r @ r),
+        free_objective=0.5 * float(y @ y),
+        gap=float(np.sum(g * v + bound * np.abs(g))),
+        violation=viol,
+        feasible=bool(np.all(np.abs(v) <= bound * (1.0 + 1e-12))),
+    )
 
 
-def kkt_check(h: np.ndarray, y_free: np.ndarray, voltage: np.ndarray,
-              v_max: float = V_LIMIT) -> KKTCheck:
+def kkt_check(
+    h: np.ndarray, y_free: np.ndarray, voltage: np.ndarray, v_max: float = V_LIMIT
+) -> KKTCheck:
     """:class:`KKTCheck` of ``voltage`` [V] for the bound with impulse response ``h`` [m/V],
     free response ``y_free`` [m] and limit ``v_max`` [V], in the scaled units of the
     solvers (mm, units of ``v_max``; the objective is half the sum of squares in mm^2)."""
     h = np.asarray(h, dtype=float)
-    return _kkt(h * (v_max / _Y_UNIT), np.asarray(y_free, dtype=float) / _Y_UNIT,
-                np.asarray(voltage, dtype=float) / v_max, 1.0)
+    return _kkt(
+        h * (v_max / _Y_UNIT),
+        np.asarray(y_free, dtype=float) / _Y_UNIT,
+        np.asarray(voltage, dtype=float) / v_max,
+        1.0,
+    )
 
 
 # --- solvers (scaled problem: min 1/2 ||y + G v||^2, |v| <= 1) -------------------------------
@@ -217,8 +239,9 @@ def _solve_bvls(h: np.ndarray, y: np.ndarray) -> np.ndarray:
     """The reference: BVLS on the dense matrix (one variable enters or leaves the free
     set per iteration, each a least-squares solve in Python: seconds for 1000 steps)."""
     n = h.size
-    res = lsq_linear(convolution_matrix(h), -y, bounds=(-1.0, 1.0), method="bvls", tol=1e-12,
-                     max_iter=10 * n)
+    res = lsq_linear(
+        convolution_matrix(h), -y, bounds=(-1.0, 1.0), method="bvls", tol=1e-12, max_iter=10 * n
+    )
     return res.x
 
 
@@ -283,8 +306,9 @@ class _OrderedCholesky:
                 if not known.all():
                     new = np.flatnonzero(~known)
                     # K[prefix, new] as the transpose of rows of the symmetric K
-                    W[new] = self._trsm(p, self.K.take(rest[new], axis=0)
-                                        .take(order[:p], axis=1).T).T
+                    W[new] = self._trsm(
+                        p, self.K.take(rest[new], axis=0).take(order[:p], axis=1).T
+                    ).T
                 S -= W @ W.T
                 L[p:n, :p] = W
             L[p:n, p:n] = sla.cholesky(S, lower=True, overwrite_a=True, check_finite=False)
@@ -346,8 +370,9 @@ class _Problem:
     chol: _OrderedCholesky
 
 
-def _pdas_stage(P: _Problem, rho: float, center: np.ndarray, up: np.ndarray, lo: np.ndarray,
-                max_iter: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool, int]:
+def _pdas_stage(
+    P: _Problem, rho: float, center: np.ndarray, up: np.ndarray, lo: np.ndarray, max_iter: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool, int]:
     """Primal-dual active-set iterations for min f(w) + rho/2 |w - center|^2, |w| <= 1, from
     the active sets ``up`` (w = 1) and ``lo`` (w = -1). Returns the last iterate, its sets,
     whether they converged (else they cycled, ran out of iterations or the factorization
@@ -387,9 +412,17 @@ def _pdas_stage(P: _Problem, rho: float, center: np.ndarray, up: np.ndarray, lo:
     return w, up, lo, False, max_iter
 
 
-def _solve_pdas(h: np.ndarray, y: np.ndarray, rtol: float = RTOL, atol: float = ATOL,
-                rho0: float = 1e-3, shrink: float = 1e4, rho_min: float = 1e-14,
-                max_iter: int = 60, max_stages: int = 16) -> _PDASResult:
+def _solve_pdas(
+    h: np.ndarray,
+    y: np.ndarray,
+    rtol: float = RTOL,
+    atol: float = ATOL,
+    rho0: float = 1e-3,
+    shrink: float = 1e4,
+    rho_min: float = 1e-14,
+    max_iter: int = 60,
+    max_stages: int = 16,
+) -> _PDASResult:
     r"""Box-constrained least squares :math:`\min_{|v| \le 1} f(v) = \tfrac12 \|y + Gv\|^2`
     for a lower-triangular Toeplitz G with first column ``h``.
 
@@ -437,8 +470,12 @@ def _solve_pdas(h: np.ndarray, y: np.ndarray, rtol: float = RTOL, atol: float = 
     # Reversed time, so that the factor order starts with the end of the episode (see
     # _stable_order); K = J G^T G J = G G^T, qr = J G^T y.
     K = reversed_gram(h)
-    P = _Problem(K=K, Kop=_ReversedGramOperator(h), chol=_OrderedCholesky(K),
-                 qr=np.correlate(y, h, "full")[n - 1:][::-1].copy())
+    P = _Problem(
+        K=K,
+        Kop=_ReversedGramOperator(h),
+        chol=_OrderedCholesky(K),
+        qr=np.correlate(y, h, "full")[n - 1 :][::-1].copy(),
+    )
     scale = float(np.max(np.abs(P.Kop.hf)) ** 2)  # ||G||^2 <= max |h(e^iw)|^2
     floor = rho_min * scale
     rho, step = rho0 * scale, shrink
@@ -514,19 +551,28 @@ def _difference(n: int):
     return sp.eye(n, format="csc") - sp.eye(n, k=-1, format="csc")
 
 
-def slew_certificate(h: np.ndarray, y: np.ndarray, w: np.ndarray, lam: np.ndarray,
-                     rho: float) -> SlewCertificate:
+def slew_certificate(
+    h: np.ndarray, y: np.ndarray, w: np.ndarray, lam: np.ndarray, rho: float
+) -> SlewCertificate:
     """:class:`SlewCertificate` of ``w`` with multipliers ``lam`` (scaled units)."""
     n = h.size
     r = y + np.convolve(h, w)[:n]
-    g = np.correlate(r, h, "full")[n - 1:]  # G^T r
+    g = np.correlate(r, h, "full")[n - 1 :]  # G^T r
     dl = lam - np.append(lam[1:], 0.0)  # D^T lam
-    lower = 0.5 * float(r @ r) - float(g @ w) - float(np.abs(g + dl).sum()) \
+    lower = (
+        0.5 * float(r @ r)
+        - float(g @ w)
+        - float(np.abs(g + dl).sum())
         - rho * float(np.abs(lam).sum())
+    )
     steps = np.diff(np.concatenate([[0.0], w]))
     feasible = bool(np.all(np.abs(w) <= 1.0 + 1e-12) and np.all(np.abs(steps) <= rho * (1 + 1e-12)))
-    return SlewCertificate(objective=0.5 * float(r @ r), lower=lower,
-                           free_objective=0.5 * float(y @ y), feasible=feasible)
+    return SlewCertificate(
+        objective=0.5 * float(r @ r),
+        lower=lower,
+        free_objective=0.5 * float(y @ y),
+        feasible=feasible,
+    )
 
 
 def _feasible(w: np.ndarray, rho: float) -> np.ndarray:
@@ -562,18 +608,34 @@ def _solve_slew(h: np.ndarray, y: np.ndarray, rho: float) -> tuple[np.ndarray, S
     A = sp.vstack([sp.eye(n, format="csc"), _difference(n)], format="csc")
     one = np.ones(n)
     solver = osqp.OSQP()
-    solver.setup(P, G.T @ y, A, np.concatenate([-one, -rho * one]),
-                 np.concatenate([one, rho * one]), eps_abs=EPS, eps_rel=EPS,
-                 max_iter=MAX_ITER, polishing=True, verbose=False)
+    solver.setup(
+        P,
+        G.T @ y,
+        A,
+        np.concatenate([-one, -rho * one]),
+        np.concatenate([one, rho * one]),
+        eps_abs=EPS,
+        eps_rel=EPS,
+        max_iter=MAX_ITER,
+        polishing=True,
+        verbose=False,
+    )
     res = solver.solve(raise_error=False)
     w = _feasible(np.asarray(res.x, dtype=float), rho)
     return w, slew_certificate(h, y, w, np.asarray(res.y, dtype=float)[n:], rho)
 
 
-def clairvoyant_bound(plant: SampledSystem, tip_index: int | np.ndarray, load: TipLoad,
-                      n_steps: int, *, method: str = "pdas", delay: int = 0,
-                      slew_step: float | None = None,
-                      v_max: float = V_LIMIT) -> BoundSolution:
+def clairvoyant_bound(
+    plant: SampledSystem,
+    tip_index: int | np.ndarray,
+    load: TipLoad,
+    n_steps: int,
+    *,
+    method: str = "pdas",
+    delay: int = 0,
+    slew_step: float | None = None,
+    v_max: float = V_LIMIT,
+) -> BoundSolution:
     r"""Solve the bound for ``load`` over ``n_steps`` periods of ``plant``.
 
     Parameters
@@ -611,8 +673,11 @@ def clairvoyant_bound(plant: SampledSystem, tip_index: int | np.ndarray, load: T
     _check_steps(n_steps, "n_steps")
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
-    if isinstance(delay, bool) or not isinstance(delay, (int, np.integer)) \
-            or not 0 <= delay < n_steps:
+    if (
+        isinstance(delay, bool)
+        or not isinstance(delay, (int, np.integer))
+        or not 0 <= delay < n_steps
+    ):
         raise ValueError(f"delay must be an integer in [0, n_steps), got {delay!r}")
     y_free = free_response(plant, tip_index, load, n_steps)
     m = n_steps - delay  # the voltages that reach the tip within the episode
@@ -622,17 +687,24 @@ def clairvoyant_bound(plant: SampledSystem, tip_index: int | np.ndarray, load: T
         v, certificate = _solve_slew(hs, ys, slew_step / v_max)
         cert = certificate
         if not cert.certifies():
-            warnings.warn(f"clairvoyant_bound: the slew-limited solution is certified only to "
-                          f"a relative gap of {cert.gap / max(cert.objective, 1e-300):.1e}",
-                          RuntimeWarning, stacklevel=2)
+            warnings.warn(
+                f"clairvoyant_bound: the slew-limited solution is certified only to "
+                f"a relative gap of {cert.gap / max(cert.objective, 1e-300):.1e}",
+                RuntimeWarning,
+                stacklevel=2,
+            )
     elif method == "pdas":
         certificate = None
         res = _solve_pdas(hs, ys)
         v = res.v
         if not res.check.certifies():
-            warnings.warn(f"clairvoyant_bound: the active-set solver could not certify its "
-                          f"optimum (relative gap {res.check.relative_gap:.1e}, tolerance "
-                          f"{RTOL:g}); using BVLS", RuntimeWarning, stacklevel=2)
+            warnings.warn(
+                f"clairvoyant_bound: the active-set solver could not certify its "
+                f"optimum (relative gap {res.check.relative_gap:.1e}, tolerance "
+                f"{RTOL:g}); using BVLS",
+                RuntimeWarning,
+                stacklevel=2,
+            )
             v = _solve_bvls(hs, ys)
     else:
         certificate = None

@@ -42,10 +42,24 @@ from acld_gym.util.blas import one_blas_thread
 from acld_gym.util.progress import Progress
 from acld_gym.util.validate import arg_type
 
-__all__ = ["EvalRow", "Episode", "rollout", "check_compatible", "bound_episode", "episode_rows",
-           "evaluate", "policy_classes", "default_policies", "policies_for",
-           "mean_rows", "format_tables", "format_effort", "format_thesis_comparison",
-           "add_scores", "plot_episodes"]
+__all__ = [
+    "EvalRow",
+    "Episode",
+    "rollout",
+    "check_compatible",
+    "bound_episode",
+    "episode_rows",
+    "evaluate",
+    "policy_classes",
+    "default_policies",
+    "policies_for",
+    "mean_rows",
+    "format_tables",
+    "format_effort",
+    "format_thesis_comparison",
+    "add_scores",
+    "plot_episodes",
+]
 
 
 @dataclass(frozen=True)
@@ -81,8 +95,9 @@ class EvalRow:
     def as_dict(self) -> dict:
         d = asdict(self)
         d["return"] = d.pop("ret")
-        return {k: (None if isinstance(v, float) and not math.isfinite(v) else v)
-                for k, v in d.items()}
+        return {
+            k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in d.items()
+        }
 
 
 def check_compatible(policy, env) -> None:
@@ -94,8 +109,9 @@ def check_compatible(policy, env) -> None:
     diff = fingerprint_differences(expected, observation_fingerprint(env))
     if diff:
         name = getattr(policy, "name", type(policy).__name__)
-        raise ValueError(f"policy {name!r} was built for another observation than this env's: "
-                         + "; ".join(diff))
+        raise ValueError(
+            f"policy {name!r} was built for another observation than this env's: " + "; ".join(diff)
+        )
 
 
 def rollout(policy, env: ACLDBeamEnv, seed: int = 0, options: dict | None = None) -> Episode:
@@ -108,8 +124,7 @@ def rollout(policy, env: ACLDBeamEnv, seed: int = 0, options: dict | None = None
     state, start = None, np.ones(1, dtype=bool)  # SB3's recurrent-policy protocol
     while not done:
         t0 = time.perf_counter()
-        action, state = policy.predict(obs, state=state, episode_start=start,
-                                       deterministic=True)
+        action, state = policy.predict(obs, state=state, episode_start=start, deterministic=True)
         start = np.zeros(1, dtype=bool)
         spent += time.perf_counter() - t0
         obs, reward, term, trunc, info = env.step(action)
@@ -134,11 +149,12 @@ def bound_episode(env: ACLDBeamEnv) -> Episode:
     env = env.unwrapped
     plant, c, n = env.episode_plant, env.config, env.max_steps
     tip = np.zeros(plant.Ad.shape[0])
-    tip[:env.nom.output.size] = env.nom.output
+    tip[: env.nom.output.size] = env.nom.output
     t0 = time.perf_counter()
     with one_blas_thread():  # small dense problems (acld_gym.util.blas)
-        sol = clairvoyant_bound(plant, tip, env.load, n, delay=c.actuator_delay,
-                                slew_step=c.slew_step)
+        sol = clairvoyant_bound(
+            plant, tip, env.load, n, delay=c.actuator_delay, slew_step=c.slew_step
+        )
     spent = time.perf_counter() - t0
     volts = sol.voltage
     if c.amplifier_bandwidth is not None:
@@ -155,13 +171,21 @@ def metrics_row(case, name: str, ep: Episode) -> EvalRow:
 
     dt = float(ep.t[1] - ep.t[0]) if ep.t.size > 1 else float(ep.t[0])
     e = effort(ep.voltage, ep.y, dt, settled_from(case))
-    return EvalRow(case=case, policy=name, peak_mm=peak(ep.y) * 1e3,
-                   settling_s=settling_time(ep.t, ep.y), ise=float(np.sum(ep.y**2) * dt),
-                   max_voltage_V=max_abs(ep.voltage), ret=float(np.sum(ep.reward)),
-                   ms_per_step=1e3 * ep.seconds_per_step, rms_voltage_V=e.rms_voltage_V,
-                   reactive_power_var=e.reactive_power_var,
-                   total_variation_V_per_s=e.total_variation_V_per_s,
-                   limit_fraction=e.limit_fraction, residual_tip_rms_m=e.residual_tip_rms_m)
+    return EvalRow(
+        case=case,
+        policy=name,
+        peak_mm=peak(ep.y) * 1e3,
+        settling_s=settling_time(ep.t, ep.y),
+        ise=float(np.sum(ep.y**2) * dt),
+        max_voltage_V=max_abs(ep.voltage),
+        ret=float(np.sum(ep.reward)),
+        ms_per_step=1e3 * ep.seconds_per_step,
+        rms_voltage_V=e.rms_voltage_V,
+        reactive_power_var=e.reactive_power_var,
+        total_variation_V_per_s=e.total_variation_V_per_s,
+        limit_fraction=e.limit_fraction,
+        residual_tip_rms_m=e.residual_tip_rms_m,
+    )
 
 
 def policy_classes() -> tuple:
@@ -184,9 +208,15 @@ def policies_for(env) -> dict:
     return {cls.name: cls.for_env(env) for cls in policy_classes()}
 
 
-def episode_rows(policies: dict, case, seed: int = 0, env_kwargs: dict | None = None,
-                 episodes: dict | None = None, progress: Progress | None = None,
-                 episode: str = "") -> list[EvalRow]:
+def episode_rows(
+    policies: dict,
+    case,
+    seed: int = 0,
+    env_kwargs: dict | None = None,
+    episodes: dict | None = None,
+    progress: Progress | None = None,
+    episode: str = "",
+) -> list[EvalRow]:
     """One episode of ``case`` (seeded: load, parameters, sensor noise) per policy, plus
     the clairvoyant bound for the same load and plant; fills ``episodes`` if given and
     reports each policy's episode to ``progress`` (labelled with ``episode``)."""
@@ -209,16 +239,24 @@ def episode_rows(policies: dict, case, seed: int = 0, env_kwargs: dict | None = 
     return rows
 
 
-def evaluate(policies: dict | None = None, cases=THESIS_CASES, seed: int = 0,
-             env_kwargs: dict | None = None, episodes: dict | None = None,
-             quiet: bool = True) -> list[EvalRow]:
+def evaluate(
+    policies: dict | None = None,
+    cases=THESIS_CASES,
+    seed: int = 0,
+    env_kwargs: dict | None = None,
+    episodes: dict | None = None,
+    quiet: bool = True,
+) -> list[EvalRow]:
     """Rows for every (case, policy) plus the bound; fills ``episodes`` if given; a
     progress line on a terminal unless ``quiet``."""
     if policies is None:
         policies = policies_for(ACLDBeamEnv(**(env_kwargs or {})))
     with Progress(len(cases) * (len(policies) + 1), "evaluate", quiet) as progress:
-        return [row for case in cases
-                for row in episode_rows(policies, case, seed, env_kwargs, episodes, progress)]
+        return [
+            row
+            for case in cases
+            for row in episode_rows(policies, case, seed, env_kwargs, episodes, progress)
+        ]
 
 
 def mean_rows(rows: list[EvalRow], case) -> list[EvalRow]:
@@ -226,8 +264,9 @@ def mean_rows(rows: list[EvalRow], case) -> list[EvalRow]:
     out = []
     for name in dict.fromkeys(r.policy for r in rows):
         sub = [asdict(r) for r in rows if r.policy == name]
-        means = {k: float(np.mean([d[k] for d in sub])) for k in sub[0]
-                 if k not in ("case", "policy")}
+        means = {
+            k: float(np.mean([d[k] for d in sub])) for k in sub[0] if k not in ("case", "policy")
+        }
         out.append(EvalRow(case=case, policy=name, **means))
     return out
 
@@ -239,14 +278,18 @@ def format_tables(rows: list[EvalRow]) -> str:
         bound = next((r.ise for r in sub if r.policy == "bound"), None)
         lqr = next((r.ise for r in sub if r.policy == "lqr"), None)
         out.append(f"\nload case {case}")
-        out.append(f"{'policy':>8} {'peak [mm]':>10} {'settle [s]':>10} {'ISE [m^2 s]':>12} "
-                   f"{'/LQR':>6} {'/bound':>7} {'max|V|':>7} {'return':>10} {'ms/step':>8}")
+        out.append(
+            f"{'policy':>8} {'peak [mm]':>10} {'settle [s]':>10} {'ISE [m^2 s]':>12} "
+            f"{'/LQR':>6} {'/bound':>7} {'max|V|':>7} {'return':>10} {'ms/step':>8}"
+        )
         for r in sub:
             rel_l = f"{r.ise / lqr:6.2f}" if lqr else "     -"
             rel_b = f"{r.ise / bound:7.2f}" if bound else "      -"
-            out.append(f"{r.policy:>8} {r.peak_mm:10.3f} {r.settling_s:10.3f} {r.ise:12.3e} "
-                       f"{rel_l} {rel_b} {r.max_voltage_V:7.1f} {r.ret:10.1f} "
-                       f"{r.ms_per_step:8.3f}")
+            out.append(
+                f"{r.policy:>8} {r.peak_mm:10.3f} {r.settling_s:10.3f} {r.ise:12.3e} "
+                f"{rel_l} {rel_b} {r.max_voltage_V:7.1f} {r.ret:10.1f} "
+                f"{r.ms_per_step:8.3f}"
+            )
         out.extend(format_effort(sub))
     return "\n".join(out)
 
@@ -260,13 +303,17 @@ def format_effort(rows: list[EvalRow]) -> list[str]:
 
     start = settled_from(rows[0].case)
     when = f"after {start:.3f} s:" if math.isfinite(start) else "(no settled window)"
-    out = [f"{'effort':>8} {'V rms [V]':>10} {'Q [mvar]':>9}  {when:>19} {'TV [kV/s]':>9} "
-           f"{'at limit':>8} {'tip rms [um]':>12}"]
+    out = [
+        f"{'effort':>8} {'V rms [V]':>10} {'Q [mvar]':>9}  {when:>19} {'TV [kV/s]':>9} "
+        f"{'at limit':>8} {'tip rms [um]':>12}"
+    ]
     for r in rows:
-        out.append(f"{r.policy:>8} {r.rms_voltage_V:10.1f} {num(r.reactive_power_var, 9, 2, 1e3)}"
-                   f"  {'':>19} {num(r.total_variation_V_per_s, 9, 2, 1e-3)} "
-                   f"{num(r.limit_fraction, 7, 1, 100)}% "
-                   f"{num(r.residual_tip_rms_m, 12, 2, 1e6)}")
+        out.append(
+            f"{r.policy:>8} {r.rms_voltage_V:10.1f} {num(r.reactive_power_var, 9, 2, 1e3)}"
+            f"  {'':>19} {num(r.total_variation_V_per_s, 9, 2, 1e-3)} "
+            f"{num(r.limit_fraction, 7, 1, 100)}% "
+            f"{num(r.residual_tip_rms_m, 12, 2, 1e6)}"
+        )
     return out
 
 
@@ -274,29 +321,41 @@ def format_thesis_comparison(rows: list[EvalRow]) -> str:
     """The env's saturated LQR and SMC rows against thesis Table 2 (peak, settling): the
     acceptance check of the reference policies on the thesis mesh (7 % peak, 10 %
     settling; tests/baselines/test_policies.py)."""
-    out = ["\nagainst thesis Table 2 (saturated rows; acceptance: peak 7 %, settling 10 %)",
-           f"{'row':>12} {'peak':>8} {'settling':>9}"]
+    out = [
+        "\nagainst thesis Table 2 (saturated rows; acceptance: peak 7 %, settling 10 %)",
+        f"{'row':>12} {'peak':>8} {'settling':>9}",
+    ]
     for r in rows:
         ref = thesis_row(r.case, r.policy, True) if r.case in THESIS_CASES else None
         if ref is not None:
-            out.append(f"{r.policy.upper() + ' case ' + str(r.case):>12} "
-                       f"{100 * (r.peak_mm / ref.peak_mm - 1):+7.1f}% "
-                       f"{100 * (r.settling_s / ref.settling_s - 1):+8.1f}%")
+            out.append(
+                f"{r.policy.upper() + ' case ' + str(r.case):>12} "
+                f"{100 * (r.peak_mm / ref.peak_mm - 1):+7.1f}% "
+                f"{100 * (r.settling_s / ref.settling_s - 1):+8.1f}%"
+            )
     return "\n".join(out)
 
 
-def add_scores(policies: dict, n_episodes: int | None, env_kwargs: dict, quiet: bool = True,
-               labels: dict | None = None, env_id: str = "ACLDBeam-v1") -> dict:
+def add_scores(
+    policies: dict,
+    n_episodes: int | None,
+    env_kwargs: dict,
+    quiet: bool = True,
+    labels: dict | None = None,
+    env_id: str = "ACLDBeam-v1",
+) -> dict:
     """Score ``policies`` on the test set of ``env_id`` (the first ``n_episodes``; 0:
     none), print the score table, and return ``{policy: score dict}`` for the JSON rows."""
     from .analysis.score import format_scores, score_policies
 
     if n_episodes == 0:
         return {}
-    scores = score_policies(policies, env_id=env_id, n_episodes=n_episodes,
-                            env_kwargs=env_kwargs, quiet=quiet)
-    where = ", ".join(f"{k}={v!r}" for k, v in env_kwargs.items()
-                      if v and (k, v) != ("mesh", "converged"))
+    scores = score_policies(
+        policies, env_id=env_id, n_episodes=n_episodes, env_kwargs=env_kwargs, quiet=quiet
+    )
+    where = ", ".join(
+        f"{k}={v!r}" for k, v in env_kwargs.items() if v and (k, v) != ("mesh", "converged")
+    )
     text = format_scores(scores, labels)
     print(text.replace(" random loads", f" random loads, {where}", 1) if where else text)
     return {name: s.as_dict() for name, s in scores.items()}
@@ -329,20 +388,35 @@ def plot_episodes(episodes: dict, directory: Path) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m baselines.evaluate", description=__doc__,
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(
+        prog="python -m baselines.evaluate",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     p.add_argument("--json", metavar="PATH", help="write the rows as JSON")
     p.add_argument("--plots", metavar="DIR", help="write one figure per case to DIR")
-    p.add_argument("--seed", type=arg_type(int, 0, 2**63 - 1), default=0,
-                   help="episode seed (sensor noise)")
-    p.add_argument("--env-id", choices=list(PRESETS), default="ACLDBeam-v1",
-                   help="the registered configuration (default ACLDBeam-v1)")
-    p.add_argument("--mesh", choices=MESHES, default=None,
-                   help="truth plant: the mesh-converged beam or the thesis mesh (default: "
-                        "the configuration's)")
-    p.add_argument("--score-episodes", type=arg_type(int, 0, 100_000), default=None,
-                   help="score on the first N episodes of the test set (0: no score; "
-                        "default: all of it)")
+    p.add_argument(
+        "--seed", type=arg_type(int, 0, 2**63 - 1), default=0, help="episode seed (sensor noise)"
+    )
+    p.add_argument(
+        "--env-id",
+        choices=list(PRESETS),
+        default="ACLDBeam-v1",
+        help="the registered configuration (default ACLDBeam-v1)",
+    )
+    p.add_argument(
+        "--mesh",
+        choices=MESHES,
+        default=None,
+        help="truth plant: the mesh-converged beam or the thesis mesh (default: "
+        "the configuration's)",
+    )
+    p.add_argument(
+        "--score-episodes",
+        type=arg_type(int, 0, 100_000),
+        default=None,
+        help="score on the first N episodes of the test set (0: no score; default: all of it)",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress line")
     args = p.parse_args(argv)
     try:  # unusable output paths fail now, before any computing
@@ -360,16 +434,16 @@ def main(argv: list[str] | None = None) -> int:
         from .policies import MPC_MISSING
 
         print(f"mpc skipped: {MPC_MISSING}")
-    rows = evaluate(policies, seed=args.seed, env_kwargs={"config": config},
-                    episodes=episodes, quiet=args.quiet)
+    rows = evaluate(
+        policies, seed=args.seed, env_kwargs={"config": config}, episodes=episodes, quiet=args.quiet
+    )
     print(format_tables(rows))
     if config.mesh == "thesis":
         print(format_thesis_comparison(rows))
     mesh = {} if args.mesh is None else {"mesh": args.mesh}  # (every id has a test set)
     scores = add_scores(policies, args.score_episodes, mesh, args.quiet, env_id=args.env_id)
     if args.json:
-        write_json(args.json, [dict(r.as_dict(), score=scores.get(r.policy))
-                               for r in rows])
+        write_json(args.json, [dict(r.as_dict(), score=scores.get(r.policy)) for r in rows])
         print(f"\nwrote {args.json}")
     if args.plots:
         plot_episodes(episodes, Path(args.plots))

@@ -28,8 +28,16 @@ from acld_gym.design.nominal import NominalDesign, nominal_design
 from acld_gym.envs.fingerprint import design_fingerprint
 from acld_gym.physics.actuator import V_LIMIT
 
-__all__ = ["PassivePolicy", "LQRPolicy", "SMCPolicy", "MPCPolicy", "MeasurementFeedback",
-           "MPC_MISSING", "mpc_available", "discrete_lqr_gain"]
+__all__ = [
+    "PassivePolicy",
+    "LQRPolicy",
+    "SMCPolicy",
+    "MPCPolicy",
+    "MeasurementFeedback",
+    "MPC_MISSING",
+    "mpc_available",
+    "discrete_lqr_gain",
+]
 
 
 class _Policy:
@@ -37,8 +45,7 @@ class _Policy:
 
     name = "policy"
 
-    def __init__(self, dt: float = 1e-3, nom: NominalDesign | None = None,
-                 mesh: str = "converged"):
+    def __init__(self, dt: float = 1e-3, nom: NominalDesign | None = None, mesh: str = "converged"):
         self.nom = nominal_design(dt, mesh=mesh) if nom is None else nom
         self.k = self.nom.design.reduced.order
 
@@ -62,8 +69,10 @@ class _Policy:
     def reduced_state(self, obs: np.ndarray) -> np.ndarray:
         obs = np.asarray(obs, dtype=np.float64)
         if obs.shape[-1] != self.k + 1:
-            raise ValueError(f"obs: {type(self).__name__} needs the env's 'estimate' observation "
-                             f"({self.k + 1} values), got shape {obs.shape}")
+            raise ValueError(
+                f"obs: {type(self).__name__} needs the env's 'estimate' observation "
+                f"({self.k + 1} values), got shape {obs.shape}"
+            )
         return obs[..., : self.k] * self.nom.xr_scale
 
     #: The voltage law on the reduced state (:class:`acld_gym.design.feedback.Feedback`);
@@ -104,8 +113,9 @@ class LQRPolicy(_Policy):
 
     name = "lqr"
 
-    def __init__(self, dt: float = 1e-3, weight: float = THESIS_LQR_WEIGHT, nom=None,
-                 mesh: str = "converged"):
+    def __init__(
+        self, dt: float = 1e-3, weight: float = THESIS_LQR_WEIGHT, nom=None, mesh: str = "converged"
+    ):
         super().__init__(dt, nom, mesh)
         self.law = self.nom.lqr_law(weight)
         self.K = self.law.a[None]
@@ -135,8 +145,15 @@ class SMCPolicy(_Policy):
 
     name = "smc"
 
-    def __init__(self, dt: float = 1e-3, weight: float = THESIS_SMC_WEIGHT,
-                 eta_factor: float = 1.5, eps: float = 1000.0, nom=None, mesh: str = "converged"):
+    def __init__(
+        self,
+        dt: float = 1e-3,
+        weight: float = THESIS_SMC_WEIGHT,
+        eta_factor: float = 1.5,
+        eps: float = 1000.0,
+        nom=None,
+        mesh: str = "converged",
+    ):
         super().__init__(dt, nom, mesh)
         if not eps > 0:
             raise ValueError(f"eps must be positive [V], got {eps!r}")
@@ -197,8 +214,15 @@ class MPCPolicy(_Policy):
 
     name = "mpc"
 
-    def __init__(self, dt: float = 1e-3, horizon: int = 60, rho: float = 1e-4,
-                 state_weight: float = STATE_WEIGHT, nom=None, mesh: str = "converged"):
+    def __init__(
+        self,
+        dt: float = 1e-3,
+        horizon: int = 60,
+        rho: float = 1e-4,
+        state_weight: float = STATE_WEIGHT,
+        nom=None,
+        mesh: str = "converged",
+    ):
         super().__init__(dt, nom, mesh)
         if not mpc_available():
             raise ImportError(MPC_MISSING)
@@ -234,8 +258,14 @@ class MPCPolicy(_Policy):
         Qx = state_weight * self.nom.design.state_weight(THESIS_LQR_WEIGHT) / V_LIMIT**2
         w, U = np.linalg.eigh(0.5 * (Qx + Qx.T))  # Q = L^T L (Q is only semi-definite)
         L = (np.sqrt(np.clip(w, 0.0, None))[:, None] * U.T) if state_weight > 0 else None
-        self._Lx = None if L is None else (np.einsum("mk,jkh->jmh", L, Gam).reshape(H * n, H),
-                                           np.einsum("mk,jkn->jmn", L, Phi).reshape(H * n, n))
+        self._Lx = (
+            None
+            if L is None
+            else (
+                np.einsum("mk,jkh->jmh", L, Gam).reshape(H * n, H),
+                np.einsum("mk,jkn->jmn", L, Phi).reshape(H * n, n),
+            )
+        )
         P = self.Theta.T @ self.Theta + rho * np.eye(H)
         if self._Lx is not None:
             P = P + self._Lx[0].T @ self._Lx[0]
@@ -263,8 +293,18 @@ class MPCPolicy(_Policy):
         if i not in self._solvers:
             P, Aeq, H = self._setup
             prob = self._osqp.OSQP()
-            prob.setup(P=P, q=np.zeros(H), A=Aeq, l=-np.ones(H), u=np.ones(H), verbose=False,
-                       eps_abs=1e-7, eps_rel=1e-7, polishing=False, max_iter=20000)
+            prob.setup(
+                P=P,
+                q=np.zeros(H),
+                A=Aeq,
+                l=-np.ones(H),
+                u=np.ones(H),
+                verbose=False,
+                eps_abs=1e-7,
+                eps_rel=1e-7,
+                polishing=False,
+                max_iter=20000,
+            )
             self._solvers[i] = prob
         return self._solvers[i]
 
@@ -299,8 +339,10 @@ class MeasurementFeedback:
 
     def __init__(self, policy: _Policy, observer):
         if observer.fed_load:
-            raise ValueError("MeasurementFeedback needs an observer that is not fed the load "
-                             "(observer='kalman'): the measurement observation has no load")
+            raise ValueError(
+                "MeasurementFeedback needs an observer that is not fed the load "
+                "(observer='kalman'): the measurement observation has no load"
+            )
         from acld_gym.envs.step import estimate_map
 
         self.policy = policy
@@ -320,20 +362,24 @@ class MeasurementFeedback:
         batched = obs.ndim == 2
         o = np.atleast_2d(obs)
         if o.shape[-1] != OBS_HIST + 1:
-            raise ValueError(f"obs: MeasurementFeedback needs the env's 'measurement' "
-                             f"observation ({OBS_HIST + 1} values), got shape {obs.shape}")
+            raise ValueError(
+                f"obs: MeasurementFeedback needs the env's 'measurement' "
+                f"observation ({OBS_HIST + 1} values), got shape {obs.shape}"
+            )
         ob, k = self.observer, self.observer.n
         y, u_prev = o[:, OBS_HIST - 1] * Y_SCALE, o[:, OBS_HIST] * V_LIMIT
         xhat = np.zeros((o.shape[0], k))
         if state is not None:
             old = np.atleast_2d(np.asarray(state, dtype=np.float64))
             lp = ob.Lp[:, 0]
-            xhat = (old[:, :k] @ (ob.A - np.outer(lp, ob.C[0])).T + np.outer(old[:, k], lp)
-                    + np.outer(u_prev, ob.B[:, 0]))
+            xhat = (
+                old[:, :k] @ (ob.A - np.outer(lp, ob.C[0])).T
+                + np.outer(old[:, k], lp)
+                + np.outer(u_prev, ob.B[:, 0])
+            )
             if episode_start is not None:
                 xhat[np.atleast_1d(np.asarray(episode_start, dtype=bool))] = 0.0
         estimate = np.hstack([xhat, y[:, None]]) @ self._est
         e = np.hstack([estimate, y[:, None] / Y_SCALE]).astype(np.float32)
         action, _ = self.policy.predict(e if batched else e[0], deterministic=deterministic)
         return action, np.hstack([xhat, y[:, None]])
-

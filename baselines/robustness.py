@@ -39,8 +39,9 @@ from acld_gym.physics.uncertainty import PARAM_NOISE_CLIP, RANDOMIZED
 __all__ = ["closed_loop_matrix", "spectral_radius", "corner_plants", "corner_study", "main"]
 
 
-def closed_loop_matrix(plant: SampledSystem, output: np.ndarray, observer: DiscreteObserver,
-                       gain: np.ndarray) -> np.ndarray:
+def closed_loop_matrix(
+    plant: SampledSystem, output: np.ndarray, observer: DiscreteObserver, gain: np.ndarray
+) -> np.ndarray:
     """The loop's one-period map on ``[x, xhat]`` (module docstring): the observer loop of
     :class:`baselines.analysis.linear.ObserverLoop` with the law written on the prior
     estimate and the measurement, :math:`V = h_x^T \\hat x + h_y y`."""
@@ -49,18 +50,28 @@ def closed_loop_matrix(plant: SampledSystem, output: np.ndarray, observer: Discr
     k = observer.n
     lc, C = observer.Lc[:, 0], observer.C[0]
     h = np.append(-(gain - (gain @ lc) * C), -(gain @ lc))  # V = h . [xhat, y]
-    loop = ObserverLoop(plant=plant, output=output, observer=observer, obs_map=np.eye(k + 1),
-                        observer_load=np.zeros(k))
+    loop = ObserverLoop(
+        plant=plant,
+        output=output,
+        observer=observer,
+        obs_map=np.eye(k + 1),
+        observer_load=np.zeros(k),
+    )
     return loop.closed_loop(LinearLaw(gain=h, offset=0.0))
 
 
-def spectral_radius(plant: SampledSystem, nom: NominalDesign, gain: np.ndarray,
-                    observer: DiscreteObserver | None = None) -> float:
+def spectral_radius(
+    plant: SampledSystem,
+    nom: NominalDesign,
+    gain: np.ndarray,
+    observer: DiscreteObserver | None = None,
+) -> float:
     """Spectral radius of the small-signal loop of ``gain`` on ``plant`` (default observer:
     the nominal Kalman filter)."""
     obs = nom.kalman if observer is None else observer
-    return float(np.max(np.abs(np.linalg.eigvals(closed_loop_matrix(plant, nom.output, obs,
-                                                                   gain)))))
+    return float(
+        np.max(np.abs(np.linalg.eigvals(closed_loop_matrix(plant, nom.output, obs, gain))))
+    )
 
 
 def corner_plants(nom: NominalDesign, param_noise: float):
@@ -69,8 +80,13 @@ def corner_plants(nom: NominalDesign, param_noise: float):
     truth = nom.truth
     f = float(np.exp(PARAM_NOISE_CLIP * param_noise))
     for signs in itertools.product((-1, 1), repeat=len(RANDOMIZED)):
-        p = replace(truth.params, **{name: getattr(truth.params, name) * f**s
-                                     for name, s in zip(RANDOMIZED, signs, strict=True)})
+        p = replace(
+            truth.params,
+            **{
+                name: getattr(truth.params, name) * f**s
+                for name, s in zip(RANDOMIZED, signs, strict=True)
+            },
+        )
         A, B, E, _ = truth.state_space(p)
         yield signs, discretize(A, B, E, nom.plant.dt, 1)
 
@@ -79,8 +95,15 @@ def corner_study(nom: NominalDesign, policies: dict, param_noise: float) -> dict
     """Per policy: ``{"nominal": radius, "worst": radius, "unstable": count, "corners": n}``
     over the corners of the box of ``param_noise`` (:func:`corner_plants`)."""
     gains = {name: pol.small_signal_gain() for name, pol in policies.items()}
-    out = {name: {"nominal": spectral_radius(nom.plant, nom, g), "worst": 0.0, "unstable": 0,
-                  "corners": 0} for name, g in gains.items()}
+    out = {
+        name: {
+            "nominal": spectral_radius(nom.plant, nom, g),
+            "worst": 0.0,
+            "unstable": 0,
+            "corners": 0,
+        }
+        for name, g in gains.items()
+    }
     for _, plant in corner_plants(nom, param_noise):
         for name, g in gains.items():
             r = spectral_radius(plant, nom, g)
@@ -94,11 +117,18 @@ def corner_study(nom: NominalDesign, policies: dict, param_noise: float) -> dict
 def main(argv: list[str] | None = None) -> int:
     from .policies import LQRPolicy, MPCPolicy, SMCPolicy
 
-    p = argparse.ArgumentParser(prog="python -m baselines.robustness", description=__doc__,
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(
+        prog="python -m baselines.robustness",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     p.add_argument("--mesh", choices=MESHES, nargs="+", default=list(MESHES))
-    p.add_argument("--param-noise", type=float, default=None,
-                   help="box half-width in std (default: the env's bound for the mesh)")
+    p.add_argument(
+        "--param-noise",
+        type=float,
+        default=None,
+        help="box half-width in std (default: the env's bound for the mesh)",
+    )
     args = p.parse_args(argv)
     print("| mesh | param_noise | policy | nominal | worst corner | unstable corners |")
     print("|---|---|---|---|---|---|")
@@ -107,8 +137,10 @@ def main(argv: list[str] | None = None) -> int:
         sigma = PARAM_NOISE_MAX[mesh] if args.param_noise is None else args.param_noise
         pols = {cls.name: cls(nom=nom) for cls in (LQRPolicy, SMCPolicy, MPCPolicy)}
         for name, rec in corner_study(nom, pols, sigma).items():
-            print(f"| {mesh} | {sigma:g} | {name} | {rec['nominal']:.5f} | {rec['worst']:.5f} | "
-                  f"{rec['unstable']} of {rec['corners']} |")
+            print(
+                f"| {mesh} | {sigma:g} | {name} | {rec['nominal']:.5f} | {rec['worst']:.5f} | "
+                f"{rec['unstable']} of {rec['corners']} |"
+            )
     return 0
 
 

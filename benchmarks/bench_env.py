@@ -83,8 +83,9 @@ def _bare_product(env: ACLDBeamVectorEnv):
     """The N = 1024 step's product alone: state rows (N x nz) times G^T (nz x m)."""
     b = env.batch
     Z, GT, out = b.Z.copy(), b.GT.copy(), np.empty_like(b.OUT)
-    return (lambda j: np.matmul(Z, GT, out=out)), f"{Z.shape[0]}x{Z.shape[1]} @ " \
-        f"{GT.shape[0]}x{GT.shape[1]}"
+    return (
+        lambda j: np.matmul(Z, GT, out=out)
+    ), f"{Z.shape[0]}x{Z.shape[1]} @ {GT.shape[0]}x{GT.shape[1]}"
 
 
 class _NoOpEnv(gym.Env):
@@ -101,9 +102,18 @@ class _NoOpEnv(gym.Env):
     def step(self, action):
         v = float(action[0])
         self.k += 1
-        info = {"tip_deflection": 0.0, "voltage": v, "requested_voltage": v, "clipped": False,
-                "tip_load": 0.0, "time": self.k * 1e-3, "xr_true": np.zeros(8),
-                "terminated_by": None, "reward_deflection": 0.0, "reward_voltage": -v * v}
+        info = {
+            "tip_deflection": 0.0,
+            "voltage": v,
+            "requested_voltage": v,
+            "clipped": False,
+            "tip_load": 0.0,
+            "time": self.k * 1e-3,
+            "xr_true": np.zeros(8),
+            "terminated_by": None,
+            "reward_deflection": 0.0,
+            "reward_voltage": -v * v,
+        }
         return np.zeros(9, np.float32), -v * v, False, self.k >= EPISODE, info
 
 
@@ -153,11 +163,19 @@ def bench_breakdown(episodes: int) -> list[tuple[str, float]]:
         rows.append(("(acld_gym.envs._stepcore not built: numpy steps only)", float("nan")))
     ref = ACLDBeamEnv(load_case="random")
     ref.compiled_step = False
-    rows.append(("single env step, numpy reference path [us]",
-                 _episode_step_us(ref, acts, max(1, episodes // 10))))
+    rows.append(
+        (
+            "single env step, numpy reference path [us]",
+            _episode_step_us(ref, acts, max(1, episodes // 10)),
+        )
+    )
     noop = _single_stepper(_NoOpEnv())
-    rows.append(("no-op Gymnasium env in Python, same spaces and info [us]",
-                 1e6 / max(_rate(noop, 1, 5 * EPISODE) for _ in range(3))))
+    rows.append(
+        (
+            "no-op Gymnasium env in Python, same spaces and info [us]",
+            1e6 / max(_rate(noop, 1, 5 * EPISODE) for _ in range(3)),
+        )
+    )
     return rows
 
 
@@ -171,15 +189,23 @@ def _first_make_seconds() -> float:
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--repeats", type=int, default=8,
-                    help="windows per measurement; the best is reported (default 8)")
+    ap.add_argument(
+        "--repeats",
+        type=int,
+        default=8,
+        help="windows per measurement; the best is reported (default 8)",
+    )
     args = ap.parse_args(argv)
     r = max(1, args.repeats)
-    print(f"ACLDBeam-v1 env-steps/s (obs 'estimate'; {os.cpu_count()} CPUs, numpy "
-          f"{np.__version__}, best of {r} windows; compiled step: {COMPILED_STEP})")
+    print(
+        f"ACLDBeam-v1 env-steps/s (obs 'estimate'; {os.cpu_count()} CPUs, numpy "
+        f"{np.__version__}, best of {r} windows; compiled step: {COMPILED_STEP})"
+    )
     startup = [_first_make_seconds() for _ in range(3)]
-    print("first gym.make('ACLDBeam-v1') in a fresh process (import included), 3 runs [s]: "
-          + ", ".join(f"{t:.2f}" for t in startup))
+    print(
+        "first gym.make('ACLDBeam-v1') in a fresh process (import included), 3 runs [s]: "
+        + ", ".join(f"{t:.2f}" for t in startup)
+    )
     # The main comparison: N = 1024 on case 1 and on random loads, and the bare product,
     # interleaved window by window so that all three see the same machine.
     big = {case: _vector_stepper(1024, load_case=case) for case in (1, "random")}
@@ -199,16 +225,31 @@ def main(argv=None) -> None:
         print(f"{name:<{width}}  {rate:>12,.0f}  ({rate / best['bare']:.2f} of the product)")
     print()
     others = [
-        ("single ACLDBeamEnv (raw class), load_case='random'",
-         _single_stepper(ACLDBeamEnv(load_case="random")), 1, EPISODE),
-        ("single gym.make (OrderEnforcing, PassiveEnvChecker), 'random'",
-         _single_stepper(gym.make("ACLDBeam-v1", load_case="random")), 1, EPISODE),
-        ("ACLDBeamVectorEnv N=1, 'random'", _vector_stepper(1, load_case="random")[1], 1,
-         EPISODE + 1),
-        ("ACLDBeamVectorEnv N=64, 'random'", _vector_stepper(64, load_case="random")[1], 64,
-         EPISODE + 1),
-        ("SB3VecEnv N=64, 'random' (infos as list of dicts)", _sb3_stepper(64), 64,
-         EPISODE + 1),
+        (
+            "single ACLDBeamEnv (raw class), load_case='random'",
+            _single_stepper(ACLDBeamEnv(load_case="random")),
+            1,
+            EPISODE,
+        ),
+        (
+            "single gym.make (OrderEnforcing, PassiveEnvChecker), 'random'",
+            _single_stepper(gym.make("ACLDBeam-v1", load_case="random")),
+            1,
+            EPISODE,
+        ),
+        (
+            "ACLDBeamVectorEnv N=1, 'random'",
+            _vector_stepper(1, load_case="random")[1],
+            1,
+            EPISODE + 1,
+        ),
+        (
+            "ACLDBeamVectorEnv N=64, 'random'",
+            _vector_stepper(64, load_case="random")[1],
+            64,
+            EPISODE + 1,
+        ),
+        ("SB3VecEnv N=64, 'random' (infos as list of dicts)", _sb3_stepper(64), 64, EPISODE + 1),
     ]
     for name, step, n, steps in others:
         rate = max(_rate(step, n, steps) for _ in range(r))

@@ -39,8 +39,13 @@ def train_rate(backend: str, n_envs: int, steps: int) -> float:
     from train.vec import make_vec_env
 
     cfg = load_config("ppo")
-    cfg = cfg.with_overrides(n_envs=n_envs, model={  # one minibatch per rollout
-        **cfg.model, "batch_size": n_envs * cfg.model["n_steps"]})
+    cfg = cfg.with_overrides(
+        n_envs=n_envs,
+        model={  # one minibatch per rollout
+            **cfg.model,
+            "batch_size": n_envs * cfg.model["n_steps"],
+        },
+    )
     venv = make_vec_env(cfg, 0, backend=backend)
     model = make_model(cfg, venv, 0)
     t0 = time.perf_counter()

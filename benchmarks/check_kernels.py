@@ -106,8 +106,10 @@ def main() -> int:
             rel = float(np.max(np.abs(a - b)) / max(float(np.max(np.abs(b))), 1e-300))
             cells.append(f"{rel:14.1e}")
         print(f"{key:32s}" + "".join(cells))
-    print("\nsign(C_r) in the raw Schur coordinates (basis='schur', observed by no env since "
-          "0.3.0; by v0 before) -- what changes between kernels:")
+    print(
+        "\nsign(C_r) in the raw Schur coordinates (basis='schur', observed by no env since "
+        "0.3.0; by v0 before) -- what changes between kernels:"
+    )
     for k in kernels:
         signs = "".join("+" if s > 0 else "-" for s in results[k]["raw_schur_sign_C"][0])
         print(f"  {k:12s} {signs}")

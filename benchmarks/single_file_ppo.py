@@ -48,10 +48,12 @@ CLIP_OBS_1X = "lambda obs: np.clip(obs, -10, 10), env.observation_space)"
 #: The modes ``ObserveModes`` keeps (mode 1 and the tip: with modes 1 and 2, seed 2 ended at
 #: 2.05x LQR on case 1, with mode 1 only at 0.93x; docs/training.md).
 MODES = 1
-EDIT = ('env = ObserveModes(UnitAction(gym.make(env_id, load_case="random", '
-        f'reward_scale="passive")), modes={MODES})')
+EDIT = (
+    'env = ObserveModes(UnitAction(gym.make(env_id, load_case="random", '
+    f'reward_scale="passive")), modes={MODES})'
+)
 IMPORTS = "import acld_gym  # noqa\nfrom acld_gym.wrappers import ObserveModes, UnitAction\n"
-SAVE = '''
+SAVE = """
 # --- instrumentation (benchmarks/single_file_ppo.py): save the agent and its normalization ---
 import pickle as _pickle
 _norm = envs.envs[0]
@@ -60,22 +62,24 @@ while not isinstance(_norm, gym.wrappers.NormalizeObservation):
 with open({out!r}, "wb") as _f:
     _actor = {{k: v.cpu().numpy() for k, v in agent.actor_mean.state_dict().items()}}
     _pickle.dump({{"actor": _actor, "mean": _norm.obs_rms.mean, "var": _norm.obs_rms.var}}, _f)
-'''
+"""
 
 
 def edited_source(text: str, out: Path) -> str:
     """The README's two edits and the instrumentation block; ``ValueError`` if the file is not
     the expected CleanRL script."""
     if text.count(MAKE) < 1 or "def make_env" not in text or "__main__" not in text:
-        raise ValueError("file: expected CleanRL's ppo_continuous_action.py (a make_env with "
-                         f"{MAKE!r})")
+        raise ValueError(
+            f"file: expected CleanRL's ppo_continuous_action.py (a make_env with {MAKE!r})"
+        )
     lines = text.splitlines(keepends=True)
     at = next(i for i, line in enumerate(lines) if line.startswith("import gymnasium"))
-    text = "".join(lines[:at + 1]) + IMPORTS + "".join(lines[at + 1:])
+    text = "".join(lines[: at + 1]) + IMPORTS + "".join(lines[at + 1 :])
     text = text.replace(MAKE, EDIT).replace(CLIP_OBS, CLIP_OBS_1X)
     main_at = text.index("    if args.save_model:")
-    block = "".join("    " + line + "\n" if line else "\n"
-                    for line in SAVE.format(out=str(out)).splitlines())
+    block = "".join(
+        "    " + line + "\n" if line else "\n" for line in SAVE.format(out=str(out)).splitlines()
+    )
     return text[:main_at] + block + text[main_at:]
 
 
@@ -84,8 +88,9 @@ class _Actor:
     the env's full observation (``slots``: the entries the trained agent saw)."""
 
     def __init__(self, saved: dict, slots=None):
-        self.layers = [(saved["actor"][f"{i}.weight"], saved["actor"][f"{i}.bias"])
-                       for i in (0, 2, 4)]
+        self.layers = [
+            (saved["actor"][f"{i}.weight"], saved["actor"][f"{i}.bias"]) for i in (0, 2, 4)
+        ]
         self.mean, self.var = saved["mean"], saved["var"]
         self.slots = None if slots is None else np.asarray(slots)
 
@@ -105,7 +110,7 @@ class _Actor:
 def split_flags(argv: list) -> tuple[list, list]:
     """This script's arguments and, after ``--``, the file's own flags."""
     cut = argv.index("--") if "--" in argv else len(argv)
-    return argv[:cut], argv[cut + 1:]
+    return argv[:cut], argv[cut + 1 :]
 
 
 def main(argv=None) -> int:
@@ -124,11 +129,24 @@ def main(argv=None) -> int:
         script = tmp / "ppo_continuous_action.py"
         script.write_text(edited_source(args.file.read_text(), saved))
         t0 = time.perf_counter()
-        subprocess.run([sys.executable, str(script), "--env-id", "ACLDBeam-v1",
-                        "--total-timesteps", str(args.total_timesteps), "--seed",
-                        str(args.seed), "--no-cuda", *flags], cwd=tmp, check=True,
-                       env={**os.environ, "OMP_NUM_THREADS": THREADS},
-                       stdout=subprocess.DEVNULL)
+        subprocess.run(
+            [
+                sys.executable,
+                str(script),
+                "--env-id",
+                "ACLDBeam-v1",
+                "--total-timesteps",
+                str(args.total_timesteps),
+                "--seed",
+                str(args.seed),
+                "--no-cuda",
+                *flags,
+            ],
+            cwd=tmp,
+            check=True,
+            env={**os.environ, "OMP_NUM_THREADS": THREADS},
+            stdout=subprocess.DEVNULL,
+        )
         wall = time.perf_counter() - t0
         import pickle
 
@@ -138,9 +156,13 @@ def main(argv=None) -> int:
         slots = ObserveModes(ACLDBeamEnv(), modes=MODES).slots
         actor = _Actor(pickle.loads(saved.read_bytes()), slots)
     rel = ise_rel_lqr(actor, "ACLDBeam-v1")
-    out = {"seed": args.seed, "total_timesteps": args.total_timesteps, "flags": flags,
-           "wall_seconds": wall,
-           "ise_rel_lqr": {str(k): float(v) for k, v in rel.items()}}
+    out = {
+        "seed": args.seed,
+        "total_timesteps": args.total_timesteps,
+        "flags": flags,
+        "wall_seconds": wall,
+        "ise_rel_lqr": {str(k): float(v) for k, v in rel.items()},
+    }
     print(json.dumps(out, indent=1))
     if args.json is not None:
         from acld_gym.util.atomic import write_text

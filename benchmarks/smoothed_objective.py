@@ -29,10 +29,13 @@ def linear_law(actor) -> tuple[np.ndarray, float]:
     clips an unclipped actor at +/-120 V)."""
     kinds = [op["op"] for op in actor.ops]
     if kinds not in (["linear"], ["linear", "clip"]) or (
-            kinds[-1] == "clip" and (actor.ops[1]["low"], actor.ops[1]["high"]) != (-1.0, 1.0)):
+        kinds[-1] == "clip" and (actor.ops[1]["low"], actor.ops[1]["high"]) != (-1.0, 1.0)
+    ):
         raise ValueError(f"actor: expected [linear] or [linear, clip(-1, 1)], got {actor.ops}")
-    return (np.asarray(actor.arrays["W0"], float).ravel(),
-            float(np.asarray(actor.arrays["b0"]).ravel()[0]))
+    return (
+        np.asarray(actor.arrays["W0"], float).ravel(),
+        float(np.asarray(actor.arrays["b0"]).ravel()[0]),
+    )
 
 
 class _PerEpisodeLaw:
@@ -65,8 +68,13 @@ def main(argv=None) -> int:
     p.add_argument("--seed", type=int, default=0, help="the PPO recipe's seed")
     p.add_argument("--loads", type=int, default=256, help="validation loads")
     p.add_argument("--draws", type=int, default=4, help="noise draws per load")
-    p.add_argument("--scales", type=float, nargs="+", default=[1.0, 0.5, 0.25],
-                   help="fractions of the trained sigma")
+    p.add_argument(
+        "--scales",
+        type=float,
+        nargs="+",
+        default=[1.0, 0.5, 0.25],
+        help="fractions of the trained sigma",
+    )
     args = p.parse_args(argv)
     from train.agent import TrainedAgent, export_sb3
     from train.bench.evaluate import validation_seeds
@@ -76,14 +84,18 @@ def main(argv=None) -> int:
     pol, record = train_sb3(load_config("ppo"), args.seed, "ACLDBeam-v1")
     T = np.asarray(record["transform"], float)
     sigma = np.exp(pol.model.policy.log_std.detach().numpy().ravel())
-    laws = {f"ppo seed {args.seed}": linear_law(export_sb3(pol.model)),  # T folded in: on z
-            "vrs (shipped)": linear_law(TrainedAgent.load("train/agents/vrs").actor)}
+    laws = {
+        f"ppo seed {args.seed}": linear_law(export_sb3(pol.model)),  # T folded in: on z
+        "vrs (shipped)": linear_law(TrainedAgent.load("train/agents/vrs").actor),
+    }
     seeds = validation_seeds(args.loads)
     rng = np.random.default_rng(12345)
     eps = rng.normal(size=(args.draws, len(seeds), sigma.size)) * sigma
     print(f"PPO's final gSDE sigma (whitened gains): {np.array2string(sigma, precision=3)}")
-    print(f"J_sigma on {args.loads} validation loads x {args.draws} gain draws (lower is "
-          f"better; 1 = passive)\n")
+    print(
+        f"J_sigma on {args.loads} validation loads x {args.draws} gain draws (lower is "
+        f"better; 1 = passive)\n"
+    )
     print("| sigma | " + " | ".join(laws) + " |")
     print("|---|" + "---|" * len(laws))
     zero = np.zeros((len(seeds), sigma.size))

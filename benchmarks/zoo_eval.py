@@ -24,8 +24,11 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("algo", choices=("ppo", "sac"))
     p.add_argument("run", type=Path, help="the rl-zoo3 run directory")
-    p.add_argument("--best", action="store_true",
-                   help="the best model of rl-zoo3's evaluations (best_model.zip)")
+    p.add_argument(
+        "--best",
+        action="store_true",
+        help="the best model of rl-zoo3's evaluations (best_model.zip)",
+    )
     args = p.parse_args(argv)
     from stable_baselines3 import PPO, SAC
 
@@ -42,8 +45,12 @@ def main(argv=None) -> int:
     headroom = getattr(model.policy, "action_headroom", 1.0)
     policy = SB3Policy(model, None, None, voltage_map=VoltageMap(headroom=headroom))
     rel = {str(k): round(float(v), 4) for k, v in ise_rel_lqr(policy, "ACLDBeam-v1").items()}
-    print(json.dumps({"run": str(args.run), "algo": args.algo, "model": path.name,
-                      "ise_rel_lqr": rel}, indent=1))
+    print(
+        json.dumps(
+            {"run": str(args.run), "algo": args.algo, "model": path.name, "ise_rel_lqr": rel},
+            indent=1,
+        )
+    )
     return 0
 
 

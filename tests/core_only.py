@@ -20,10 +20,12 @@ sys.meta_path.insert(0, Block())
 """
 
 
-def run_core_only(code: str, cwd: str | Path | None = None,
-                  blocked_extra: tuple[str, ...] = ()) -> subprocess.CompletedProcess:
+def run_core_only(
+    code: str, cwd: str | Path | None = None, blocked_extra: tuple[str, ...] = ()
+) -> subprocess.CompletedProcess:
     """``code`` in a fresh interpreter with :data:`BLOCKED` (and ``blocked_extra``)
     unimportable; the completed process, its output captured as text."""
     blocker = _BLOCKER.replace(repr(BLOCKED), repr(BLOCKED + tuple(blocked_extra)))
-    return subprocess.run([sys.executable, "-c", blocker + code], capture_output=True,
-                          text=True, cwd=cwd)
+    return subprocess.run(
+        [sys.executable, "-c", blocker + code], capture_output=True, text=True, cwd=cwd
+    )

@@ -11,8 +11,10 @@ import pytest
 ROOT = Path(__file__).resolve().parent.parent
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md"))]
 #: Top-level directories of the repository whose paths the pages point at.
-_PATH = re.compile(r"(?<![\w./-])((?:acld_gym|baselines|train|benchmarks|tests|docs|\.ci)"
-                   r"/[\w./*<>{},-]*[\w*>}])")
+_PATH = re.compile(
+    r"(?<![\w./-])((?:acld_gym|baselines|train|benchmarks|tests|docs|\.ci)"
+    r"/[\w./*<>{},-]*[\w*>}])"
+)
 _PLACEHOLDER = re.compile(r"<[^>]*>|\{[^}]*\}|(?<=/)[A-Z][A-Z_]*(?=[./]|$)")
 
 
@@ -27,15 +29,19 @@ def named_paths(text: str) -> set[str]:
 
 
 def test_named_paths_parser():
-    text = ("see `train/benchmark/ALGO.yaml` and `acld_gym/physics/data/plant-<hash>.npz`,\n"
-            "`python -m train.benchmark --out runs/x` and `tests/{a,b}.py`\n"
-            "```bash\ncat train/nothing.yaml\n```\n")
-    assert named_paths(text) == {"train/benchmark/*.yaml", "acld_gym/physics/data/plant-*.npz",
-                                 "tests/*.py"}
+    text = (
+        "see `train/benchmark/ALGO.yaml` and `acld_gym/physics/data/plant-<hash>.npz`,\n"
+        "`python -m train.benchmark --out runs/x` and `tests/{a,b}.py`\n"
+        "```bash\ncat train/nothing.yaml\n```\n"
+    )
+    assert named_paths(text) == {
+        "train/benchmark/*.yaml",
+        "acld_gym/physics/data/plant-*.npz",
+        "tests/*.py",
+    }
 
 
 @pytest.mark.parametrize("page", PAGES, ids=lambda p: str(p.relative_to(ROOT)))
 def test_every_named_path_exists(page):
-    missing = sorted(p for p in named_paths(page.read_text())
-                     if not glob.glob(str(ROOT / p)))
+    missing = sorted(p for p in named_paths(page.read_text()) if not glob.glob(str(ROOT / p)))
     assert not missing, f"{page.name} names paths that do not exist: {missing}"

@@ -36,8 +36,11 @@ def _rows(text: str, score: bool = False) -> list[list[str]]:
     """The policy rows of the evaluation tables (``score``: of the score table that follows
     them), without the ms/step column of the case tables."""
     cases, _, scores = text.partition("\nscore on ")
-    rows = [line.split() for line in (scores if score else cases).splitlines()
-            if re.match(r"^\s+(passive|lqr|smc|mpc|bound)\s", line)]
+    rows = [
+        line.split()
+        for line in (scores if score else cases).splitlines()
+        if re.match(r"^\s+(passive|lqr|smc|mpc|bound)\s", line)
+    ]
     return [r[:-1] if len(r) == 9 else r for r in rows]  # (9 columns: a row with ms/step)
 
 
@@ -47,8 +50,11 @@ def _same_rows(printed: list[list[str]], page: list[list[str]]) -> list[str]:
     cycle (the lab and hard presets) that CPU-dependent round-off reaches the fourth digit
     (tip RMS 56.32 against 56.31 um with OpenBLAS's Nehalem kernels). The MPC's numbers
     are compared to one unit of their last digit, its shares at the limit to 0.5 points."""
-    bad = [f"{len(printed)} rows printed, {len(page)} on the page"] if len(printed) != len(
-        page) else []
+    bad = (
+        [f"{len(printed)} rows printed, {len(page)} on the page"]
+        if len(printed) != len(page)
+        else []
+    )
     for a, b in zip(printed, page, strict=False):
         if a == b:
             continue
@@ -60,8 +66,11 @@ def _same_rows(printed: list[list[str]], page: list[list[str]]) -> list[str]:
             x, y = x.strip("[],%"), y.strip("[],%")  # also the score's "[0.004," entries
             xv, yv = float(x), float(y)
             digits = y.partition("e")[0].partition(".")[2]
-            unit = 0.5 if pct else 10.0 ** -len(digits) * (
-                10.0 ** int(y.partition("e")[2]) if "e" in y else 1.0)
+            unit = (
+                0.5
+                if pct
+                else 10.0 ** -len(digits) * (10.0 ** int(y.partition("e")[2]) if "e" in y else 1.0)
+            )
             if abs(xv - yv) > unit * (1 + 1e-9):
                 bad.append(f"{a} != {b}")
                 break
@@ -87,10 +96,14 @@ def test_same_rows_tolerates_only_the_mpc_last_digit():
 
 def _sections() -> list[tuple[str, str]]:
     text = "\n".join((DOCS / page).read_text() for page in TABLE_PAGES)
-    sections = re.findall(r"`python -m baselines\.evaluate --env-id (\S+)`:\n\n```\n(.*?)```",
-                          text, flags=re.S)
-    assert [env_id for env_id, _ in sections] == ["ACLDBeam-v1", "ACLDBeamLab-v1",
-                                                   "ACLDBeamHard-v1"]
+    sections = re.findall(
+        r"`python -m baselines\.evaluate --env-id (\S+)`:\n\n```\n(.*?)```", text, flags=re.S
+    )
+    assert [env_id for env_id, _ in sections] == [
+        "ACLDBeam-v1",
+        "ACLDBeamLab-v1",
+        "ACLDBeamHard-v1",
+    ]
     return sections
 
 

@@ -32,10 +32,18 @@ def module_name(path: Path) -> str:
 
 def self_attributes(tree: ast.Module) -> dict[str, set[str]]:
     """The instance attributes (``self.x = ...``) each class of a module assigns."""
-    return {c.name: {n.attr for n in ast.walk(c) if isinstance(n, ast.Attribute) and
-                     isinstance(n.ctx, ast.Store) and isinstance(n.value, ast.Name) and
-                     n.value.id == "self"}
-            for c in ast.walk(tree) if isinstance(c, ast.ClassDef)}
+    return {
+        c.name: {
+            n.attr
+            for n in ast.walk(c)
+            if isinstance(n, ast.Attribute)
+            and isinstance(n.ctx, ast.Store)
+            and isinstance(n.value, ast.Name)
+            and n.value.id == "self"
+        }
+        for c in ast.walk(tree)
+        if isinstance(c, ast.ClassDef)
+    }
 
 
 def top_level_names(tree: ast.Module) -> frozenset[str]:
@@ -62,14 +70,16 @@ def docstrings(tree: ast.Module) -> list[tuple[str | None, str]]:
             elif isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef)):
                 out.append((cls, ast.get_docstring(child) or ""))
                 visit(child, cls)
+
     visit(tree, None)
     return out
 
 
 def _getattr_chain(obj, names: list[str]) -> bool:
     for name in names:
-        if name in getattr(obj, "__dataclass_fields__", {}) or \
-                name in getattr(obj, "__annotations__", {}):
+        if name in getattr(obj, "__dataclass_fields__", {}) or name in getattr(
+            obj, "__annotations__", {}
+        ):
             obj = None  # a field: nothing further to look up
             continue
         if obj is None or not hasattr(obj, name):
@@ -89,9 +99,14 @@ def _absolute(target: str) -> bool:
     return False
 
 
-def resolves(role: str, target: str, module: str, cls: str | None,
-             defined: frozenset[str] | None = None,
-             attributes: dict[str, set[str]] | None = None) -> bool:
+def resolves(
+    role: str,
+    target: str,
+    module: str,
+    cls: str | None,
+    defined: frozenset[str] | None = None,
+    attributes: dict[str, set[str]] | None = None,
+) -> bool:
     """Whether ``target`` names something, absolutely or from the docstring's module/class.
     ``defined``: the module's top-level names, read from its source instead of importing
     it (the test modules, which import their helpers relative to pytest's rootdir)."""
@@ -123,16 +138,25 @@ def broken_roles() -> list[tuple[str, str, str]]:
 
 
 def broken_test_paths() -> list[str]:
-    texts = [*sources(), ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md")),
-             *sorted((ROOT / "train").rglob("*.yaml"))]
-    return [f"{p.relative_to(ROOT)}: {m}" for p in texts
-            for m in dict.fromkeys(TEST_PATH.findall(p.read_text()))
-            if not (ROOT / m).exists()]
+    texts = [
+        *sources(),
+        ROOT / "README.md",
+        *sorted((ROOT / "docs").rglob("*.md")),
+        *sorted((ROOT / "train").rglob("*.yaml")),
+    ]
+    return [
+        f"{p.relative_to(ROOT)}: {m}"
+        for p in texts
+        for m in dict.fromkeys(TEST_PATH.findall(p.read_text()))
+        if not (ROOT / m).exists()
+    ]
 
 
 def test_the_scanner_finds_broken_references():
-    tree = ast.parse('"""See :func:`numpy.sum`, :class:`Nope`, :mod:`no.such`."""\n'
-                     'class A:\n    """:meth:`A.f`"""\n    def f(self):\n        """x"""\n')
+    tree = ast.parse(
+        '"""See :func:`numpy.sum`, :class:`Nope`, :mod:`no.such`."""\n'
+        'class A:\n    """:meth:`A.f`"""\n    def f(self):\n        """x"""\n'
+    )
     found = [(cls, ROLE.findall(d)) for cls, d in docstrings(tree)]
     assert found[0] == (None, [("func", "numpy.sum"), ("class", "Nope"), ("mod", "no.such")])
     assert found[1] == ("A", [("meth", "A.f")])
@@ -147,16 +171,16 @@ def test_the_scanner_finds_broken_references():
     assert resolves("attr", "x", "tests.x", "B", frozenset(), attrs)
     assert resolves("attr", "B.x", "tests.x", None, frozenset(), attrs)
     assert not resolves("attr", "y", "tests.x", "B", frozenset(), attrs)
-    assert TEST_PATH.findall("(tests/train/test_agents.py) and src/tests/x") == \
-        ["tests/train/test_agents.py"]
+    assert TEST_PATH.findall("(tests/train/test_agents.py) and src/tests/x") == [
+        "tests/train/test_agents.py"
+    ]
 
 
 def test_every_docstring_reference_resolves():
     roles = broken_roles()
     broken = [f"{f}: :{role}:`{t}`" for f, role, t in roles if t not in PENDING.get(f, ())]
     assert not broken, f"{len(broken)} broken:\n" + "\n".join(broken)
-    mended = {(f, t) for f, names in PENDING.items() for t in names} - \
-        {(f, t) for f, _, t in roles}
+    mended = {(f, t) for f, names in PENDING.items() for t in names} - {(f, t) for f, _, t in roles}
     assert not mended, f"mended, remove from PENDING: {sorted(mended)}"
 
 

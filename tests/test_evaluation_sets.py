@@ -53,8 +53,9 @@ def test_each_preset_has_its_own_block_of_seeds():
     assert TEST_SEEDS["ACLDBeam-v0"] == TEST_SEEDS["ACLDBeam-v1"]
 
 
-@pytest.mark.parametrize("seeds, word", [((), "distinct"), ((500_000, 500_000), "distinct"),
-                                         ((7,), "reserved")])
+@pytest.mark.parametrize(
+    "seeds, word", [((), "distinct"), ((500_000, 500_000), "distinct"), ((7,), "reserved")]
+)
 def test_a_set_outside_the_rules_is_refused(seeds, word):
     with pytest.raises(ValueError, match=word):
         EvaluationSet("ACLDBeam-v1", 1, seeds)

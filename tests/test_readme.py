@@ -29,7 +29,7 @@ BLOCKS = python_blocks(README.read_text())
 
 def test_readme_has_the_quick_starts():
     assert len(BLOCKS) >= 3
-    assert any("gym.make(\"ACLDBeam-v1\"" in b for b in BLOCKS)
+    assert any('gym.make("ACLDBeam-v1"' in b for b in BLOCKS)
 
 
 @pytest.fixture(scope="module")

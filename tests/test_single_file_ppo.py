@@ -19,7 +19,7 @@ sfp = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(sfp)
 
 # The shape of CleanRL's ppo_continuous_action.py where the script edits it.
-CLEANRL_LIKE = '''import numpy as np
+CLEANRL_LIKE = """import numpy as np
 import gymnasium as gym
 import torch
 
@@ -38,7 +38,7 @@ if __name__ == "__main__":
     agent = None
     if args.save_model:
         pass
-'''
+"""
 
 
 def test_edits_are_the_readmes_and_nothing_else(tmp_path):
@@ -50,9 +50,13 @@ def test_edits_are_the_readmes_and_nothing_else(tmp_path):
     assert repr(str(out)) in text
     # undoing the three edits and the block gives the file back
     start = text.index("\n    # --- instrumentation")
-    block = text[start:text.index("    if args.save_model:")]
-    undone = (text.replace(sfp.IMPORTS, "").replace(sfp.EDIT, sfp.MAKE)
-              .replace(sfp.CLIP_OBS_1X, sfp.CLIP_OBS).replace(block, ""))
+    block = text[start : text.index("    if args.save_model:")]
+    undone = (
+        text.replace(sfp.IMPORTS, "")
+        .replace(sfp.EDIT, sfp.MAKE)
+        .replace(sfp.CLIP_OBS_1X, sfp.CLIP_OBS)
+        .replace(block, "")
+    )
     assert undone == CLEANRL_LIKE
     compile(text, "ppo_continuous_action.py", "exec")
 
@@ -64,8 +68,7 @@ def test_other_files_are_refused():
 
 def test_the_readme_line_builds_a_clean_env():
     env_id = "ACLDBeam-v1"
-    scope = {"gym": gym, "env_id": env_id, "ObserveModes": ObserveModes,
-             "UnitAction": UnitAction}
+    scope = {"gym": gym, "env_id": env_id, "ObserveModes": ObserveModes, "UnitAction": UnitAction}
     exec(sfp.EDIT, scope)
     env = scope["env"]
     check_env(env, skip_render_check=True)
@@ -76,8 +79,10 @@ def test_the_readme_line_builds_a_clean_env():
 
 def test_actor_reads_the_trained_slots_and_returns_volts():
     rng = np.random.default_rng(0)
-    layers = {f"{i}.weight": rng.normal(size=shape) for i, shape in
-              ((0, (4, 3)), (2, (4, 4)), (4, (1, 4)))}
+    layers = {
+        f"{i}.weight": rng.normal(size=shape)
+        for i, shape in ((0, (4, 3)), (2, (4, 4)), (4, (1, 4)))
+    }
     layers.update({f"{i}.bias": rng.normal(size=n) for i, n in ((0, 4), (2, 4), (4, 1))})
     saved = {"actor": layers, "mean": rng.normal(size=3), "var": rng.uniform(1, 2, 3)}
     env = gym.make("ACLDBeam-v1").unwrapped
@@ -96,5 +101,7 @@ def test_actor_reads_the_trained_slots_and_returns_volts():
 
 def test_flags_after_the_separator_are_the_files():
     assert sfp.split_flags(["f.py", "--seed", "3", "--", "--num-envs", "8"]) == (
-        ["f.py", "--seed", "3"], ["--num-envs", "8"])
+        ["f.py", "--seed", "3"],
+        ["--num-envs", "8"],
+    )
     assert sfp.split_flags(["f.py"]) == (["f.py"], [])

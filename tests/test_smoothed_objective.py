@@ -27,7 +27,8 @@ def test_law_without_noise_is_the_agents_validation_cost(name):
     seeds = validation_seeds(8)
     zero = np.zeros((len(seeds), W.size))
     assert so.gain_noise_cost(W, b, zero, seeds) == pytest.approx(
-        validation_cost(agent, seeds=seeds), rel=1e-9)
+        validation_cost(agent, seeds=seeds), rel=1e-9
+    )
 
 
 def test_gain_noise_is_per_episode():
@@ -38,7 +39,8 @@ def test_gain_noise_is_per_episode():
     assert so.gain_noise_cost(W, 0.0, dW, seeds) == pytest.approx(np.mean(per_load), rel=1e-9)
     dW[0] = -W  # episode 0 without control: the passive beam, cost 1 on its load
     assert so.gain_noise_cost(W, 0.0, dW, seeds) == pytest.approx(
-        np.mean([1.0, *per_load[1:]]), rel=1e-9)
+        np.mean([1.0, *per_load[1:]]), rel=1e-9
+    )
     assert min(per_load) < 0.9  # so the passive episode did change the mean
 
 

@@ -17,7 +17,7 @@ def test_unit_action_round_trip_is_exact():
     env = UnitAction(ACLDBeamEnv(load_case=1))
     assert env.action_space == gym.spaces.Box(-1.0, 1.0, (1,), np.float32)
     rng = np.random.default_rng(0)
-    a = np.concatenate([rng.uniform(-1, 1, 100_000), [-1.0, 1.0, 0.0, 1e-30, -2.0**-24]])
+    a = np.concatenate([rng.uniform(-1, 1, 100_000), [-1.0, 1.0, 0.0, 1e-30, -(2.0**-24)]])
     a = a.astype(np.float32)
     volts = env.action(a)
     assert volts.dtype == np.float64 and np.abs(volts).max() <= 120.0
@@ -50,8 +50,10 @@ def test_unit_action_headroom_round_trip_and_limit():
     assert info["voltage"] == 90.0 and not info["clipped"]
     _, _, _, _, info = env.step(np.array([-0.5], np.float32))  # -180 V: clipped, reported
     assert info["voltage"] == -120.0 and info["clipped"]
-    check_env(UnitAction(ACLDBeamEnv(load_case=1, episode_length=0.05), headroom=2.5),
-              skip_render_check=True)
+    check_env(
+        UnitAction(ACLDBeamEnv(load_case=1, episode_length=0.05), headroom=2.5),
+        skip_render_check=True,
+    )
 
 
 @pytest.mark.parametrize("bad", [0.5, 0.0, -2.0, 101.0, float("nan"), True, "3", None])
@@ -72,21 +74,27 @@ def test_observe_modes_keeps_the_first_modes_and_the_tip():
         z, *_ = plain.step(np.array([a], np.float32))
         u, *_ = env.step(np.array([a], np.float32))
         assert np.array_equal(u, z[[0, 1, 2, 3, 8]])
-    scaled = ObserveModes(ACLDBeamEnv(load_case="random", reward_scale="passive",
-                                      observe_reward_scale=True), modes=1)
+    scaled = ObserveModes(
+        ACLDBeamEnv(load_case="random", reward_scale="passive", observe_reward_scale=True), modes=1
+    )
     u, info = scaled.reset(seed=0)
     assert u.shape == (4,) and np.isclose(u[-1], np.log(info["reward_scale"]), rtol=1e-6)
     assert np.array_equal(ObserveModes(ACLDBeamEnv(load_case=1), 4).slots, np.arange(9))
-    assert np.array_equal(ObserveModes(ACLDBeamEnv(load_case=1, mesh="thesis"), 3).slots,
-                          np.arange(7))
-    check_env(ObserveModes(ACLDBeamEnv(load_case=1, episode_length=0.05)),
-              skip_render_check=True)
+    assert np.array_equal(
+        ObserveModes(ACLDBeamEnv(load_case=1, mesh="thesis"), 3).slots, np.arange(7)
+    )
+    check_env(ObserveModes(ACLDBeamEnv(load_case=1, episode_length=0.05)), skip_render_check=True)
 
 
-@pytest.mark.parametrize("kwargs, modes, match", [
-    ({}, 0, r"modes must be in \[1, 4\]"), ({}, 5, r"modes must be in \[1, 4\]"),
-    ({}, 2.0, "modes must be an integer"), ({"obs_mode": "measurement"}, 2, "obs_mode"),
-])
+@pytest.mark.parametrize(
+    "kwargs, modes, match",
+    [
+        ({}, 0, r"modes must be in \[1, 4\]"),
+        ({}, 5, r"modes must be in \[1, 4\]"),
+        ({}, 2.0, "modes must be an integer"),
+        ({"obs_mode": "measurement"}, 2, "obs_mode"),
+    ],
+)
 def test_observe_modes_rejects_bad_input(kwargs, modes, match):
     with pytest.raises(ValueError, match=match):
         ObserveModes(ACLDBeamEnv(load_case=1, **kwargs), modes)
@@ -96,8 +104,11 @@ def test_observe_modes_rejects_an_observation_already_changed():
     """The slots come from the env's layout, so an observation an inner wrapper reshaped
     is refused by name, not sliced blindly."""
     inner = ObserveModes(ACLDBeamEnv(load_case=1), 3)
-    with pytest.raises(ValueError, match=r"env: ObserveModes needs the ACLDBeam env's own "
-                                         r"observation of 9 entries, got shape \(7,\)"):
+    with pytest.raises(
+        ValueError,
+        match=r"env: ObserveModes needs the ACLDBeam env's own "
+        r"observation of 9 entries, got shape \(7,\)",
+    ):
         ObserveModes(inner, 2)
 
 
@@ -109,8 +120,9 @@ def test_estimate_slots_is_the_layout():
 
 
 def test_whiten_observation_keeps_passthrough_and_checks():
-    env = ACLDBeamEnv(load_case="random", episode_length=0.05, reward_scale="passive",
-                      observe_reward_scale=True)
+    env = ACLDBeamEnv(
+        load_case="random", episode_length=0.05, reward_scale="passive", observe_reward_scale=True
+    )
     rng = np.random.default_rng(2)
     T = whitening(rng.normal(size=(500, 9)))
     w = WhitenObservation(env, T, passthrough=1)
@@ -140,8 +152,13 @@ def test_wrapped_made_envs_keep_a_recreatable_spec():
     ``gym.make(env.spec)`` rebuilds the same wrapped env (and ``check_env`` runs on a made
     env): the same observations for the same seed and actions."""
     T = np.diag(np.arange(1.0, 6.0))
-    made = WhitenObservation(ObserveModes(UnitAction(
-        gym.make("ACLDBeam-v1", load_case=2, episode_length=0.05), headroom=2.0), modes=2), T)
+    made = WhitenObservation(
+        ObserveModes(
+            UnitAction(gym.make("ACLDBeam-v1", load_case=2, episode_length=0.05), headroom=2.0),
+            modes=2,
+        ),
+        T,
+    )
     names = [(w.name, w.kwargs) for w in made.spec.additional_wrappers]
     assert [n for n, _ in names] == ["UnitAction", "ObserveModes", "WhitenObservation"]
     assert names[0][1] == {"headroom": 2.0} and names[1][1] == {"modes": 2}
@@ -153,5 +170,7 @@ def test_wrapped_made_envs_keep_a_recreatable_spec():
         u, *_ = made.step(np.array([a], np.float32))
         v, *_ = again.step(np.array([a], np.float32))
         assert np.array_equal(u, v)
-    check_env(ObserveModes(UnitAction(gym.make("ACLDBeam-v1", episode_length=0.05)), modes=1),
-              skip_render_check=True)
+    check_env(
+        ObserveModes(UnitAction(gym.make("ACLDBeam-v1", episode_length=0.05)), modes=1),
+        skip_render_check=True,
+    )

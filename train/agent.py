@@ -34,9 +34,21 @@ from acld_gym.util.atomic import write_atomic, write_json
 from .direction import direction_features
 from .voltage import VoltageMap
 
-__all__ = ["TrainedAgent", "ActorProgram", "AgentFileError", "export_sb3", "actor_parts",
-           "linear_program", "observation_width", "POLICY_FILE", "META_FILE", "MODEL_FILE",
-           "STATS_FILE", "CURVE_FILE", "versions"]
+__all__ = [
+    "TrainedAgent",
+    "ActorProgram",
+    "AgentFileError",
+    "export_sb3",
+    "actor_parts",
+    "linear_program",
+    "observation_width",
+    "POLICY_FILE",
+    "META_FILE",
+    "MODEL_FILE",
+    "STATS_FILE",
+    "CURVE_FILE",
+    "versions",
+]
 
 POLICY_FILE = "policy.npz"
 META_FILE = "metadata.json"
@@ -84,8 +96,7 @@ class ActorProgram:
 
     _KINDS = ("normalize", "direction", "linear", "tanh", "relu", "clip")
 
-    def __init__(self, ops: list[dict], arrays: dict[str, np.ndarray],
-                 n_obs: int | None = None):
+    def __init__(self, ops: list[dict], arrays: dict[str, np.ndarray], n_obs: int | None = None):
         self.ops = [dict(op) for op in ops]
         self.arrays = {k: np.asarray(v, dtype=np.float64) for k, v in arrays.items()}
         layer = 0
@@ -125,18 +136,22 @@ class ActorProgram:
                 width_in, width = self._expect(w, (width, None), width, ndim=2)
                 self._expect(b, (width,), width)
         if width is not None and width != 1:
-            raise AgentFileError(f"{POLICY_FILE}: the actor's last layer gives {width} "
-                                 "values, expected one action")
+            raise AgentFileError(
+                f"{POLICY_FILE}: the actor's last layer gives {width} values, expected one action"
+            )
 
     def _expect(self, key: str, shape: tuple, width: int | None, ndim: int = 1) -> tuple:
         """The shape of array ``key``, checked against ``shape`` (None: any size)."""
         got = self.arrays[key].shape
-        if len(got) != ndim or any(w is not None and g != w
-                                   for g, w in zip(got, shape, strict=True)):
+        if len(got) != ndim or any(
+            w is not None and g != w for g, w in zip(got, shape, strict=True)
+        ):
             want = ", ".join("n" if w is None else str(w) for w in shape)
-            raise AgentFileError(f"{POLICY_FILE}: array {key!r} has shape {got}, expected "
-                                 f"({want}{',' if ndim == 1 else ''}) (the actor's width "
-                                 f"there: {width})")
+            raise AgentFileError(
+                f"{POLICY_FILE}: array {key!r} has shape {got}, expected "
+                f"({want}{',' if ndim == 1 else ''}) (the actor's width "
+                f"there: {width})"
+            )
         return got
 
     def __call__(self, obs: np.ndarray) -> np.ndarray:
@@ -146,8 +161,9 @@ class ActorProgram:
         for op in self.ops:
             kind = op["op"]
             if kind == "normalize":
-                z = np.clip((z - a["mean"]) / np.sqrt(a["var"] + op["eps"]), -op["clip"],
-                            op["clip"])
+                z = np.clip(
+                    (z - a["mean"]) / np.sqrt(a["var"] + op["eps"]), -op["clip"], op["clip"]
+                )
             elif kind == "direction":
                 z = direction_features(z)
             elif kind == "linear":
@@ -179,8 +195,11 @@ def actor_parts(model) -> tuple[Any, list, bool]:
     if not hasattr(pol, "mlp_extractor"):  # ARS (sb3-contrib): action_net is the actor
         return pol.features_extractor, list(pol.action_net), False
     # PPO / A2C: Gaussian mean, clipped to the box
-    return (pol.pi_features_extractor, [*pol.mlp_extractor.policy_net, pol.action_net],
-            bool(pol.squash_output))
+    return (
+        pol.pi_features_extractor,
+        [*pol.mlp_extractor.policy_net, pol.action_net],
+        bool(pol.squash_output),
+    )
 
 
 def export_sb3(model, obs_norm=None) -> ActorProgram:
@@ -196,8 +215,9 @@ def export_sb3(model, obs_norm=None) -> ActorProgram:
     ops: list[dict] = []
     arrays: dict[str, np.ndarray] = {}
     if obs_norm is not None and getattr(obs_norm, "norm_obs", False):
-        ops.append({"op": "normalize", "clip": float(obs_norm.clip_obs),
-                    "eps": float(obs_norm.epsilon)})
+        ops.append(
+            {"op": "normalize", "clip": float(obs_norm.clip_obs), "eps": float(obs_norm.epsilon)}
+        )
         arrays["mean"] = obs_norm.obs_rms.mean.copy()
         arrays["var"] = obs_norm.obs_rms.var.copy()
     extractor, layers, squash = actor_parts(model)
@@ -206,8 +226,10 @@ def export_sb3(model, obs_norm=None) -> ActorProgram:
     elif isinstance(extractor, DropLast):  # an asymmetric agent: the actor never read the
         pass  # appended log(reward scale), and the deployed env does not append it
     elif not isinstance(extractor, FlattenExtractor):
-        raise TypeError(f"export_sb3 supports the flatten or direction features only, got "
-                        f"{type(extractor).__name__}")
+        raise TypeError(
+            f"export_sb3 supports the flatten or direction features only, got "
+            f"{type(extractor).__name__}"
+        )
     layer = 0
     for m in layers:
         if isinstance(m, nn.Linear):
@@ -228,8 +250,9 @@ def export_sb3(model, obs_norm=None) -> ActorProgram:
     return ActorProgram(ops, arrays)
 
 
-def linear_program(theta: np.ndarray, transform: np.ndarray | None = None,
-                   features: str | None = None) -> ActorProgram:
+def linear_program(
+    theta: np.ndarray, transform: np.ndarray | None = None, features: str | None = None
+) -> ActorProgram:
     r"""The saturated linear actor :math:`a = \mathrm{clip}(w \cdot f + b, -1, 1)` as an
     :class:`ActorProgram`, with ``theta = [w, b]`` and f the features of
     :math:`u = T^T z` (``transform`` T, identity if None): u itself (``features=None``) or
@@ -241,8 +264,10 @@ def linear_program(theta: np.ndarray, transform: np.ndarray | None = None,
         raise ValueError(f"features must be None or 'direction', got {features!r}")
     if features is None:  # one layer: (z T) w + b = z (T w) + b
         W = w if transform is None else np.asarray(transform, np.float64) @ w
-        return ActorProgram([{"op": "linear", "layer": 0}, {"op": "clip", "low": -1.0,
-                                                              "high": 1.0}], {"W0": W, "b0": b})
+        return ActorProgram(
+            [{"op": "linear", "layer": 0}, {"op": "clip", "low": -1.0, "high": 1.0}],
+            {"W0": W, "b0": b},
+        )
     ops: list[dict] = []
     arrays: dict[str, np.ndarray] = {}
     if transform is not None:
@@ -250,8 +275,11 @@ def linear_program(theta: np.ndarray, transform: np.ndarray | None = None,
         ops.append({"op": "linear", "layer": 0})
         arrays.update(W0=T, b0=np.zeros(T.shape[1]))
     layer = len(ops)
-    ops += [{"op": "direction"}, {"op": "linear", "layer": layer},
-            {"op": "clip", "low": -1.0, "high": 1.0}]
+    ops += [
+        {"op": "direction"},
+        {"op": "linear", "layer": layer},
+        {"op": "clip", "low": -1.0, "high": 1.0},
+    ]
     arrays.update({f"W{layer}": w, f"b{layer}": b})
     return ActorProgram(ops, arrays)
 
@@ -260,8 +288,11 @@ def observation_width(metadata: dict) -> int | None:
     """The width of the observation an agent's metadata records (the ``"estimate"``
     observation: the design order + 1), or None when it does not say."""
     obs = metadata.get("observation")
-    if isinstance(obs, dict) and obs.get("obs_mode") == "estimate" and \
-            isinstance(obs.get("xr_scale"), list):
+    if (
+        isinstance(obs, dict)
+        and obs.get("obs_mode") == "estimate"
+        and isinstance(obs.get("xr_scale"), list)
+    ):
         return len(obs["xr_scale"]) + 1
     return None
 
@@ -274,15 +305,21 @@ class TrainedAgent:
     ``action_headroom`` from the metadata; an agent without them: none and 1).
     """
 
-    def __init__(self, actor: ActorProgram, metadata: dict, name: str = "agent",
-                 directory: Path | None = None):
+    def __init__(
+        self,
+        actor: ActorProgram,
+        metadata: dict,
+        name: str = "agent",
+        directory: Path | None = None,
+    ):
         self.actor = actor
         self.metadata = dict(metadata)
         self.name = name
         self.directory = directory
         try:
-            self.map = VoltageMap(self.metadata.get("residual"),
-                                  headroom=self.metadata.get("action_headroom", 1.0))
+            self.map = VoltageMap(
+                self.metadata.get("residual"), headroom=self.metadata.get("action_headroom", 1.0)
+            )
         except ValueError as exc:
             raise AgentFileError(f"{META_FILE}: {exc}") from None
 
@@ -308,8 +345,9 @@ class TrainedAgent:
         return d
 
     @classmethod
-    def load(cls, directory: str | Path, name: str | None = None,
-             check: bool = True) -> TrainedAgent:
+    def load(
+        cls, directory: str | Path, name: str | None = None, check: bool = True
+    ) -> TrainedAgent:
         """Load an agent directory without executing anything from it.
 
         With ``check`` (default), the recorded observation fingerprint is compared with
@@ -328,8 +366,9 @@ class TrainedAgent:
         except (UnicodeDecodeError, json.JSONDecodeError) as exc:
             raise AgentFileError(f"{meta_path}: not valid JSON ({exc})") from None
         if not isinstance(meta, dict) or not {"actor", "observation", "env"} <= set(meta):
-            raise AgentFileError(f"{meta_path}: expected an agent's metadata with 'actor', "
-                                 "'observation' and 'env'")
+            raise AgentFileError(
+                f"{meta_path}: expected an agent's metadata with 'actor', 'observation' and 'env'"
+            )
         try:
             with np.load(pol_path, allow_pickle=False) as z:
                 arrays = {k: z[k] for k in z.files}
@@ -355,21 +394,25 @@ class TrainedAgent:
         env_meta = self.metadata["env"]
         env = gym.make(env_meta["id"], **env_meta.get("kwargs", {}))
         try:
-            diff = fingerprint_differences(self.observation_fingerprint,
-                                           observation_fingerprint(env))
+            diff = fingerprint_differences(
+                self.observation_fingerprint, observation_fingerprint(env)
+            )
         finally:
             env.close()
         if diff:
             where = self.directory if self.directory is not None else self.name
-            raise AgentFileError(f"agent {str(where)!r} was trained on another observation "
-                                 f"than {env_meta['id']}'s today: " + "; ".join(diff))
+            raise AgentFileError(
+                f"agent {str(where)!r} was trained on another observation "
+                f"than {env_meta['id']}'s today: " + "; ".join(diff)
+            )
 
     # --- policy -----------------------------------------------------------------------
     def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
         """SB3 protocol: ``(voltages, state)``, shape (n, 1) for a batch or (1,)."""
         if not deterministic:
-            raise ValueError("deterministic must be True: TrainedAgent evaluates the "
-                             "deterministic policy")
+            raise ValueError(
+                "deterministic must be True: TrainedAgent evaluates the deterministic policy"
+            )
         obs = np.asarray(observation, dtype=np.float32)
         batched = obs.ndim == 2
         obs2 = np.atleast_2d(obs)

@@ -53,38 +53,86 @@ from .bench.trials import (
 )
 from .config import CONFIG_DIR, read_config
 
-__all__ = ["CONFIG_DIR", "DEFAULT_ALGOS", "agent_dir", "read_config", "policy_program",
-           "run_trial", "run_trials", "summarize", "markdown", "plot_curves", "main"]
+__all__ = [
+    "CONFIG_DIR",
+    "DEFAULT_ALGOS",
+    "agent_dir",
+    "read_config",
+    "policy_program",
+    "run_trial",
+    "run_trials",
+    "summarize",
+    "markdown",
+    "plot_curves",
+    "main",
+]
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="python -m train.benchmark", description=__doc__,
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--algos", nargs="+", default=None, metavar="NAME",
-                   help=f"configs under train/benchmark/ (default: {' '.join(DEFAULT_ALGOS)})")
-    p.add_argument("--config", nargs="+", default=(), metavar="YAML",
-                   help="further config files (e.g. the ablations); alone, only these run")
+    p = argparse.ArgumentParser(
+        prog="python -m train.benchmark",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument(
+        "--algos",
+        nargs="+",
+        default=None,
+        metavar="NAME",
+        help=f"configs under train/benchmark/ (default: {' '.join(DEFAULT_ALGOS)})",
+    )
+    p.add_argument(
+        "--config",
+        nargs="+",
+        default=(),
+        metavar="YAML",
+        help="further config files (e.g. the ablations); alone, only these run",
+    )
     p.add_argument("--seeds", nargs="+", type=int, default=[0, 1, 2, 3, 4])
-    p.add_argument("--timesteps", type=int, default=None,
-                   help="override every config's env steps per run (quick checks)")
-    p.add_argument("--eval-points", type=int, default=None,
-                   help="override the learning-curve evaluations per run")
+    p.add_argument(
+        "--timesteps",
+        type=int,
+        default=None,
+        help="override every config's env steps per run (quick checks)",
+    )
+    p.add_argument(
+        "--eval-points",
+        type=int,
+        default=None,
+        help="override the learning-curve evaluations per run",
+    )
     p.add_argument("--env-id", default=DEFAULT_ENV_ID, help=f"(default {DEFAULT_ENV_ID})")
-    p.add_argument("--random-episodes", type=int, default=20,
-                   help="held-out random-load episodes of the evaluation (default 20)")
-    p.add_argument("--backend", choices=("auto", "ray", "local"), default="auto",
-                   help="ray: Ray Tune trials; local: one after the other; auto: ray if "
-                        "installed")
+    p.add_argument(
+        "--random-episodes",
+        type=int,
+        default=20,
+        help="held-out random-load episodes of the evaluation (default 20)",
+    )
+    p.add_argument(
+        "--backend",
+        choices=("auto", "ray", "local"),
+        default="auto",
+        help="ray: Ray Tune trials; local: one after the other; auto: ray if installed",
+    )
     p.add_argument("--num-cpus", type=int, default=2, help="CPUs of a local Ray (default 2)")
     p.add_argument("--address", default=None, help="Ray cluster address (default: local)")
     p.add_argument("--out", default="runs/benchmark", help="output directory")
-    p.add_argument("--no-bound", action="store_true",
-                   help="skip the clairvoyant bound's reference (about 30 s)")
-    p.add_argument("--resume", action="store_true",
-                   help="reuse trials already in OUT/trials with the same config and env id")
-    p.add_argument("--no-train", action="store_true",
-                   help="with --resume: train nothing, report the reused trials only and "
-                        "name the missing ones")
+    p.add_argument(
+        "--no-bound",
+        action="store_true",
+        help="skip the clairvoyant bound's reference (about 30 s)",
+    )
+    p.add_argument(
+        "--resume",
+        action="store_true",
+        help="reuse trials already in OUT/trials with the same config and env id",
+    )
+    p.add_argument(
+        "--no-train",
+        action="store_true",
+        help="with --resume: train nothing, report the reused trials only and "
+        "name the missing ones",
+    )
     return p
 
 
@@ -121,13 +169,22 @@ def main(argv: list[str] | None = None) -> int:
             path = trial_path(out, name, seed)
             if args.resume and path.is_file():
                 rec = json.loads(path.read_text())
-                if (rec.get("config") == json.loads(json.dumps(data))
-                        and rec.get("env_id") == args.env_id
-                        and rec.get("random_episodes") == args.random_episodes):
+                if (
+                    rec.get("config") == json.loads(json.dumps(data))
+                    and rec.get("env_id") == args.env_id
+                    and rec.get("random_episodes") == args.random_episodes
+                ):
                     records.append(rec)
                     continue
-            trials.append({"name": name, "config": data, "seed": seed, "env_id": args.env_id,
-                           "random_episodes": args.random_episodes})
+            trials.append(
+                {
+                    "name": name,
+                    "config": data,
+                    "seed": seed,
+                    "env_id": args.env_id,
+                    "random_episodes": args.random_episodes,
+                }
+            )
     if args.no_train:
         if not args.resume:
             parser.error("--no-train needs --resume")
@@ -139,22 +196,31 @@ def main(argv: list[str] | None = None) -> int:
     from .bench.evaluate import references
 
     t0 = time.perf_counter()
-    refs = references(args.env_id, out / f"references-{args.env_id}.json",
-                      args.random_episodes, bound=not args.no_bound)
-    print(f"{len(trials)} runs ({len(records)} reused), backend {backend}, env {args.env_id}",
-          flush=True)
+    refs = references(
+        args.env_id,
+        out / f"references-{args.env_id}.json",
+        args.random_episodes,
+        bound=not args.no_bound,
+    )
+    print(
+        f"{len(trials)} runs ({len(records)} reused), backend {backend}, env {args.env_id}",
+        flush=True,
+    )
     records += run_trials(trials, out, backend, args.num_cpus, args.address)
     wall = time.perf_counter() - t0
     summary = summarize(records, refs)
     summary["wall_seconds"] = wall
     summary["backend"] = backend
     summary["command"] = "python -m train.benchmark " + " ".join(
-        sys.argv[1:] if argv is None else argv)
+        sys.argv[1:] if argv is None else argv
+    )
     runs_wall = sum(r["wall_seconds"] for r in records)
-    text = markdown(summary) + (f"\nWall time of this command: {wall:.0f} s ({backend}, "
-                                f"{len(trials)} runs trained, {len(records) - len(trials)} "
-                                f"reused); the runs' own wall times (training and "
-                                f"evaluation) add up to {runs_wall:.0f} s.\n")
+    text = markdown(summary) + (
+        f"\nWall time of this command: {wall:.0f} s ({backend}, "
+        f"{len(trials)} runs trained, {len(records) - len(trials)} "
+        f"reused); the runs' own wall times (training and "
+        f"evaluation) add up to {runs_wall:.0f} s.\n"
+    )
     write_text(out / "results.md", text)
     write_text(out / "results.json", json.dumps(summary, indent=1) + "\n")
     plot_curves(summary, out / "learning_curves.png")

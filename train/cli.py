@@ -50,28 +50,59 @@ def _load_case_arg(text: str):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="python -m train", description=__doc__,
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("algo", choices=RECIPES, help="the algorithm (its recipe: "
-                   "train/benchmark/<algo>.yaml)")
-    p.add_argument("--config", metavar="YAML", default=None,
-                   help="another config file of the same algorithm (default: the recipe)")
+    p = argparse.ArgumentParser(
+        prog="python -m train",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument(
+        "algo", choices=RECIPES, help="the algorithm (its recipe: train/benchmark/<algo>.yaml)"
+    )
+    p.add_argument(
+        "--config",
+        metavar="YAML",
+        default=None,
+        help="another config file of the same algorithm (default: the recipe)",
+    )
     p.add_argument("--seed", type=_seed, default=0, help=f"seed in [0, {MAX_SEED}] (default 0)")
-    p.add_argument("--timesteps", type=_positive_int, default=None,
-                   help="env steps per run (default: the config's timesteps)")
-    p.add_argument("--n-envs", type=_positive_int, default=None,
-                   help="sub-envs of the batched env (default: the config's)")
-    p.add_argument("--load-case", type=_load_case_arg, default=None,
-                   help="train on one load case: 1, 2, 3 or random (default: the config's "
-                        "loads)")
-    p.add_argument("--param-noise", type=_param_noise, default=None,
-                   help="per-episode parameter randomization of the training env (an env "
-                        "option; default: the config's, else none)")
+    p.add_argument(
+        "--timesteps",
+        type=_positive_int,
+        default=None,
+        help="env steps per run (default: the config's timesteps)",
+    )
+    p.add_argument(
+        "--n-envs",
+        type=_positive_int,
+        default=None,
+        help="sub-envs of the batched env (default: the config's)",
+    )
+    p.add_argument(
+        "--load-case",
+        type=_load_case_arg,
+        default=None,
+        help="train on one load case: 1, 2, 3 or random (default: the config's loads)",
+    )
+    p.add_argument(
+        "--param-noise",
+        type=_param_noise,
+        default=None,
+        help="per-episode parameter randomization of the training env (an env "
+        "option; default: the config's, else none)",
+    )
     p.add_argument("--env-id", default="ACLDBeam-v1", help="(default ACLDBeam-v1)")
-    p.add_argument("--random-episodes", type=_episodes, default=20,
-                   help="held-out random-load episodes of the evaluation, 1..20 (default 20)")
-    p.add_argument("--out", metavar="DIR", default=None,
-                   help="output directory (default: runs/<recipe>-s<seed>)")
+    p.add_argument(
+        "--random-episodes",
+        type=_episodes,
+        default=20,
+        help="held-out random-load episodes of the evaluation, 1..20 (default 20)",
+    )
+    p.add_argument(
+        "--out",
+        metavar="DIR",
+        default=None,
+        help="output directory (default: runs/<recipe>-s<seed>)",
+    )
     return p
 
 
@@ -81,8 +112,7 @@ def configure(args: argparse.Namespace) -> tuple[str, dict]:
     flag or the key."""
     name, data = read_config(args.config or args.algo)
     if data["algo"] != args.algo:
-        raise ValueError(f"--config: {args.config} is a {data['algo']!r} config, not "
-                         f"{args.algo!r}")
+        raise ValueError(f"--config: {args.config} is a {data['algo']!r} config, not {args.algo!r}")
     data = dict(data)
     if args.timesteps is not None:
         data["timesteps"] = args.timesteps
@@ -126,19 +156,23 @@ def main(argv: list[str] | None = None) -> int:
     from .config import TrainConfig
 
     cfg = TrainConfig.from_dict(data)
-    command = "python -m train " + " ".join(shlex.quote(a) for a in
-                                            (sys.argv[1:] if argv is None else argv))
+    command = "python -m train " + " ".join(
+        shlex.quote(a) for a in (sys.argv[1:] if argv is None else argv)
+    )
     runs = f" ({cfg.restarts} runs of {cfg.timesteps})" if cfg.restarts > 1 else ""
-    print(f"training {cfg.algo.upper()} ({name}, {cfg.training}) for {cfg.budget} env "
-          f"steps{runs}, seed {args.seed}", flush=True)
-    rec, policy = run_trial(name, data, args.seed, args.env_id, args.random_episodes,
-                            command=command)
+    print(
+        f"training {cfg.algo.upper()} ({name}, {cfg.training}) for {cfg.budget} env "
+        f"steps{runs}, seed {args.seed}",
+        flush=True,
+    )
+    rec, policy = run_trial(
+        name, data, args.seed, args.env_id, args.random_episodes, command=command
+    )
     save_agent(policy, rec, out)
     write_text(out / "trial.json", json.dumps(rec) + "\n")
     episodes = eval_episodes(args.random_episodes)
     lqr = lqr_ise(args.env_id, episodes)
     rel = "  ".join(f"case {c}: {rec['final_ise'][str(c)] / lqr[c]:.3f}" for c in episodes)
     print(f"trained in {rec['train_seconds']:.0f} s; ISE / LQR  {rel}")
-    print(f"wrote {out}/: policy.npz + metadata.json (the agent), learning_curve.csv, "
-          "trial.json")
+    print(f"wrote {out}/: policy.npz + metadata.json (the agent), learning_curve.csv, trial.json")
     return 0

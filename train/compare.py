@@ -47,9 +47,20 @@ from baselines.evaluate import (
     plot_episodes,
 )
 
-__all__ = ["AGENTS_DIR", "HELDOUT_SEEDS", "agent_names", "load_agents", "training_labels",
-           "compare", "relative", "markdown_table", "markdown_scores", "learning_curves_figure",
-           "plot_learning_curves", "main"]
+__all__ = [
+    "AGENTS_DIR",
+    "HELDOUT_SEEDS",
+    "agent_names",
+    "load_agents",
+    "training_labels",
+    "compare",
+    "relative",
+    "markdown_table",
+    "markdown_scores",
+    "learning_curves_figure",
+    "plot_learning_curves",
+    "main",
+]
 
 AGENTS_DIR = Path(__file__).resolve().parent / "agents"
 #: Seeds of the held-out random-load episodes (training uses seeds < 1000 per sub-env).
@@ -94,21 +105,39 @@ def training_labels(policies: dict) -> dict[str, str]:
     return out
 
 
-def compare(policies: dict, cases=(1, 2, 3), random_seeds=HELDOUT_SEEDS, seed: int = 0,
-            env_kwargs: dict | None = None, episodes: dict | None = None,
-            quiet: bool = True) -> list[EvalRow]:
+def compare(
+    policies: dict,
+    cases=(1, 2, 3),
+    random_seeds=HELDOUT_SEEDS,
+    seed: int = 0,
+    env_kwargs: dict | None = None,
+    episodes: dict | None = None,
+    quiet: bool = True,
+) -> list[EvalRow]:
     """Rows per thesis case (episode ``seed``) and the mean over the held-out random
     episodes (``case="random"``); every policy sees the same episodes. A progress line
     on a terminal unless ``quiet``."""
     stages = (len(cases) + len(random_seeds)) * (len(policies) + 1)
     with Progress(stages, "compare", quiet) as progress:
-        rows = [r for case in cases
-                for r in episode_rows(policies, case, seed, env_kwargs, episodes, progress)]
+        rows = [
+            r
+            for case in cases
+            for r in episode_rows(policies, case, seed, env_kwargs, episodes, progress)
+        ]
         if random_seeds:
             n = len(random_seeds)
-            held = [r for k, s in enumerate(random_seeds)
-                    for r in episode_rows(policies, "random", s, env_kwargs, progress=progress,
-                                          episode=f" · episode {k + 1}/{n}")]
+            held = [
+                r
+                for k, s in enumerate(random_seeds)
+                for r in episode_rows(
+                    policies,
+                    "random",
+                    s,
+                    env_kwargs,
+                    progress=progress,
+                    episode=f" · episode {k + 1}/{n}",
+                )
+            ]
             rows += mean_rows(held, "random")
     return rows
 
@@ -131,21 +160,26 @@ def relative(rows: list[EvalRow], labels: dict | None = None) -> list[dict]:
 def markdown_table(rows: list[dict]) -> str:
     """The comparison as one markdown table (rows from :func:`relative`); the effort after
     settling is "-" where there is no settled window (random loads)."""
+
     def num(x, fmt: str, scale: float = 1.0) -> str:
         return "-" if x is None else format(x * scale, fmt)
 
-    head = ("| case | policy | trained | peak [mm] | settling [s] | ISE [m^2 s] | ISE / LQR "
-            "| ISE / bound | max abs V [V] | V rms [V] | Q [mvar] | TV after settling [kV/s] "
-            "| at limit after settling | ms / step |")
+    head = (
+        "| case | policy | trained | peak [mm] | settling [s] | ISE [m^2 s] | ISE / LQR "
+        "| ISE / bound | max abs V [V] | V rms [V] | Q [mvar] | TV after settling [kV/s] "
+        "| at limit after settling | ms / step |"
+    )
     out = [head, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for d in rows:
-        out.append(f"| {d['case']} | {d['policy']} | {d.get('training', '')} "
-                   f"| {d['peak_mm']:.3f} | {d['settling_s']:.3f} "
-                   f"| {d['ise']:.3e} | {d['ise_rel_lqr']:.2f} | {d['ise_rel_bound']:.2f} "
-                   f"| {d['max_voltage_V']:.0f} | {num(d.get('rms_voltage_V'), '.1f')} "
-                   f"| {num(d.get('reactive_power_var'), '.1f', 1e3)} "
-                   f"| {num(d.get('total_variation_V_per_s'), '.1f', 1e-3)} "
-                   f"| {num(d.get('limit_fraction'), '.0%')} | {d['ms_per_step']:.3f} |")
+        out.append(
+            f"| {d['case']} | {d['policy']} | {d.get('training', '')} "
+            f"| {d['peak_mm']:.3f} | {d['settling_s']:.3f} "
+            f"| {d['ise']:.3e} | {d['ise_rel_lqr']:.2f} | {d['ise_rel_bound']:.2f} "
+            f"| {d['max_voltage_V']:.0f} | {num(d.get('rms_voltage_V'), '.1f')} "
+            f"| {num(d.get('reactive_power_var'), '.1f', 1e3)} "
+            f"| {num(d.get('total_variation_V_per_s'), '.1f', 1e-3)} "
+            f"| {num(d.get('limit_fraction'), '.0%')} | {d['ms_per_step']:.3f} |"
+        )
     return "\n".join(out)
 
 
@@ -159,14 +193,20 @@ def markdown_scores(rows: list[dict]) -> str:
     if not seen:
         return ""
     first = next(iter(seen.values()))["score"]
-    out = [f"Score on `{first['test_set']}` ({first['n_episodes']} random loads): IQM of "
-           "(ISE_LQR - ISE) / (ISE_LQR - ISE_bound) per episode, 95 % bootstrap CI "
-           "(LQR 0, clairvoyant bound 1).", "",
-           "| policy | trained | score (IQM) | 95 % CI |", "|---|---|---|---|"]
+    out = [
+        f"Score on `{first['test_set']}` ({first['n_episodes']} random loads): IQM of "
+        "(ISE_LQR - ISE) / (ISE_LQR - ISE_bound) per episode, 95 % bootstrap CI "
+        "(LQR 0, clairvoyant bound 1).",
+        "",
+        "| policy | trained | score (IQM) | 95 % CI |",
+        "|---|---|---|---|",
+    ]
     for name, d in seen.items():
         sc = d["score"]
-        out.append(f"| {name} | {d.get('training', '')} | {sc['iqm']:.3f} "
-                   f"| [{sc['ci_low']:.3f}, {sc['ci_high']:.3f}] |")
+        out.append(
+            f"| {name} | {d.get('training', '')} | {sc['iqm']:.3f} "
+            f"| [{sc['ci_low']:.3f}, {sc['ci_high']:.3f}] |"
+        )
     return "\n".join(out)
 
 
@@ -200,8 +240,13 @@ def learning_curves_figure(agents: dict):
     for ax, case in zip(axes, (1, 2, 3), strict=True):
         for name, rows in curves.items():
             sub = [r for r in rows if r["case"] == str(case) and int(r["timesteps"]) > 0]
-            ax.plot([int(r["timesteps"]) for r in sub],
-                    [float(r["ise"]) / lqr[case] for r in sub], marker=".", lw=1, label=name)
+            ax.plot(
+                [int(r["timesteps"]) for r in sub],
+                [float(r["ise"]) / lqr[case] for r in sub],
+                marker=".",
+                lw=1,
+                label=name,
+            )
         ax.axhline(1.0, color="k", ls="--", lw=1, label="LQR")
         ax.set_xscale("log")
         ratio_log_axis(ax)
@@ -230,26 +275,57 @@ def plot_learning_curves(agents: dict, directory: Path) -> Path | None:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="python -m train.compare", description=__doc__,
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(
+        prog="python -m train.compare",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     p.add_argument("--json", metavar="PATH", help="write the rows as JSON")
     p.add_argument("--plots", metavar="DIR", help="write the figures to DIR")
     p.add_argument("--markdown", metavar="PATH", help="write the table as markdown")
-    p.add_argument("--agents", metavar="DIR", default=str(AGENTS_DIR),
-                   help="directory of agent directories (default: the shipped train/agents)")
-    p.add_argument("--only", metavar="NAME", nargs="*", default=(),
-                   help="these agents only (default: every agent trained on --mesh)")
-    p.add_argument("--random-episodes", type=arg_type(int, 0, 1000), default=len(HELDOUT_SEEDS),
-                   help="held-out random-load episodes (default 20; 0 for none)")
-    p.add_argument("--param-noise", type=arg_type(float, 0.0, 0.1), default=0.0,
-                   help="per-episode parameter randomization of the plant (default 0)")
-    p.add_argument("--seed", type=arg_type(int, 0, 2**63 - 1), default=0,
-                   help="seed of the thesis-case episodes")
-    p.add_argument("--mesh", choices=MESHES, default="converged",
-                   help="truth plant (default: the converged beam); the agents trained on it")
-    p.add_argument("--score-episodes", type=arg_type(int, 0, 100_000), default=None,
-                   help="score on the first N episodes of the test set (0: no score; "
-                        "default: all of it)")
+    p.add_argument(
+        "--agents",
+        metavar="DIR",
+        default=str(AGENTS_DIR),
+        help="directory of agent directories (default: the shipped train/agents)",
+    )
+    p.add_argument(
+        "--only",
+        metavar="NAME",
+        nargs="*",
+        default=(),
+        help="these agents only (default: every agent trained on --mesh)",
+    )
+    p.add_argument(
+        "--random-episodes",
+        type=arg_type(int, 0, 1000),
+        default=len(HELDOUT_SEEDS),
+        help="held-out random-load episodes (default 20; 0 for none)",
+    )
+    p.add_argument(
+        "--param-noise",
+        type=arg_type(float, 0.0, 0.1),
+        default=0.0,
+        help="per-episode parameter randomization of the plant (default 0)",
+    )
+    p.add_argument(
+        "--seed",
+        type=arg_type(int, 0, 2**63 - 1),
+        default=0,
+        help="seed of the thesis-case episodes",
+    )
+    p.add_argument(
+        "--mesh",
+        choices=MESHES,
+        default="converged",
+        help="truth plant (default: the converged beam); the agents trained on it",
+    )
+    p.add_argument(
+        "--score-episodes",
+        type=arg_type(int, 0, 100_000),
+        default=None,
+        help="score on the first N episodes of the test set (0: no score; default: all of it)",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress line")
     return p
 
@@ -273,13 +349,20 @@ def main(argv: list[str] | None = None) -> int:
     policies = {**default_policies(args.mesh), **agents}
     seeds = tuple(range(HELDOUT_SEEDS[0], HELDOUT_SEEDS[0] + args.random_episodes))
     episodes: dict = {}
-    rows = compare(policies, random_seeds=seeds, seed=args.seed,
-                   env_kwargs={"param_noise": args.param_noise, "mesh": args.mesh},
-                   episodes=episodes, quiet=args.quiet)
+    rows = compare(
+        policies,
+        random_seeds=seeds,
+        seed=args.seed,
+        env_kwargs={"param_noise": args.param_noise, "mesh": args.mesh},
+        episodes=episodes,
+        quiet=args.quiet,
+    )
     labels = training_labels(policies)
     title = f" (param_noise = {args.param_noise})" if args.param_noise else ""
-    print(f"Agents vs reference policies{title}; 'random' = mean over {len(seeds)} "
-          "held-out random-load episodes")
+    print(
+        f"Agents vs reference policies{title}; 'random' = mean over {len(seeds)} "
+        "held-out random-load episodes"
+    )
     print(format_tables(rows))
     env_kwargs = {"param_noise": args.param_noise, "mesh": args.mesh}
     scores = add_scores(policies, args.score_episodes, env_kwargs, args.quiet, labels)
@@ -289,8 +372,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f"\nwrote {args.json}")
     if args.markdown:
         scored = markdown_scores(table)
-        write_text(args.markdown, markdown_table(table) + "\n" + (f"\n{scored}\n" if scored
-                                                                   else ""))
+        write_text(
+            args.markdown, markdown_table(table) + "\n" + (f"\n{scored}\n" if scored else "")
+        )
         print(f"wrote {args.markdown}")
     if args.plots:
         plot_episodes(episodes, Path(args.plots))

@@ -48,8 +48,13 @@ ALGOS = ("vrs", *SB3_ALGOS)
 CONFIG_DIR = Path(__file__).resolve().parent / "benchmark"
 RESIDUALS = (None, "lqr")
 #: Smallest value of the SB3 integer arguments that may be below 1 (-1: "as many as").
-_INT_MIN = {"seed": 0, "verbose": 0, "learning_starts": 0, "sde_sample_freq": -1,
-            "gradient_steps": -1}
+_INT_MIN = {
+    "seed": 0,
+    "verbose": 0,
+    "learning_starts": 0,
+    "sde_sample_freq": -1,
+    "gradient_steps": -1,
+}
 
 
 @dataclass(frozen=True)
@@ -120,12 +125,14 @@ def _section(cls, data: dict, name: str):
     ``average``);
     ``ValueError`` naming ``name`` and its unknown or missing keys."""
     known = {f.name for f in fields(cls)}
-    required = {f.name for f in fields(cls)
-                if f.default is MISSING and f.default_factory is MISSING}
+    required = {
+        f.name for f in fields(cls) if f.default is MISSING and f.default_factory is MISSING
+    }
     unknown, missing = sorted(set(data) - known), sorted(required - set(data))
     if unknown or missing:
-        raise ValueError(f"{name}: unknown key(s) {unknown}, missing {missing}; expected "
-                         f"some of {sorted(known)}")
+        raise ValueError(
+            f"{name}: unknown key(s) {unknown}, missing {missing}; expected some of {sorted(known)}"
+        )
     return cls(**data)
 
 
@@ -136,8 +143,11 @@ def _distill_config_class():
 
 
 #: The sub-mappings of a :class:`TrainConfig` and (a function giving) the dataclass of each.
-_SECTIONS = {"distill": _distill_config_class, "select": lambda: SelectConfig,
-             "average": lambda: AverageConfig}
+_SECTIONS = {
+    "distill": _distill_config_class,
+    "select": lambda: SelectConfig,
+    "average": lambda: AverageConfig,
+}
 
 
 def algo_class(algo: str):
@@ -264,9 +274,13 @@ class TrainConfig:
         for name in ("timesteps", "n_envs", "eval_points"):
             check_int(name, getattr(self, name), 1, 10**12)
         check_int("restarts", self.restarts, 1, 64)
-        if not isinstance(self.loads, dict) or not self.loads or any(
-            isinstance(w, bool) or not (isinstance(w, (int, float)) and w > 0)
-            for w in self.loads.values()
+        if (
+            not isinstance(self.loads, dict)
+            or not self.loads
+            or any(
+                isinstance(w, bool) or not (isinstance(w, (int, float)) and w > 0)
+                for w in self.loads.values()
+            )
         ):
             raise ValueError(f"loads must map cases to positive weights, got {self.loads!r}")
         for case in self.loads:
@@ -277,32 +291,43 @@ class TrainConfig:
         if not isinstance(self.model, dict):
             raise ValueError(f"model must be a mapping, got {self.model!r}")
         if sb3 and "policy" not in self.model:
-            raise ValueError(f"{self.algo}: model must name the SB3 policy (e.g. policy: "
-                             "MlpPolicy)")
-        if isinstance(self.whiten_steps, bool) or not isinstance(self.whiten_steps, int) or (
-            self.whiten_steps < 0 or (self.whiten_steps and self.algo in ("vrs", "ars"))
+            raise ValueError(
+                f"{self.algo}: model must name the SB3 policy (e.g. policy: MlpPolicy)"
+            )
+        if (
+            isinstance(self.whiten_steps, bool)
+            or not isinstance(self.whiten_steps, int)
+            or (self.whiten_steps < 0 or (self.whiten_steps and self.algo in ("vrs", "ars")))
         ):
-            raise ValueError(f"whiten_steps must be a non-negative integer (SB3 algorithms "
-                             f"other than ars; vrs: model.whiten), got {self.whiten_steps!r}")
+            raise ValueError(
+                f"whiten_steps must be a non-negative integer (SB3 algorithms "
+                f"other than ars; vrs: model.whiten), got {self.whiten_steps!r}"
+            )
         if not isinstance(self.normalize, dict):
             raise ValueError(f"normalize must be a mapping, got {self.normalize!r}")
-        if self.whiten_steps and (self.features is not None
-                                  or self.normalize.get("norm_obs", False)):
-            raise ValueError("whiten_steps needs features: null and norm_obs: false (the "
-                             "trained actor takes the whitening into its first layer)")
-        if not isinstance(self.episode_scale, bool) or (self.episode_scale
-                                                        and self.algo != "ppo"):
-            raise ValueError(f"episode_scale must be true or false, and true for ppo only; "
-                             f"got {self.episode_scale!r}")
+        if self.whiten_steps and (
+            self.features is not None or self.normalize.get("norm_obs", False)
+        ):
+            raise ValueError(
+                "whiten_steps needs features: null and norm_obs: false (the "
+                "trained actor takes the whitening into its first layer)"
+            )
+        if not isinstance(self.episode_scale, bool) or (self.episode_scale and self.algo != "ppo"):
+            raise ValueError(
+                f"episode_scale must be true or false, and true for ppo only; "
+                f"got {self.episode_scale!r}"
+            )
         if not isinstance(self.env_kwargs, dict):
-            raise ValueError(f"env_kwargs must be a mapping of env options, got "
-                             f"{self.env_kwargs!r}")
+            raise ValueError(
+                f"env_kwargs must be a mapping of env options, got {self.env_kwargs!r}"
+            )
         if self.env_kwargs:
             if not sb3:
                 raise ValueError("env_kwargs are for the SB3 algorithms (vrs has its own env)")
             if "load_case" in self.env_kwargs:
-                raise ValueError("env_kwargs: the training loads are the loads: field, not "
-                                 "load_case")
+                raise ValueError(
+                    "env_kwargs: the training loads are the loads: field, not load_case"
+                )
             from acld_gym.envs.config import make_config
 
             try:  # the training env's options, validated by the env's own config
@@ -315,8 +340,9 @@ class TrainConfig:
 
         check_headroom(self.action_headroom, "action_headroom")
         if self.action_headroom != 1.0 and not sb3:
-            raise ValueError("action_headroom is for the SB3 algorithms (vrs: a saturated "
-                             "linear actor)")
+            raise ValueError(
+                "action_headroom is for the SB3 algorithms (vrs: a saturated linear actor)"
+            )
         if self.shaping is not None:
             check_real("shaping", self.shaping, 0.0, 1e6, low_open=True)
         for name in _SECTIONS:  # the sub-mappings, each validated by its dataclass
@@ -325,18 +351,30 @@ class TrainConfig:
                 raise ValueError(f"{name} must be a mapping or null, got {value!r}")
             _ = self._section_config(name)
         if self.distill is not None and self.residual is not None:
-            raise ValueError("distill needs residual: null (the action's sign is the "
-                             f"voltage's), got residual {self.residual!r}")
+            raise ValueError(
+                "distill needs residual: null (the action's sign is the "
+                f"voltage's), got residual {self.residual!r}"
+            )
         if self.select is not None and self.normalize.get("norm_obs", False):
-            raise ValueError("select needs norm_obs: false (the chosen parameters would "
-                             "meet the final observation statistics)")
-        if not sb3 and (self.residual or self.shaping is not None or self.distill
-                        or self.select is not None or self.average is not None):
-            raise ValueError("residual, shaping, distill, select and average are for the SB3 "
-                             "algorithms")
+            raise ValueError(
+                "select needs norm_obs: false (the chosen parameters would "
+                "meet the final observation statistics)"
+            )
+        if not sb3 and (
+            self.residual
+            or self.shaping is not None
+            or self.distill
+            or self.select is not None
+            or self.average is not None
+        ):
+            raise ValueError(
+                "residual, shaping, distill, select and average are for the SB3 algorithms"
+            )
         if self.restarts > 1 and self.select is None:
-            raise ValueError(f"restarts: {self.restarts} runs need select: (the choice between "
-                             "them is on the validation loads); got select: null")
+            raise ValueError(
+                f"restarts: {self.restarts} runs need select: (the choice between "
+                "them is on the validation loads); got select: null"
+            )
         if sb3:
             self._check_sb3()
 
@@ -346,8 +384,7 @@ class TrainConfig:
         allowed = set(inspect.signature(VecNormalize).parameters) - {"venv", "gamma"}
         bad = sorted(set(self.normalize) - allowed)
         if bad:
-            raise ValueError(f"normalize: unknown key(s) {bad}; expected some of "
-                             f"{sorted(allowed)}")
+            raise ValueError(f"normalize: unknown key(s) {bad}; expected some of {sorted(allowed)}")
         try:
             cls = algo_class(self.algo)
         except ImportError:  # sb3-contrib not installed: checked when the run starts
@@ -355,13 +392,19 @@ class TrainConfig:
         params = inspect.signature(cls).parameters
         unknown = sorted(k for k in self.model if k not in params)
         if unknown:
-            raise ValueError(f"model: unknown key(s) {unknown} for {self.algo.upper()}; "
-                             f"expected some of "
-                             f"{sorted(k for k in params if k not in ('env', 'self'))}")
+            raise ValueError(
+                f"model: unknown key(s) {unknown} for {self.algo.upper()}; "
+                f"expected some of "
+                f"{sorted(k for k in params if k not in ('env', 'self'))}"
+            )
         for key, value in self.model.items():
             default = params[key].default
-            if (isinstance(default, bool) or default is None or key == "policy"
-                    or isinstance(value, (dict, list, tuple))):  # a schedule, a train_freq
+            if (
+                isinstance(default, bool)
+                or default is None
+                or key == "policy"
+                or isinstance(value, (dict, list, tuple))
+            ):  # a schedule, a train_freq
                 continue
             if isinstance(default, (int, float)) and not isinstance(value, bool):
                 if isinstance(default, int) and key not in ("learning_rate", "clip_range"):
@@ -415,8 +458,14 @@ class TrainConfig:
         + RL"``, or with controller knowledge in the action or the reward, say so."""
         teacher = self.teacher
         label = "from scratch" if teacher is None else f"DAgger from {teacher.upper()} + RL"
-        extra = [s for s, on in (("LQR residual", self.residual == "lqr"),
-                                 ("LQ-potential shaping", self.shaping is not None)) if on]
+        extra = [
+            s
+            for s, on in (
+                ("LQR residual", self.residual == "lqr"),
+                ("LQ-potential shaping", self.shaping is not None),
+            )
+            if on
+        ]
         return label if not extra else f"{label} ({', '.join(extra)})"
 
     @classmethod
@@ -508,4 +557,3 @@ def read_config(spec: str | Path) -> tuple[str, dict]:
 def load_config(spec: str | Path) -> TrainConfig:
     """The validated :class:`TrainConfig` of a config (:func:`read_config`)."""
     return TrainConfig.from_dict(read_config(spec)[1])
-

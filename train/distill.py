@@ -63,16 +63,20 @@ class DistillConfig:
 
     def __post_init__(self):
         if self.teacher not in TEACHERS:
-            raise ValueError(f"distill.teacher must be one of {list(TEACHERS)}, "
-                             f"got {self.teacher!r}")
+            raise ValueError(
+                f"distill.teacher must be one of {list(TEACHERS)}, got {self.teacher!r}"
+            )
         for name in ("iterations", "max_iter"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:
                 raise ValueError(f"distill.{name} must be a positive integer, got {value!r}")
         for name in ("beta", "beta_decay"):
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) \
-                    or not 0.0 <= value <= 1.0:
+            if (
+                isinstance(value, bool)
+                or not isinstance(value, (int, float))
+                or not 0.0 <= value <= 1.0
+            ):
                 raise ValueError(f"distill.{name} must be a number in [0, 1], got {value!r}")
 
     def betas(self) -> list[float]:
@@ -115,9 +119,15 @@ def fit_sign(f, params, x, s, max_iter: int = 300) -> float:
     place); returns the final mean loss."""
     import torch
 
-    opt = torch.optim.LBFGS(params, lr=1.0, max_iter=max_iter, history_size=20,
-                            line_search_fn="strong_wolfe", tolerance_grad=1e-9,
-                            tolerance_change=1e-12)
+    opt = torch.optim.LBFGS(
+        params,
+        lr=1.0,
+        max_iter=max_iter,
+        history_size=20,
+        line_search_fn="strong_wolfe",
+        tolerance_grad=1e-9,
+        tolerance_change=1e-12,
+    )
 
     def closure():
         opt.zero_grad()
@@ -148,11 +158,15 @@ def distill(model, venv, cfg: DistillConfig, seed: int = 0, log=None) -> list[di
 
     agent_env = find_wrapper(venv, VecAgentEnv)
     if agent_env is None:
-        raise ValueError("distill needs the training env of train.vec.make_vec_env "
-                         "(no VecAgentEnv inside the given env)")
+        raise ValueError(
+            "distill needs the training env of train.vec.make_vec_env "
+            "(no VecAgentEnv inside the given env)"
+        )
     if agent_env.residual is not None:
-        raise ValueError("distill needs the plain voltage map (residual: null), got "
-                         f"residual {agent_env.residual!r}")
+        raise ValueError(
+            "distill needs the plain voltage map (residual: null), got "
+            f"residual {agent_env.residual!r}"
+        )
     from baselines.evaluate import default_policies
 
     teacher = default_policies()[cfg.teacher]
@@ -182,11 +196,17 @@ def distill(model, venv, cfg: DistillConfig, seed: int = 0, log=None) -> list[di
         s = torch.as_tensor(np.concatenate(sign_all), dtype=torch.float32)
         loss = fit_sign(f, params, x, s, cfg.max_iter)
         with torch.no_grad():
-            m_it = f(torch.as_tensor(venv.normalize_obs(np.concatenate(raw_it)),
-                                     dtype=torch.float32)).numpy()
+            m_it = f(
+                torch.as_tensor(venv.normalize_obs(np.concatenate(raw_it)), dtype=torch.float32)
+            ).numpy()
         agree = float(np.mean(np.where(m_it >= 0.0, 1.0, -1.0) == np.concatenate(sign_it)))
-        rec = {"iteration": it, "beta": round(beta, 6), "labels": int(len(x)),
-               "loss": round(loss, 6), "agreement": round(agree, 4)}
+        rec = {
+            "iteration": it,
+            "beta": round(beta, 6),
+            "labels": int(len(x)),
+            "loss": round(loss, 6),
+            "agreement": round(agree, 4),
+        }
         history.append(rec)
         if log is not None:
             log(rec)

@@ -18,6 +18,7 @@ from .direction import EPS, direction_features
 
 __all__ = ["DirectionFeatures", "direction_features", "FEATURES"]
 
+
 class DirectionFeatures(BaseFeaturesExtractor):
     r"""Features :math:`[z / |z|,\ \log |z|]` of the observation z (d + 1 values).
 
@@ -31,8 +32,10 @@ class DirectionFeatures(BaseFeaturesExtractor):
 
     def __init__(self, observation_space: spaces.Box):
         if len(observation_space.shape) != 1:
-            raise ValueError(f"observation_space: DirectionFeatures needs a flat Box, "
-                             f"got shape {observation_space.shape}")
+            raise ValueError(
+                f"observation_space: DirectionFeatures needs a flat Box, "
+                f"got shape {observation_space.shape}"
+            )
         super().__init__(observation_space, features_dim=observation_space.shape[0] + 1)
 
     def forward(self, observations: torch.Tensor) -> torch.Tensor:

@@ -30,18 +30,16 @@ def best_seed(out: str | Path, config: str) -> int:
     out``); the first of equal means. The held-out random loads take no part."""
     path = Path(out) / "results.json"
     if not path.is_file():
-        raise FileNotFoundError(f"no benchmark results {str(path)!r} (the --out of "
-                                "python -m train.benchmark)")
+        raise FileNotFoundError(
+            f"no benchmark results {str(path)!r} (the --out of python -m train.benchmark)"
+        )
     algos = json.loads(path.read_text()).get("algorithms", {})
     if config not in algos:
-        raise ValueError(f"config {config!r} is not in {str(path)!r}; it has "
-                         f"{sorted(algos)}")
+        raise ValueError(f"config {config!r} is not in {str(path)!r}; it has {sorted(algos)}")
     per_seed = algos[config].get("per_seed")
     keys = ("seed", *RULE_CASES)
-    if not per_seed or not all(isinstance(r, dict) and all(k in r for k in keys)
-                               for r in per_seed):
-        raise ValueError(f"{str(path)!r}: config {config!r} needs per_seed rows with "
-                         f"{list(keys)}")
+    if not per_seed or not all(isinstance(r, dict) and all(k in r for k in keys) for r in per_seed):
+        raise ValueError(f"{str(path)!r}: config {config!r} needs per_seed rows with {list(keys)}")
     means = [sum(float(r[c]) for c in RULE_CASES) / len(RULE_CASES) for r in per_seed]
     return int(per_seed[means.index(min(means))]["seed"])
 
@@ -69,11 +67,18 @@ def ship(run: str | Path, name: str, agents_dir: str | Path = AGENTS_DIR) -> Pat
 
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="python -m train.ship", description=__doc__)
-    p.add_argument("run", help="an agent directory: the --out of python -m train, or "
-                              "<out>/agents/<config>-s<seed> of python -m train.benchmark; "
-                              "with --best, that <out>")
-    p.add_argument("--best", metavar="CONFIG", help="ship the seed of benchmark config CONFIG "
-                   "best on the thesis cases (mean ISE / LQR over cases 1-3)")
+    p.add_argument(
+        "run",
+        help="an agent directory: the --out of python -m train, or "
+        "<out>/agents/<config>-s<seed> of python -m train.benchmark; "
+        "with --best, that <out>",
+    )
+    p.add_argument(
+        "--best",
+        metavar="CONFIG",
+        help="ship the seed of benchmark config CONFIG "
+        "best on the thesis cases (mean ISE / LQR over cases 1-3)",
+    )
     p.add_argument("name", help="agent name, e.g. ppo, sac, ppo_robust")
     p.add_argument("--agents", default=str(AGENTS_DIR), help="destination (default: shipped)")
     args = p.parse_args(argv)

@@ -46,8 +46,13 @@ def trial(config: dict, out: str | Path) -> dict:
         data["model"] = {**data["model"], "learning_rate": float(config["learning_rate"])}
     if config.get("n_envs") is not None:
         data["n_envs"] = int(config["n_envs"])
-    rec, policy = run_trial(name, data, int(config["seed"]), random_episodes=1,
-                            command=f"python -m train.sweep (trial {config})")
+    rec, policy = run_trial(
+        name,
+        data,
+        int(config["seed"]),
+        random_episodes=1,
+        command=f"python -m train.sweep (trial {config})",
+    )
     save_agent(policy, rec, Path(out))
     episodes = {int(c): (0,) for c in THESIS}
     lqr = lqr_ise(episodes=episodes)
@@ -62,12 +67,20 @@ def _tune_trainable(config: dict) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="python -m train.sweep", description=__doc__,
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(
+        prog="python -m train.sweep",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     p.add_argument("algo", choices=RECIPES)
     p.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
-    p.add_argument("--learning-rates", type=float, nargs="+", default=None,
-                   help="grid of learning rates (default: the config's)")
+    p.add_argument(
+        "--learning-rates",
+        type=float,
+        nargs="+",
+        default=None,
+        help="grid of learning rates (default: the config's)",
+    )
     p.add_argument("--timesteps", type=int, default=200_000, help="env steps per trial")
     p.add_argument("--num-cpus", type=int, default=2, help="CPUs for a local Ray (default 2)")
     p.add_argument("--address", default=None, help="Ray cluster address (default: local)")
@@ -93,14 +106,18 @@ def main(argv: list[str] | None = None) -> int:
     except ImportError:
         parser.error('Ray Tune is not installed: pip install -e ".[sweep]"')
     init_ray(args.address, args.num_cpus)
-    space = {"algo": args.algo, "timesteps": args.timesteps,
-             "seed": tune.grid_search(args.seeds),
-             "learning_rate": (tune.grid_search(args.learning_rates) if args.learning_rates
-                               else None)}
+    space = {
+        "algo": args.algo,
+        "timesteps": args.timesteps,
+        "seed": tune.grid_search(args.seeds),
+        "learning_rate": (tune.grid_search(args.learning_rates) if args.learning_rates else None),
+    }
     tuner = tune.Tuner(
-        tune.with_resources(_tune_trainable, {"cpu": 1}), param_space=space,
+        tune.with_resources(_tune_trainable, {"cpu": 1}),
+        param_space=space,
         tune_config=tune.TuneConfig(metric="ise_rel_lqr", mode="min"),
-        run_config=tune.RunConfig(storage_path=str(Path(args.out).resolve()), name=args.algo))
+        run_config=tune.RunConfig(storage_path=str(Path(args.out).resolve()), name=args.algo),
+    )
     results = tuner.fit()
     df = results.get_dataframe()
     cols = [c for c in ("config/seed", "config/learning_rate", "ise_rel_lqr") if c in df]

@@ -26,11 +26,21 @@ from acld_gym.physics.actuator import V_LIMIT
 from .features import direction_features
 from .voltage import VoltageMap
 
-__all__ = ["VoltageMap", "VecAgentEnv", "VecDirectionFeatures", "VecWhiten", "ConcatVecEnv",
-           "lq_potential", "find_wrapper", "make_vec_env"]
+__all__ = [
+    "VoltageMap",
+    "VecAgentEnv",
+    "VecDirectionFeatures",
+    "VecWhiten",
+    "ConcatVecEnv",
+    "lq_potential",
+    "find_wrapper",
+    "make_vec_env",
+]
 
-def lq_potential(gamma: float, lam: float, y_ref: float = 1e-3, dt: float = 1e-3,
-                 mesh: str = "converged") -> np.ndarray:
+
+def lq_potential(
+    gamma: float, lam: float, y_ref: float = 1e-3, dt: float = 1e-3, mesh: str = "converged"
+) -> np.ndarray:
     r"""Matrix P of the shaping potential :math:`\Phi(z) = -z^T P z`, z = the observation's
     reduced-state part.
 
@@ -45,8 +55,12 @@ def lq_potential(gamma: float, lam: float, y_ref: float = 1e-3, dt: float = 1e-3
     S = np.diag(nom.xr_scale)
     Si = np.diag(1.0 / nom.xr_scale)
     g = np.sqrt(gamma)
-    _, X = discrete_lqr_gain(g * Si @ sr.Ad @ S, g * Si @ sr.Bd, S @ C.T @ C @ S / y_ref**2,
-                             np.array([[lam / V_LIMIT**2]]))
+    _, X = discrete_lqr_gain(
+        g * Si @ sr.Ad @ S,
+        g * Si @ sr.Bd,
+        S @ C.T @ C @ S / y_ref**2,
+        np.array([[lam / V_LIMIT**2]]),
+    )
     return X
 
 
@@ -65,9 +79,15 @@ class VecAgentEnv(VecEnvWrapper):
     training and evaluation keeps both wrapped alike (``VecNormalize`` statistics
     are synchronized level by level)."""
 
-    def __init__(self, venv: VecEnv, residual: str | None = None, gamma: float = 0.99,
-                 shaping: float | None = None, mesh: str = "converged",
-                 headroom: float = 1.0):
+    def __init__(
+        self,
+        venv: VecEnv,
+        residual: str | None = None,
+        gamma: float = 0.99,
+        shaping: float | None = None,
+        mesh: str = "converged",
+        headroom: float = 1.0,
+    ):
         super().__init__(venv, action_space=spaces.Box(-1.0, 1.0, (1,), np.float32))
         self.map = VoltageMap(residual, mesh, headroom)
         self.gamma = float(gamma)
@@ -102,8 +122,9 @@ class VecAgentEnv(VecEnvWrapper):
             final = obs.copy()
             for i in np.flatnonzero(dones):
                 final[i] = infos[i]["terminal_observation"]
-            rewards = (rewards + self.gamma * self.potential(final)
-                       - self.potential(self._obs)).astype(np.float32)
+            rewards = (
+                rewards + self.gamma * self.potential(final) - self.potential(self._obs)
+            ).astype(np.float32)
         self._obs = obs
         return obs, rewards, dones, infos
 
@@ -165,7 +186,8 @@ class VecWhiten(VecEnvWrapper):
             terminal = np.asarray(infos[i]["terminal_observation"], dtype=np.float64)
             d = terminal.shape[-1] - self.passthrough
             infos[i]["terminal_observation"] = np.concatenate(
-                [terminal[:d] @ self.transform, terminal[d:]]).astype(np.float32)
+                [terminal[:d] @ self.transform, terminal[d:]]
+            ).astype(np.float32)
         return self._u(obs), rewards, dones, infos
 
 
@@ -259,8 +281,9 @@ def find_wrapper(venv: VecEnv, cls: type) -> VecEnv | None:
     return None
 
 
-def make_vec_env(cfg, seed: int, env_id: str = acld_gym.ENV_ID,
-                 backend: str = "native") -> VecNormalize:
+def make_vec_env(
+    cfg, seed: int, env_id: str = acld_gym.ENV_ID, backend: str = "native"
+) -> VecNormalize:
     """The training env of a :class:`train.config.TrainConfig`, seeded (sub-env i gets
     ``seed + i``): per training load case a batched env of ``env_id`` with the config's
     ``env_kwargs`` (sub-envs split as :func:`_split_envs`), :class:`VecAgentEnv` with the
@@ -287,12 +310,14 @@ def make_vec_env(cfg, seed: int, env_id: str = acld_gym.ENV_ID,
 
             # "module:id": the worker processes import acld_gym, which registers the ids
             full_id = env_id if ":" in env_id else f"acld_gym:{env_id}"
-            parts.append(sb3_make_vec_env(full_id, n_envs=n, env_kwargs=kwargs,
-                                          vec_env_cls=SubprocVecEnv))
+            parts.append(
+                sb3_make_vec_env(full_id, n_envs=n, env_kwargs=kwargs, vec_env_cls=SubprocVecEnv)
+            )
     venv: VecEnv = parts[0] if len(parts) == 1 else ConcatVecEnv(parts)
     venv.seed(seed)
-    venv = VecAgentEnv(venv, cfg.residual, cfg.gamma, cfg.shaping, mesh=cfg.mesh,
-                       headroom=cfg.action_headroom)
+    venv = VecAgentEnv(
+        venv, cfg.residual, cfg.gamma, cfg.shaping, mesh=cfg.mesh, headroom=cfg.action_headroom
+    )
     if cfg.whiten_steps:  # log c, if observed, stays as it is (the critic's scale)
         venv = VecWhiten(venv, passthrough=int(bool(cfg.env_kwargs.get("observe_reward_scale"))))
     if cfg.features == "direction":

@@ -27,8 +27,7 @@ class VoltageMap:
     agent (:class:`train.agent.TrainedAgent`).
     """
 
-    def __init__(self, residual: str | None = None, mesh: str = "converged",
-                 headroom: float = 1.0):
+    def __init__(self, residual: str | None = None, mesh: str = "converged", headroom: float = 1.0):
         from acld_gym.wrappers import check_headroom
 
         if residual not in (None, "lqr"):
@@ -43,8 +42,7 @@ class VoltageMap:
 
     def __call__(self, action: np.ndarray, obs: np.ndarray) -> np.ndarray:
         """Volts, shape (n, 1), for actions (n, 1) and raw observations (n, d)."""
-        a = self.headroom * np.clip(np.asarray(action, dtype=np.float64).reshape(-1, 1),
-                                    -1.0, 1.0)
+        a = self.headroom * np.clip(np.asarray(action, dtype=np.float64).reshape(-1, 1), -1.0, 1.0)
         if self._lqr is not None:
             u0 = self._lqr.voltage(self._lqr.reduced_state(np.atleast_2d(obs)))[:, None]
             a = u0 / V_LIMIT + 2.0 * a

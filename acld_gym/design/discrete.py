@@ -80,8 +80,9 @@ class SampledSystem:
         return f0 @ self.W0.T + f1 @ self.W1.T
 
 
-def discretize(A: np.ndarray, B: np.ndarray, E: np.ndarray, dt: float,
-               substeps: int = 10) -> SampledSystem:
+def discretize(
+    A: np.ndarray, B: np.ndarray, E: np.ndarray, dt: float, substeps: int = 10
+) -> SampledSystem:
     """Zero-order-hold discretization with first-order-hold load sub-steps.
 
     Parameters
@@ -101,7 +102,7 @@ def discretize(A: np.ndarray, B: np.ndarray, E: np.ndarray, dt: float,
     F[:n, :n] = A
     F[:n, n] = B[:, 0]
     Phi = expm_balanced(F, dt)
-    Ad, Bd = Phi[:n, :n], Phi[:n, n:n + 1]
+    Ad, Bd = Phi[:n, :n], Phi[:n, n : n + 1]
     # One sub-step h with a constant input c and a ramp r(s) = s/h (r' = 1/h):
     # expm gives G = int e^{A(h-s)} E ds and Rm = int e^{A(h-s)} E s/h ds.
     Fh = np.zeros((n + 3, n + 3))
@@ -110,8 +111,8 @@ def discretize(A: np.ndarray, B: np.ndarray, E: np.ndarray, dt: float,
     Fh[:n, n + 1] = E[:, 0]
     Fh[n + 1, n + 2] = 1.0 / h
     P = expm_balanced(Fh, h)
-    G = P[:n, n]                # int_0^h e^{A(h-s)} E ds
-    Rm = P[:n, n + 2]           # int_0^h e^{A(h-s)} E (s/h) ds
+    G = P[:n, n]  # int_0^h e^{A(h-s)} E ds
+    Rm = P[:n, n + 2]  # int_0^h e^{A(h-s)} E (s/h) ds
     # Linear interpolation f = f0 (1 - s/h) + f1 s/h on a sub-interval.
     w0, w1 = G - Rm, Rm
     Ah = expm_balanced(A, h)
@@ -137,7 +138,7 @@ def _output_rows(Ad: np.ndarray, c: np.ndarray, n: int) -> np.ndarray:
     p, Ap = 1, Ad
     while p < n:
         m = min(p, n - p)
-        rows[p:p + m] = rows[:m] @ Ap
+        rows[p : p + m] = rows[:m] @ Ap
         p += m
         if p < n:
             Ap = Ap @ Ap
@@ -161,8 +162,9 @@ def _output_vector(output, nx: int) -> np.ndarray:
         return c
     c = np.asarray(output, dtype=float).reshape(-1)
     if c.size != nx:
-        raise ValueError(f"output must be a state index or a row of {nx} weights, "
-                         f"got shape {np.shape(output)}")
+        raise ValueError(
+            f"output must be a state index or a row of {nx} weights, got shape {np.shape(output)}"
+        )
     return c
 
 

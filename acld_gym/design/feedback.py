@@ -30,9 +30,16 @@ import scipy.linalg as sla
 from acld_gym.design.numerics import care_gain
 from acld_gym.design.reduction import ReducedModel
 
-__all__ = ["Feedback", "passive", "lqr", "smc", "projected_weight", "discrete_lqr_gain",
-           "THESIS_LQR_WEIGHT",
-           "THESIS_SMC_WEIGHT"]
+__all__ = [
+    "Feedback",
+    "passive",
+    "lqr",
+    "smc",
+    "projected_weight",
+    "discrete_lqr_gain",
+    "THESIS_LQR_WEIGHT",
+    "THESIS_SMC_WEIGHT",
+]
 
 #: Full-state weight of the thesis's LQR, Q = 1e11 I (Table 1).
 THESIS_LQR_WEIGHT = 1e11
@@ -80,8 +87,9 @@ def passive(k: int) -> Feedback:
     return Feedback(a=z, s=z, c=0.0, eps=1.0, name="passive")
 
 
-def _projected_lqr(red: ReducedModel, weight: float, R: float,
-                   metric: np.ndarray | None) -> np.ndarray:
+def _projected_lqr(
+    red: ReducedModel, weight: float, R: float, metric: np.ndarray | None
+) -> np.ndarray:
     if not weight > 0:
         raise ValueError(f"weight must be positive, got {weight!r}")
     if not R > 0:
@@ -90,8 +98,9 @@ def _projected_lqr(red: ReducedModel, weight: float, R: float,
     return K[0]
 
 
-def projected_weight(red: ReducedModel, weight: float,
-                     metric: np.ndarray | None = None) -> np.ndarray:
+def projected_weight(
+    red: ReducedModel, weight: float, metric: np.ndarray | None = None
+) -> np.ndarray:
     r""":math:`q\,S_R^T W S_R`: the full-state weight ``weight * W`` seen by the reduced
     state (W = ``metric``, default the identity), symmetrized."""
     SR = red.SR
@@ -99,15 +108,25 @@ def projected_weight(red: ReducedModel, weight: float,
     return 0.5 * (Q + Q.T)
 
 
-def lqr(red: ReducedModel, weight: float = THESIS_LQR_WEIGHT, R: float = 1.0,
-        metric: np.ndarray | None = None) -> Feedback:
+def lqr(
+    red: ReducedModel,
+    weight: float = THESIS_LQR_WEIGHT,
+    R: float = 1.0,
+    metric: np.ndarray | None = None,
+) -> Feedback:
     """LQR with the full-state weight ``weight * W`` projected by S_R (eq. 67)."""
     K = _projected_lqr(red, weight, R, metric)
     return Feedback(a=K, s=np.zeros_like(K), c=0.0, eps=1.0, name="lqr")
 
 
-def smc(red: ReducedModel, weight: float = THESIS_SMC_WEIGHT, R: float = 1.0,
-        eta_factor: float = 1.5, eps: float = 1.0, metric: np.ndarray | None = None) -> Feedback:
+def smc(
+    red: ReducedModel,
+    weight: float = THESIS_SMC_WEIGHT,
+    R: float = 1.0,
+    eta_factor: float = 1.5,
+    eps: float = 1.0,
+    metric: np.ndarray | None = None,
+) -> Feedback:
     """Sliding-mode control with boundary layer (eqs. 68-72).
 
     ``red.E`` must hold the reduced tip-load input :math:`S_L^T \\hat B`.
@@ -123,8 +142,9 @@ def smc(red: ReducedModel, weight: float = THESIS_SMC_WEIGHT, R: float = 1.0,
     return Feedback(a=a, s=S, c=float(np.sign(sb)) * eta, eps=eps, name="smc")
 
 
-def discrete_lqr_gain(A: np.ndarray, B: np.ndarray, Q: np.ndarray,
-                      R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def discrete_lqr_gain(
+    A: np.ndarray, B: np.ndarray, Q: np.ndarray, R: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """Discrete LQR: :math:`K = (R + B^T X B)^{-1} B^T X A` with X from the DARE;
     returns ``(K, X)``."""
     X = sla.solve_discrete_are(A, B, 0.5 * (Q + Q.T), R)

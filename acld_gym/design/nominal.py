@@ -72,8 +72,9 @@ class NominalDesign:
     def lqr_gain(self, weight: float = THESIS_LQR_WEIGHT) -> np.ndarray:
         r"""The discrete LQR gain K (1, k) on the sampled reduced model, V = -K x_r, with the
         thesis's weights :math:`Q = w\,S_R^T S_R`, R = 1 (eqs. 65-67; ``weight`` = w)."""
-        K, _ = discrete_lqr_gain(self.reduced.Ad, self.reduced.Bd,
-                                 self.design.state_weight(weight), np.eye(1))
+        K, _ = discrete_lqr_gain(
+            self.reduced.Ad, self.reduced.Bd, self.design.state_weight(weight), np.eye(1)
+        )
         return K
 
     def lqr_law(self, weight: float = THESIS_LQR_WEIGHT) -> Feedback:
@@ -90,9 +91,15 @@ class NominalDesign:
 
 
 @lru_cache(maxsize=8)
-def nominal_design(dt: float = 1e-3, substeps: int = 10, sensor_std: float = SENSOR_NOISE_M,
-                   load_std: float = 1.0, mesh: str = "converged", basis: str = "modal",
-                   model_std: float = MODEL_STD) -> NominalDesign:
+def nominal_design(
+    dt: float = 1e-3,
+    substeps: int = 10,
+    sensor_std: float = SENSOR_NOISE_M,
+    load_std: float = 1.0,
+    mesh: str = "converged",
+    basis: str = "modal",
+    model_std: float = MODEL_STD,
+) -> NominalDesign:
     """Nominal design of the ``mesh`` plant (:data:`acld_gym.physics.truth.MESHES`) sampled at
     ``dt``, with the design order :data:`acld_gym.design.pipeline.DESIGN_ORDER` and the Kalman
     filter's model-error noise ``model_std`` (cached: the env, its vector version and
@@ -106,13 +113,22 @@ def nominal_design(dt: float = 1e-3, substeps: int = 10, sensor_std: float = SEN
     sd = discretize(A, B, E, dt, substeps)
     r = d.reduced
     sr = discretize(r.A, r.B, r.E, dt, substeps)
-    kal = discrete_kalman(sr.Ad, sr.Bd, sr.Ed, r.C, load_std=load_std, sensor_std=sensor_std,
-                          model_std=model_std)
+    kal = discrete_kalman(
+        sr.Ad, sr.Bd, sr.Ed, r.C, load_std=load_std, sensor_std=sensor_std, model_std=model_std
+    )
     cont = d.observer("thesis")
     # Held-input matrix of the thesis gain: int_0^dt e^{As} ds L (columnwise ZOH).
     sl = discretize(A, cont.L, E, dt, 1)
     th = discrete_thesis(sd.Ad, sl.Bd, sd.Bd, Cy, cont)
     res = simulate(A, B, E, Cy, cont, d.passive, thesis_load(1), t_end=0.2, v_max=None)
     scale = np.abs(res.xr).max(axis=0)
-    return NominalDesign(design=d, plant=sd, reduced=sr, kalman=kal, thesis=th, xr_scale=scale,
-                         mesh=mesh, basis=basis)
+    return NominalDesign(
+        design=d,
+        plant=sd,
+        reduced=sr,
+        kalman=kal,
+        thesis=th,
+        xr_scale=scale,
+        mesh=mesh,
+        basis=basis,
+    )

@@ -14,9 +14,14 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
-__all__ = ["DiagonalScaling", "balancing_scaling", "expm_balanced", "lyap_controllability",
-           "lyap_observability",
-           "care_gain"]
+__all__ = [
+    "DiagonalScaling",
+    "balancing_scaling",
+    "expm_balanced",
+    "lyap_controllability",
+    "lyap_observability",
+    "care_gain",
+]
 
 
 @dataclass(frozen=True)
@@ -59,8 +64,9 @@ def lyap_observability(A: np.ndarray, C: np.ndarray) -> np.ndarray:
     return _sym(sla.solve_continuous_lyapunov(A.T, -C.T @ C))
 
 
-def care_gain(A: np.ndarray, B: np.ndarray, Q: np.ndarray,
-              R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def care_gain(
+    A: np.ndarray, B: np.ndarray, Q: np.ndarray, R: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """Continuous LQR: ``K = R^-1 B^T X`` with X the stabilizing CARE solution.
 
     Solved in balanced coordinates: with :math:`x = D x_s`,

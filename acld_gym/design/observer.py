@@ -31,8 +31,15 @@ import scipy.linalg as sla
 from acld_gym.design.numerics import care_gain
 from acld_gym.design.reduction import ReducedModel
 
-__all__ = ["Observer", "DiscreteObserver", "thesis_observer", "kalman_observer", "discrete_kalman",
-           "discrete_thesis", "MODEL_STD"]
+__all__ = [
+    "Observer",
+    "DiscreteObserver",
+    "thesis_observer",
+    "kalman_observer",
+    "discrete_kalman",
+    "discrete_thesis",
+    "MODEL_STD",
+]
 
 
 @dataclass(frozen=True, eq=False)
@@ -59,12 +66,25 @@ class Observer:
         return bool(np.any(self.E))
 
 
-def thesis_observer(A: np.ndarray, B: np.ndarray, E: np.ndarray, Cy: np.ndarray,
-                    red: ReducedModel, fed_load: bool = True) -> Observer:
+def thesis_observer(
+    A: np.ndarray,
+    B: np.ndarray,
+    E: np.ndarray,
+    Cy: np.ndarray,
+    red: ReducedModel,
+    fed_load: bool = True,
+) -> Observer:
     """Full-order observer with the thesis's CARE gain (Q = I, R = 1)."""
     Lt, _ = care_gain(A.T, Cy.T, np.eye(A.shape[0]), np.eye(1))
-    return Observer(A=A, B=B, E=E if fed_load else np.zeros_like(E), C=Cy, L=Lt.T,
-                    T=red.SL.T, name="thesis" + ("+load" if fed_load else ""))
+    return Observer(
+        A=A,
+        B=B,
+        E=E if fed_load else np.zeros_like(E),
+        C=Cy,
+        L=Lt.T,
+        T=red.SL.T,
+        name="thesis" + ("+load" if fed_load else ""),
+    )
 
 
 def _noise_covariances(E: np.ndarray, load_std: float, sensor_std: float):
@@ -77,8 +97,9 @@ def _noise_covariances(E: np.ndarray, load_std: float, sensor_std: float):
     return 0.5 * (W + W.T), np.array([[sensor_std**2]])
 
 
-def kalman_observer(red: ReducedModel, load_std: float = 1.0, sensor_std: float = 1e-7,
-                    bandwidth_s: float = 1e-3) -> Observer:
+def kalman_observer(
+    red: ReducedModel, load_std: float = 1.0, sensor_std: float = 1e-7, bandwidth_s: float = 1e-3
+) -> Observer:
     """Continuous steady-state Kalman filter on the reduced model.
 
     The tip load is white process noise of standard deviation ``load_std`` [N]
@@ -90,8 +111,9 @@ def kalman_observer(red: ReducedModel, load_std: float = 1.0, sensor_std: float 
     W, V = _noise_covariances(red.E, load_std, sensor_std)
     Lt, _ = care_gain(red.A.T, red.C.T, W * bandwidth_s, V * bandwidth_s)
     k = red.order
-    return Observer(A=red.A, B=red.B, E=np.zeros_like(red.E), C=red.C, L=Lt.T, T=np.eye(k),
-                    name="kalman")
+    return Observer(
+        A=red.A, B=red.B, E=np.zeros_like(red.E), C=red.C, L=Lt.T, T=np.eye(k), name="kalman"
+    )
 
 
 @dataclass(frozen=True, eq=False)
@@ -127,9 +149,15 @@ class DiscreteObserver:
 MODEL_STD = 0.1
 
 
-def discrete_kalman(Ad: np.ndarray, Bd: np.ndarray, Ed: np.ndarray, Cr: np.ndarray,
-                    load_std: float = 1.0, sensor_std: float = 1e-7,
-                    model_std: float = MODEL_STD) -> DiscreteObserver:
+def discrete_kalman(
+    Ad: np.ndarray,
+    Bd: np.ndarray,
+    Ed: np.ndarray,
+    Cr: np.ndarray,
+    load_std: float = 1.0,
+    sensor_std: float = 1e-7,
+    model_std: float = MODEL_STD,
+) -> DiscreteObserver:
     r"""Steady-state discrete Kalman filter for the sampled reduced model.
 
     ``Ed`` is the sampled load input (state increment for 1 N held over a
@@ -157,13 +185,23 @@ def discrete_kalman(Ad: np.ndarray, Bd: np.ndarray, Ed: np.ndarray, Cr: np.ndarr
         W = W + model_std**2 * np.diag(np.diag(Pi))
     X = sla.solve_discrete_are(Ad.T, Cr.T, W, V)
     M = X @ Cr.T @ np.linalg.inv(Cr @ X @ Cr.T + V)
-    return DiscreteObserver(A=Ad, B=Bd, C=Cr, Lc=M, Lp=Ad @ M, T=np.eye(Ad.shape[0]),
-                            fed_load=False, name="kalman")
+    return DiscreteObserver(
+        A=Ad, B=Bd, C=Cr, Lc=M, Lp=Ad @ M, T=np.eye(Ad.shape[0]), fed_load=False, name="kalman"
+    )
 
 
-def discrete_thesis(Ad: np.ndarray, Bd_of_L: np.ndarray, Bd: np.ndarray, Cy: np.ndarray,
-                    continuous: Observer) -> DiscreteObserver:
+def discrete_thesis(
+    Ad: np.ndarray, Bd_of_L: np.ndarray, Bd: np.ndarray, Cy: np.ndarray, continuous: Observer
+) -> DiscreteObserver:
     """The thesis's observer sampled with the period of ``Ad`` (``Bd_of_L`` is the
     held-input matrix of the gain, :math:`\\int_0^\\Delta e^{As}ds\\,L`)."""
-    return DiscreteObserver(A=Ad, B=Bd, C=Cy, Lc=np.zeros_like(Bd_of_L), Lp=Bd_of_L,
-                            T=continuous.T, fed_load=continuous.fed_load, name=continuous.name)
+    return DiscreteObserver(
+        A=Ad,
+        B=Bd,
+        C=Cy,
+        Lc=np.zeros_like(Bd_of_L),
+        Lp=Bd_of_L,
+        T=continuous.T,
+        fed_load=continuous.fed_load,
+        name=continuous.name,
+    )

@@ -96,8 +96,14 @@ class Design:
         raise ValueError(f"observer must be 'thesis', 'thesis-unfed' or 'kalman', got {kind!r}")
 
 
-def design(model: Plant | BeamModel | None = None, order: int = REDUCED_ORDER,
-           smc_eps: float = 1.0, *, basis: str = "modal", **model_kwargs) -> Design:
+def design(
+    model: Plant | BeamModel | None = None,
+    order: int = REDUCED_ORDER,
+    smc_eps: float = 1.0,
+    *,
+    basis: str = "modal",
+    **model_kwargs,
+) -> Design:
     """Reduce a truth plant (default: the thesis's FE model) and design on it.
 
     Parameters
@@ -116,21 +122,18 @@ def design(model: Plant | BeamModel | None = None, order: int = REDUCED_ORDER,
     """
     if isinstance(model, Plant):
         if model_kwargs:
-            raise ValueError("model_kwargs: give either a model or build_model keywords, "
-                             "not both")
+            raise ValueError("model_kwargs: give either a model or build_model keywords, not both")
         truth = model
     elif isinstance(model, BeamModel):
         if model_kwargs:
-            raise ValueError("model_kwargs: give either a model or build_model keywords, "
-                             "not both")
+            raise ValueError("model_kwargs: give either a model or build_model keywords, not both")
         truth = fe_plant(model.params, model.mesh)
     elif model is None:
         from acld_gym.physics.model import resolve
 
         truth = fe_plant(*resolve(**model_kwargs))
     else:
-        raise ValueError(f"model must be a Plant, a BeamModel or None, got "
-                         f"{type(model).__name__}")
+        raise ValueError(f"model must be a Plant, a BeamModel or None, got {type(model).__name__}")
     A, B, E, Cy = truth.state_space()
     red = schur_balanced_truncation(A, B, Cy, order, E=E, basis=basis)
     return Design(truth=truth, reduced=red, smc_eps=smc_eps)

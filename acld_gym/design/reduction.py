@@ -62,8 +62,17 @@ from acld_gym.design.numerics import (
     lyap_observability,
 )
 
-__all__ = ["ReducedModel", "ModalForm", "modal_form", "schur_balanced_truncation",
-           "frequency_response", "hinf_norm", "BASES", "EIGEN_RTOL", "HANKEL_GAP_RTOL"]
+__all__ = [
+    "ReducedModel",
+    "ModalForm",
+    "modal_form",
+    "schur_balanced_truncation",
+    "frequency_response",
+    "hinf_norm",
+    "BASES",
+    "EIGEN_RTOL",
+    "HANKEL_GAP_RTOL",
+]
 
 #: Coordinates of the reduced model: ``"modal"`` (canonical, see the module docstring) or
 #: ``"schur"`` (the raw Schur-method coordinates; machine-dependent, kept for ACLDBeam-v0).
@@ -84,7 +93,8 @@ def _ordered_schur(X: np.ndarray, big_first: bool, threshold: float, k: int) -> 
     if sdim != want:
         raise np.linalg.LinAlgError(
             f"Schur ordering selected {sdim} eigenvalues of PQ, expected {want}: "
-            "no clear gap between the kept and the discarded Hankel singular values")
+            "no clear gap between the kept and the discarded Hankel singular values"
+        )
     return Z
 
 
@@ -117,8 +127,9 @@ class ModalForm:
         return out
 
 
-def modal_form(A: np.ndarray, B: np.ndarray, C: np.ndarray,
-               eigen_rtol: float = EIGEN_RTOL) -> ModalForm:
+def modal_form(
+    A: np.ndarray, B: np.ndarray, C: np.ndarray, eigen_rtol: float = EIGEN_RTOL
+) -> ModalForm:
     r"""The canonical real modal form of ``(A, B, C)`` (module docstring).
 
     For eigenvalue :math:`\lambda_i` with left eigenvector :math:`w_i`
@@ -150,27 +161,33 @@ def modal_form(A: np.ndarray, B: np.ndarray, C: np.ndarray,
     order = idx[np.lexsort((lam[idx].imag, np.abs(lam[idx])))]
     lam_k = lam[order]
     if 2 * np.count_nonzero(~real[order]) + np.count_nonzero(real[order]) != n:
-        raise np.linalg.LinAlgError("modal_form: eigenvalues of A do not pair up into "
-                                    "real values and conjugate pairs")
+        raise np.linalg.LinAlgError(
+            "modal_form: eigenvalues of A do not pair up into real values and conjugate pairs"
+        )
     allv = np.concatenate([lam_k, lam_k[lam_k.imag > 0].conj()])
-    dist = np.abs(allv[:, None] - allv[None, :]) / np.maximum(np.abs(allv)[:, None],
-                                                              np.abs(allv)[None, :])
+    dist = np.abs(allv[:, None] - allv[None, :]) / np.maximum(
+        np.abs(allv)[:, None], np.abs(allv)[None, :]
+    )
     np.fill_diagonal(dist, np.inf)
     if dist.min() < eigen_rtol:
         i, j = np.unravel_index(np.argmin(dist), dist.shape)
         raise np.linalg.LinAlgError(
             f"modal_form: eigenvalues {allv[i]:.6g} and {allv[j]:.6g} are closer than "
-            f"{eigen_rtol:g} (relative): the modal basis is not unique")
+            f"{eigen_rtol:g} (relative): the modal basis is not unique"
+        )
     rows, blocks = [], []
     for i in order:
         w = W[:, i] / np.conj(W[:, i].conj() @ V[:, i])  # w^H v = 1
         beta = complex(w.conj() @ B[:, 0])
         gamma = complex(C[0] @ V[:, i])  # output of eta = w^H x
         scale = abs(beta) * abs(gamma)
-        if scale <= 1e-12 * np.linalg.norm(w) * np.linalg.norm(B) * np.linalg.norm(C) * \
-                np.linalg.norm(V[:, i]):
-            raise np.linalg.LinAlgError(f"modal_form: the mode at {lam[i]:.6g} 1/s has no "
-                                        "voltage input or no output: no sign convention")
+        if scale <= 1e-12 * np.linalg.norm(w) * np.linalg.norm(B) * np.linalg.norm(
+            C
+        ) * np.linalg.norm(V[:, i]):
+            raise np.linalg.LinAlgError(
+                f"modal_form: the mode at {lam[i]:.6g} 1/s has no "
+                "voltage input or no output: no sign convention"
+            )
         # output row norm: |gamma| / t for a real mode, 2 |gamma| / t for a pair (x holds
         # the mode and its conjugate); input row norm: t |beta|. Equal them.
         t = np.sqrt((1.0 if real[i] else 2.0) * abs(gamma) / abs(beta))
@@ -215,7 +232,7 @@ class ReducedModel:
     @property
     def error_bound(self) -> float:
         """:math:`2 \\sum_{i>k} \\sigma_i`, the H-infinity bound on the truncation error."""
-        return 2.0 * float(np.sum(self.hsv[self.order:]))
+        return 2.0 * float(np.sum(self.hsv[self.order :]))
 
     def to_statespace(self):
         """The reduced model as a ``control.StateSpace`` (inputs voltage [V] and, when
@@ -230,9 +247,15 @@ class ReducedModel:
         return float(self.hsv[self.order - 1] / self.hsv[self.order])
 
 
-def schur_balanced_truncation(A: np.ndarray, B: np.ndarray, C: np.ndarray, order: int,
-                              E: np.ndarray | None = None, *,
-                              basis: str = "modal") -> ReducedModel:
+def schur_balanced_truncation(
+    A: np.ndarray,
+    B: np.ndarray,
+    C: np.ndarray,
+    order: int,
+    E: np.ndarray | None = None,
+    *,
+    basis: str = "modal",
+) -> ReducedModel:
     """Reduce a stable ``(A, B, C)`` to ``order`` states by the Schur method.
 
     Parameters
@@ -273,11 +296,12 @@ def schur_balanced_truncation(A: np.ndarray, B: np.ndarray, C: np.ndarray, order
         raise np.linalg.LinAlgError(
             f"order {order}: Hankel values {hsv[order - 1]:.6g} and {hsv[order]:.6g} are "
             f"nearly equal (relative gap < {HANKEL_GAP_RTOL:g}), so the kept subspace is not "
-            "determined by the model; choose another order")
+            "determined by the model; choose another order"
+        )
     threshold = np.sqrt(lam[order - 1] * lam[order]) if lam[order] > 0 else 0.5 * lam[order - 1]
     VD = _ordered_schur(PQ, True, threshold, order)
     VA = _ordered_schur(PQ, False, threshold, order)
-    VLbig = VA[:, n - order:]
+    VLbig = VA[:, n - order :]
     VRbig = VD[:, :order]
     U, s, Vt = np.linalg.svd(VLbig.T @ VRbig)
     SLs = VLbig @ U / np.sqrt(s)[None, :]
@@ -300,8 +324,9 @@ def schur_balanced_truncation(A: np.ndarray, B: np.ndarray, C: np.ndarray, order
     return ReducedModel(A=Ar, B=Br, C=Cr, E=Er, SL=SL, SR=SR, hsv=hsv, basis=basis)
 
 
-def frequency_response(A: np.ndarray, B: np.ndarray, C: np.ndarray,
-                       omega: np.ndarray) -> np.ndarray:
+def frequency_response(
+    A: np.ndarray, B: np.ndarray, C: np.ndarray, omega: np.ndarray
+) -> np.ndarray:
     """SISO response :math:`C (j\\omega I - A)^{-1} B` at each ``omega`` [rad/s].
 
     Evaluated in balanced coordinates for accuracy.
@@ -312,8 +337,14 @@ def frequency_response(A: np.ndarray, B: np.ndarray, C: np.ndarray,
     return np.array([(Cs @ np.linalg.solve(1j * w * eye - As, Bs))[0, 0] for w in omega])
 
 
-def hinf_norm(A: np.ndarray, B: np.ndarray, C: np.ndarray, wmin: float = 1e-1,
-              wmax: float = 1e8, points: int = 3000) -> tuple[float, float]:
+def hinf_norm(
+    A: np.ndarray,
+    B: np.ndarray,
+    C: np.ndarray,
+    wmin: float = 1e-1,
+    wmax: float = 1e8,
+    points: int = 3000,
+) -> tuple[float, float]:
     """H-infinity norm of a stable SISO system by a dense log sweep refined
     around the peak. Returns ``(norm, omega_peak)``."""
     w = np.logspace(np.log10(wmin), np.log10(wmax), points)

@@ -63,11 +63,22 @@ class ClosedLoop:
     frequencies : harmonic load frequencies [rad/s] the loop must carry.
     """
 
-    def __init__(self, A, B, E, Cy, observer: Observer, feedback: Feedback,
-                 v_max: float | None, frequencies: tuple[float, ...] = ()):
+    def __init__(
+        self,
+        A,
+        B,
+        E,
+        Cy,
+        observer: Observer,
+        feedback: Feedback,
+        v_max: float | None,
+        frequencies: tuple[float, ...] = (),
+    ):
         if not isinstance(observer, Observer):
-            raise ValueError(f"observer: the continuous-time simulator needs an Observer, got "
-                             f"{type(observer).__name__}")
+            raise ValueError(
+                f"observer: the continuous-time simulator needs an Observer, got "
+                f"{type(observer).__name__}"
+            )
         if v_max is not None and not v_max > 0:
             raise ValueError(f"v_max must be positive or None, got {v_max!r}")
         n, no, nh = A.shape[0], observer.n, len(frequencies)
@@ -82,7 +93,7 @@ class ClosedLoop:
         F0 = np.zeros((N, N))
         fl = np.zeros(N)  # load row: f = c + sum s1
         fl[self.ix_c] = 1.0
-        fl[self.ix_s:self.ix_one:2] = 1.0
+        fl[self.ix_s : self.ix_one : 2] = 1.0
         F0[self.ix_x, self.ix_x] = A
         F0[self.ix_x, :] += np.outer(E[:, 0], fl)
         F0[self.ix_o, self.ix_o] = observer.A - observer.L @ observer.C
@@ -148,7 +159,7 @@ class ClosedLoop:
     def set_load(self, z: np.ndarray, load: TipLoad, t0: float, t1: float) -> None:
         piece = load.piece(t0, t1)
         z[self.ix_c] = piece.const
-        z[self.ix_s:self.ix_one] = 0.0
+        z[self.ix_s : self.ix_one] = 0.0
         for amp, w, ph in piece.harmonics:
             j = self.freqs.index(w)
             z[self.ix_s + 2 * j] += amp * np.sin(w * t0 + ph)
@@ -186,8 +197,9 @@ class ClosedLoop:
             p += hi
         return z
 
-    def run(self, load: TipLoad, t_end: float, dt: float = 1e-4, refine: int = 12,
-            progress=None) -> SimulationResult:
+    def run(
+        self, load: TipLoad, t_end: float, dt: float = 1e-4, refine: int = 12, progress=None
+    ) -> SimulationResult:
         """Simulate from rest over [0, t_end], sampling every ``dt``."""
         if not t_end > 0 or not dt > 0:
             raise ValueError(f"t_end and dt must be positive, got {t_end!r}, {dt!r}")
@@ -214,9 +226,20 @@ class ClosedLoop:
         return SimulationResult(t=grid, y=y, voltage=v, load=load(grid), xr=xr)
 
 
-def simulate(A, B, E, Cy, observer: Observer, feedback: Feedback, load: TipLoad,
-             t_end: float = 1.0, v_max: float | None = 120.0, dt: float = 1e-4,
-             refine: int = 12, progress=None) -> SimulationResult:
+def simulate(
+    A,
+    B,
+    E,
+    Cy,
+    observer: Observer,
+    feedback: Feedback,
+    load: TipLoad,
+    t_end: float = 1.0,
+    v_max: float | None = 120.0,
+    dt: float = 1e-4,
+    refine: int = 12,
+    progress=None,
+) -> SimulationResult:
     """Simulate the closed loop from rest (see :class:`ClosedLoop`)."""
     loop = ClosedLoop(A, B, E, Cy, observer, feedback, v_max, load.harmonic_frequencies)
     return loop.run(load, t_end, dt=dt, refine=refine, progress=progress)

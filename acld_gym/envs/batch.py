@@ -118,8 +118,11 @@ class BatchStep:
         #: The reward scale's cost on a list of loads (None without ``reward_scale``).
         self.scale_cost = (
             PassiveCost(passive_plant(nom, c), nom.output, self.steps, c.y_ref)
-            if c.reward_scale == "passive" else
-            LQRCost(c, self.steps) if c.reward_scale == "lqr" else None)
+            if c.reward_scale == "passive"
+            else LQRCost(c, self.steps)
+            if c.reward_scale == "lqr"
+            else None
+        )
         #: The configuration's plant (the nominal one, shifted to its temperature, with its
         #: amplifier); an episode's own when drawn (param_noise, temperature_range).
         self.base_plant = fixed_plant(nom, c)
@@ -138,16 +141,26 @@ class BatchStep:
         self.compiled = bool(compiled and COMPILED_STEP)
         # The numpy step's load table (without a compiled step): per env (steps, 2 s) samples
         # and (steps + 1) tip loads.
-        self.tables = None if self.compiled else (
-            np.zeros((N, self.steps, 2 * lay.substeps)), np.zeros((N, self.steps + 1)))
+        self.tables = (
+            None
+            if self.compiled
+            else (np.zeros((N, self.steps, 2 * lay.substeps)), np.zeros((N, self.steps + 1)))
+        )
         self.core = None
         self._make_core()
 
     # --- construction ---------------------------------------------------------------------
     def fused_matrix(self, plant: SampledSystem) -> np.ndarray:
         """The whole step's matrix G for ``plant`` (the observer keeps the nominal design)."""
-        return output_matrix(plant, self.nom.plant, self.observer, self.layout, self.nom.output,
-                             self.nom.design.reduced.SL, self.est)
+        return output_matrix(
+            plant,
+            self.nom.plant,
+            self.observer,
+            self.layout,
+            self.nom.output,
+            self.nom.design.reduced.SL,
+            self.est,
+        )
 
     def _make_core(self) -> None:
         if not self.compiled:
@@ -156,13 +169,28 @@ class BatchStep:
         c = self.config
         self._codes_version = self.codes.version
         self.core = BatchCore(
-            GT=self.GT if self.GT_env is None else self.GT_env, Z=self.Z, OUT=self.OUT, k=self.k,
-            noise=self.noise, y_hist=self.y_hist, comp=self.codes.comp, ncomp=self.codes.ncomp,
-            pool=self.codes.pool, times=self.times, **self.layout.core_kwargs(),
+            GT=self.GT if self.GT_env is None else self.GT_env,
+            Z=self.Z,
+            OUT=self.OUT,
+            k=self.k,
+            noise=self.noise,
+            y_hist=self.y_hist,
+            comp=self.codes.comp,
+            ncomp=self.codes.ncomp,
+            pool=self.codes.pool,
+            times=self.times,
+            **self.layout.core_kwargs(),
             obs_mode=("estimate", "measurement", "full").index(c.obs_mode),
             n_obs=self.n_obs - int(c.observe_reward_scale),
-            dt=c.dt, y_ref=c.y_ref, lam=c.lam, v_max=V_LIMIT, limit=c.deflection_limit,
-            y_scale=Y_SCALE, slew_step=c.slew_step or 0.0, dgemm=_dgemm())
+            dt=c.dt,
+            y_ref=c.y_ref,
+            lam=c.lam,
+            v_max=V_LIMIT,
+            limit=c.deflection_limit,
+            y_scale=Y_SCALE,
+            slew_step=c.slew_step or 0.0,
+            dgemm=_dgemm(),
+        )
 
     def __getstate__(self):
         state = self.__dict__.copy()
@@ -188,11 +216,11 @@ class BatchStep:
             if self.compiled:
                 self.codes.set(i, load)
             else:
-                self.tables[0][i], self.tables[1][i] = load_schedule(nom.plant, load, 0,
-                                                                     self.steps)
+                self.tables[0][i], self.tables[1][i] = load_schedule(nom.plant, load, 0, self.steps)
             if self.GT_env is not None:
-                self.GT_env[i] = self.fused_matrix(plant).T if plant is not self.base_plant \
-                    else self.GT
+                self.GT_env[i] = (
+                    self.fused_matrix(plant).T if plant is not self.base_plant else self.GT
+                )
             self.plants[i] = plant
         if self.scale_cost is not None:
             self.reward_scale[rows] = self.scale_cost([loads[j] for j in range(len(rows))])
@@ -227,9 +255,18 @@ class BatchStep:
             res[4]["clipped"] = requested != v
             return self.scaled(res)
         r = self.advance(v)
-        values = (r.y, r.voltage, requested, requested != v, r.tip_load, self.k * self.config.dt,
-                  r.xr,
-                  WHY[r.code], r.reward_deflection, r.reward_voltage)
+        values = (
+            r.y,
+            r.voltage,
+            requested,
+            requested != v,
+            r.tip_load,
+            self.k * self.config.dt,
+            r.xr,
+            WHY[r.code],
+            r.reward_deflection,
+            r.reward_voltage,
+        )
         ones = np.ones(self.num_envs, dtype=bool)
         info = {}
         for key, val in zip(INFO_KEYS, values, strict=True):
@@ -283,8 +320,9 @@ class BatchStep:
         Z[:, lay.inputs] = self._inputs() if inputs is None else inputs
         if lay.slew:  # the amplifier moves from its last output towards the command, at most
             held = Z[:, lay.held]  # slew_step per period
-            Z[:, lay.amplifier] = held + np.clip(Z[:, lay.command] - held, -c.slew_step,
-                                                 c.slew_step)
+            Z[:, lay.amplifier] = held + np.clip(
+                Z[:, lay.command] - held, -c.slew_step, c.slew_step
+            )
         if self.GT_env is None:
             np.matmul(Z, self.GT, out=self.OUT)
         else:
@@ -299,11 +337,18 @@ class BatchStep:
         reward, r_y, r_v = reward_terms(y, volts, c.y_ref, c.lam, V_LIMIT)
         if self.scale_cost is not None:
             reward = reward / self.reward_scale
-        return StepResult(obs=self.observations(), reward=reward, reward_deflection=r_y,
-                          reward_voltage=r_v,
-                          code=termination_codes(y, reward, self.OUT, c.deflection_limit),
-                          truncated=self.k >= self.steps, y=y, voltage=volts,
-                          tip_load=self.tip_loads(), xr=self.OUT[:, lay.out_xr].copy())
+        return StepResult(
+            obs=self.observations(),
+            reward=reward,
+            reward_deflection=r_y,
+            reward_voltage=r_v,
+            code=termination_codes(y, reward, self.OUT, c.deflection_limit),
+            truncated=self.k >= self.steps,
+            y=y,
+            voltage=volts,
+            tip_load=self.tip_loads(),
+            xr=self.OUT[:, lay.out_xr].copy(),
+        )
 
     def _inputs(self) -> np.ndarray:
         """``[f0, f1, w']`` of every env's current period (loads from the table, or computed)."""
@@ -313,8 +358,9 @@ class BatchStep:
             out[:, :-1] = self.tables[0][idx, np.minimum(k, self.steps - 1)]
         else:
             for i in range(self.num_envs):
-                out[i, :-1] = load_schedule(self.nom.plant, self.loads[i], int(k[i]),
-                                            int(k[i]) + 1)[0][0]
+                out[i, :-1] = load_schedule(
+                    self.nom.plant, self.loads[i], int(k[i]), int(k[i]) + 1
+                )[0][0]
         out[:, -1] = self.noise[idx, np.minimum(k + 1, self.steps)]
         return out
 
@@ -326,8 +372,9 @@ class BatchStep:
         if mode == "estimate":
             out = self.OUT[rows, lay.out_estimate]
         elif mode == "measurement":
-            out = np.concatenate([self.y_hist[rows] / Y_SCALE,
-                                  self.Z[rows, lay.voltage, None] / V_LIMIT], axis=-1)
+            out = np.concatenate(
+                [self.y_hist[rows] / Y_SCALE, self.Z[rows, lay.voltage, None] / V_LIMIT], axis=-1
+            )
         else:
             out = self.Z[rows, lay.x]
         return self._append_scale(out.astype(np.float32), rows)
@@ -340,5 +387,9 @@ class BatchStep:
         k = self.k[rows]
         if self.tables is not None and np.all(k <= self.steps):
             return self.tables[1][rows, k]
-        return np.array([float(self.loads[i](k_i * self.config.dt))
-                         for i, k_i in zip(rows.tolist(), k.tolist(), strict=True)])
+        return np.array(
+            [
+                float(self.loads[i](k_i * self.config.dt))
+                for i, k_i in zip(rows.tolist(), k.tolist(), strict=True)
+            ]
+        )

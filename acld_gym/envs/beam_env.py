@@ -231,8 +231,7 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
     #: numpy reference step from the next reset on (benchmarks and tests compare the two).
     compiled_step = COMPILED_STEP
 
-    def __init__(self, config: EnvConfig | None = None, render_mode: str | None = None,
-                 **kwargs):
+    def __init__(self, config: EnvConfig | None = None, render_mode: str | None = None, **kwargs):
         self.config = make_config(config, **kwargs)
         check_render_mode(render_mode, self.metadata["render_modes"])
         self.render_mode = render_mode
@@ -251,22 +250,33 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
         self._fast = _not_reset  # the compiled step after reset(); None where it declines
 
     # --- state ----------------------------------------------------------------------------
-    batch = property(lambda self: self._batch,
-                     doc="The batched step this env is the N = 1 case of "
-                         "(:class:`acld_gym.envs.batch.BatchStep`: its state and step).")
+    batch = property(
+        lambda self: self._batch,
+        doc="The batched step this env is the N = 1 case of "
+        "(:class:`acld_gym.envs.batch.BatchStep`: its state and step).",
+    )
     k = property(lambda self: int(self._batch.k[0]), doc="Steps taken in the episode.")
-    v = property(lambda self: float(self._batch.Z[0, self._batch.layout.voltage]),
-                 doc="Voltage applied in the last step [V].")
-    y_meas = property(lambda self: float(self._batch.Z[0, self._batch.layout.y_meas]),
-                      doc="Last tip measurement [m].")
-    x = property(lambda self: self._batch.Z[0, self._batch.layout.x],
-                 doc="True plant state [q; dq/dt] (a view).")
-    xhat = property(lambda self: self._batch.Z[0, self._batch.layout.xhat],
-                    doc="Observer state (a view).")
-    episode_plant = property(lambda self: self._batch.plants[0],
-                             doc="The sampled plant of this episode (randomized with "
-                                 "``param_noise``), a "
-                                 ":class:`acld_gym.design.discrete.SampledSystem`.")
+    v = property(
+        lambda self: float(self._batch.Z[0, self._batch.layout.voltage]),
+        doc="Voltage applied in the last step [V].",
+    )
+    y_meas = property(
+        lambda self: float(self._batch.Z[0, self._batch.layout.y_meas]),
+        doc="Last tip measurement [m].",
+    )
+    x = property(
+        lambda self: self._batch.Z[0, self._batch.layout.x],
+        doc="True plant state [q; dq/dt] (a view).",
+    )
+    xhat = property(
+        lambda self: self._batch.Z[0, self._batch.layout.xhat], doc="Observer state (a view)."
+    )
+    episode_plant = property(
+        lambda self: self._batch.plants[0],
+        doc="The sampled plant of this episode (randomized with "
+        "``param_noise``), a "
+        ":class:`acld_gym.design.discrete.SampledSystem`.",
+    )
 
     @property
     def spec(self):
@@ -299,8 +309,11 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
         super().reset(seed=check_seed(seed))  # a rejected reset leaves the RNG as it was
         c = self.config
         load, plant = draw_episode(self.np_random, case, self.nom, c, self.harmonic_modes)
-        noise = (draw_noise(self.np_random, c.sensor_noise, self.max_steps + 1)
-                 if c.sensor_noise else np.zeros(self.max_steps + 1))
+        noise = (
+            draw_noise(self.np_random, c.sensor_noise, self.max_steps + 1)
+            if c.sensor_noise
+            else np.zeros(self.max_steps + 1)
+        )
         if self._batch.compiled != (self.compiled_step and COMPILED_STEP):
             self._batch = BatchStep(c, 1, self.max_steps, self.compiled_step)
         self._batch.start_episodes([0], [load], [plant], noise[None])
@@ -309,10 +322,18 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
         self._started = True
         self._fast = self._fast_step()
         b = self._batch
-        info = {"tip_deflection": 0.0, "voltage": 0.0, "requested_voltage": 0.0,
-                "clipped": False, "tip_load": float(b.tip_loads()[0]), "time": 0.0,
-                "xr_true": np.zeros(self.nom.design.reduced.order), "terminated_by": None,
-                "reward_deflection": 0.0, "reward_voltage": 0.0}
+        info = {
+            "tip_deflection": 0.0,
+            "voltage": 0.0,
+            "requested_voltage": 0.0,
+            "clipped": False,
+            "tip_load": float(b.tip_loads()[0]),
+            "time": 0.0,
+            "xr_true": np.zeros(self.nom.design.reduced.order),
+            "terminated_by": None,
+            "reward_deflection": 0.0,
+            "reward_voltage": 0.0,
+        }
         if b.scale_cost is not None:
             info["reward_scale"] = float(b.reward_scale[0])
         return b.observations()[0], info
@@ -378,9 +399,17 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
 def _single(res: StepResult, requested: float, command: float, k: int, dt: float):
     """Gymnasium's 5-tuple of env 0 of a batch step (as the compiled ``step_one`` gives it)."""
     code = int(res.code[0])
-    values = (float(res.y[0]), float(res.voltage[0]), requested, requested != command,
-              float(res.tip_load[0]), k * dt,
-              res.xr[0], TERMINATED_BY[code], float(res.reward_deflection[0]),
-              float(res.reward_voltage[0]))
+    values = (
+        float(res.y[0]),
+        float(res.voltage[0]),
+        requested,
+        requested != command,
+        float(res.tip_load[0]),
+        k * dt,
+        res.xr[0],
+        TERMINATED_BY[code],
+        float(res.reward_deflection[0]),
+        float(res.reward_voltage[0]),
+    )
     info: dict[str, Any] = dict(zip(INFO_KEYS, values, strict=True))
     return res.obs[0], float(res.reward[0]), code != 0, bool(res.truncated[0]), info

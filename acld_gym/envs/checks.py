@@ -20,8 +20,7 @@ def check_actions(action, n: int, v_max: float, vector: bool = False):
     """
     a = np.asarray(action)
     if a.dtype.kind not in "iuf":
-        raise ValueError(f"action must be real numbers (volts), got {action!r} "
-                         f"(dtype {a.dtype})")
+        raise ValueError(f"action must be real numbers (volts), got {action!r} (dtype {a.dtype})")
     shapes = ((n,), (n, 1)) if vector else ((1,),)
     if a.shape not in shapes:
         want = " or ".join(str(s) for s in shapes)
@@ -35,8 +34,9 @@ def check_actions(action, n: int, v_max: float, vector: bool = False):
 def check_render_mode(render_mode, render_modes) -> None:
     """``ValueError`` unless ``render_mode`` is None or one of ``render_modes``."""
     if render_mode is not None and render_mode not in render_modes:
-        raise ValueError(f"render_mode must be one of {list(render_modes)} or "
-                         f"None, got {render_mode!r}")
+        raise ValueError(
+            f"render_mode must be one of {list(render_modes)} or None, got {render_mode!r}"
+        )
 
 
 def episode_spec(spec, steps: int):

@@ -30,9 +30,20 @@ from acld_gym.physics.temperature import T_REF, TEMPERATURE_RANGE, check_tempera
 from acld_gym.physics.truth import MESHES
 from acld_gym.util.validate import check_choice, check_int, check_real
 
-__all__ = ["EnvConfig", "ConfigAttributes", "make_config", "config_table", "check_param_noise",
-           "check_episode_size", "PARAM_NOISE_MAX", "OBS_MODES", "OBSERVERS", "MAX_EPISODE_STEPS",
-           "MAX_TABLE_STEPS", "SENSOR_NOISE_M"]
+__all__ = [
+    "EnvConfig",
+    "ConfigAttributes",
+    "make_config",
+    "config_table",
+    "check_param_noise",
+    "check_episode_size",
+    "PARAM_NOISE_MAX",
+    "OBS_MODES",
+    "OBSERVERS",
+    "MAX_EPISODE_STEPS",
+    "MAX_TABLE_STEPS",
+    "SENSOR_NOISE_M",
+]
 
 OBS_MODES = ("estimate", "measurement", "full")
 OBSERVERS = ("kalman", "thesis")
@@ -69,58 +80,112 @@ class EnvConfig:
     """
 
     load_case: int | str | TipLoad = _f(
-        1, "-", "1, 2, 3 (thesis ch. 5), 'random' (a new random load per episode) or a "
-                "TipLoad (a custom load, acld_gym.physics.loads)")
+        1,
+        "-",
+        "1, 2, 3 (thesis ch. 5), 'random' (a new random load per episode) or a "
+        "TipLoad (a custom load, acld_gym.physics.loads)",
+    )
     mesh: str = _f("converged", "-", "truth plant: 'converged' (36 states) or 'thesis' (38)")
-    dt: float = _f(1e-3, "s", "control period of a piezo rig; the plant is built for 2 pi/dt",
-                   1e-4, 1e-2)
-    episode_length: float = _f(1.0, "s", "episode duration, at most MAX_EPISODE_STEPS steps",
-                               1e-4, 1e3)
-    observer: str = _f("kalman", "-", "'kalman' (reduced model, not fed the load) or 'thesis' "
-                                      "(full order, fed the load)")
+    dt: float = _f(
+        1e-3, "s", "control period of a piezo rig; the plant is built for 2 pi/dt", 1e-4, 1e-2
+    )
+    episode_length: float = _f(
+        1.0, "s", "episode duration, at most MAX_EPISODE_STEPS steps", 1e-4, 1e3
+    )
+    observer: str = _f(
+        "kalman",
+        "-",
+        "'kalman' (reduced model, not fed the load) or 'thesis' (full order, fed the load)",
+    )
     obs_mode: str = _f("estimate", "-", "'estimate', 'measurement' or 'full' (privileged)")
-    sensor_noise: float = _f(SENSOR_NOISE_M, "m", "std of the tip sensor (seeded; 0 for none)",
-                             0.0, 1e-3)
+    sensor_noise: float = _f(
+        SENSOR_NOISE_M, "m", "std of the tip sensor (seeded; 0 for none)", 0.0, 1e-3
+    )
     y_ref: float = _f(1e-3, "m", "deflection scale of the reward", 1e-9, 1.0)
     lam: float = _f(0.01, "-", "voltage weight of the reward", 0.0, 1e6)
-    param_noise: float = _f(0.0, "-", "relative std of the per-episode log-normal parameter "
-                                      "factors (truncated at 3 std), at most param_noise_max",
-                            0.0, None)
+    param_noise: float = _f(
+        0.0,
+        "-",
+        "relative std of the per-episode log-normal parameter "
+        "factors (truncated at 3 std), at most param_noise_max",
+        0.0,
+        None,
+    )
     deflection_limit: float = _f(0.02, "m", "termination limit of |tip deflection|", 1e-6, 1.0)
     harmonic_modes: tuple[float, float] | None = _f(
-        None, "rad/s", "targets of the random loads' harmonics; None: the plant's own first two "
-                       "damped modes")
-    model_std: float = _f(MODEL_STD, "-", "model-error noise of the Kalman filter "
-                                          "(acld_gym.design.observer.discrete_kalman)", 0.0, 1e3)
+        None,
+        "rad/s",
+        "targets of the random loads' harmonics; None: the plant's own first two damped modes",
+    )
+    model_std: float = _f(
+        MODEL_STD,
+        "-",
+        "model-error noise of the Kalman filter (acld_gym.design.observer.discrete_kalman)",
+        0.0,
+        1e3,
+    )
     param_noise_max: float | None = _f(
-        None, "-", "bound of param_noise; None: PARAM_NOISE_MAX of the mesh, within which the "
-                   "baselines are certified stable", 0.0, 1.0)
+        None,
+        "-",
+        "bound of param_noise; None: PARAM_NOISE_MAX of the mesh, within which the "
+        "baselines are certified stable",
+        0.0,
+        1.0,
+    )
     actuator_delay: int = _f(
-        0, "periods", "latency from the action to the amplifier, in whole control periods "
-                      "(computation and conversion delay)", 0, MAX_DELAY)
+        0,
+        "periods",
+        "latency from the action to the amplifier, in whole control periods "
+        "(computation and conversion delay)",
+        0,
+        MAX_DELAY,
+    )
     amplifier_bandwidth: float | None = _f(
-        None, "Hz", "small-signal bandwidth of the amplifier: a first-order lag from the "
-                    "command to the patch voltage, sampled exactly; None: ideal", 1.0, 1e6)
+        None,
+        "Hz",
+        "small-signal bandwidth of the amplifier: a first-order lag from the "
+        "command to the patch voltage, sampled exactly; None: ideal",
+        1.0,
+        1e6,
+    )
     slew_rate: float | None = _f(
-        None, "V/s", "largest rate of change of the amplifier's output (its current limit on "
-                     "the patch's capacitance, acld_gym.physics.actuator); None: unlimited",
-        1.0, 1e9)
+        None,
+        "V/s",
+        "largest rate of change of the amplifier's output (its current limit on "
+        "the patch's capacitance, acld_gym.physics.actuator); None: unlimited",
+        1.0,
+        1e9,
+    )
     temperature: float = _f(
-        T_REF, "°C", "temperature of the viscoelastic layer (time-temperature superposition, "
-                     "acld_gym.physics.temperature); 20 °C: the thesis's GHM parameters",
-        *TEMPERATURE_RANGE)
+        T_REF,
+        "°C",
+        "temperature of the viscoelastic layer (time-temperature superposition, "
+        "acld_gym.physics.temperature); 20 °C: the thesis's GHM parameters",
+        *TEMPERATURE_RANGE,
+    )
     temperature_range: tuple[float, float] | None = _f(
-        None, "°C", "draw the temperature per episode, uniform in (low, high); None: "
-                    "always temperature")
+        None,
+        "°C",
+        "draw the temperature per episode, uniform in (low, high); None: always temperature",
+    )
     reward_scale: str | None = _f(
-        None, "-", "None (the reward as defined), 'passive' or 'lqr': each reward of an "
-                   "episode divided by the passive beam's, or LQR's, mean step cost on its "
-                   "load (acld_gym.envs.scale; info['reward_scale'])")
+        None,
+        "-",
+        "None (the reward as defined), 'passive' or 'lqr': each reward of an "
+        "episode divided by the passive beam's, or LQR's, mean step cost on its "
+        "load (acld_gym.envs.scale; info['reward_scale'])",
+    )
     observe_reward_scale: bool = _f(
-        False, "-", "append log(reward scale) to the observation as its last entry: "
-                    "privileged, for a critic only; needs reward_scale")
-    env_id: str = _f("ACLDBeam-v1", "-", "the registered id this configuration belongs to "
-                                         "(recorded in the observation fingerprint)")
+        False,
+        "-",
+        "append log(reward scale) to the observation as its last entry: "
+        "privileged, for a critic only; needs reward_scale",
+    )
+    env_id: str = _f(
+        "ACLDBeam-v1",
+        "-",
+        "the registered id this configuration belongs to (recorded in the observation fingerprint)",
+    )
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
@@ -131,23 +196,39 @@ class EnvConfig:
         for f in dataclasses.fields(self):
             md = f.metadata
             if f.type == "float" and md.get("low") is not None:  # incl. temperature
-                set_(self, f.name, check_real(f.name, getattr(self, f.name), md["low"],
-                                              md["high"], unit=md["unit"]))
+                set_(
+                    self,
+                    f.name,
+                    check_real(
+                        f.name, getattr(self, f.name), md["low"], md["high"], unit=md["unit"]
+                    ),
+                )
         if self.param_noise_max is not None:
-            set_(self, "param_noise_max", check_real("param_noise_max", self.param_noise_max,
-                                                     0.0, 1.0, low_open=True))
-        set_(self, "param_noise", check_param_noise(self.param_noise, self.mesh,
-                                                    self.param_noise_max))
+            set_(
+                self,
+                "param_noise_max",
+                check_real("param_noise_max", self.param_noise_max, 0.0, 1.0, low_open=True),
+            )
+        set_(
+            self,
+            "param_noise",
+            check_param_noise(self.param_noise, self.mesh, self.param_noise_max),
+        )
         if self.harmonic_modes is not None:
             modes = self.harmonic_modes
             if not isinstance(modes, (tuple, list)) or len(modes) != 2:
-                raise ValueError(f"harmonic_modes must be None or two frequencies [rad/s], got "
-                                 f"{modes!r}")
-            set_(self, "harmonic_modes", tuple(
-                check_real("harmonic_modes", w, 0.0, 1e7, low_open=True, unit="rad/s")
-                for w in modes))
-        set_(self, "actuator_delay", check_int("actuator_delay", self.actuator_delay, 0,
-                                               MAX_DELAY))
+                raise ValueError(
+                    f"harmonic_modes must be None or two frequencies [rad/s], got {modes!r}"
+                )
+            set_(
+                self,
+                "harmonic_modes",
+                tuple(
+                    check_real("harmonic_modes", w, 0.0, 1e7, low_open=True, unit="rad/s")
+                    for w in modes
+                ),
+            )
+        set_(self, "actuator_delay", check_int("actuator_delay", self.actuator_delay, 0, MAX_DELAY))
         for name in ("amplifier_bandwidth", "slew_rate"):
             value, md = getattr(self, name), self.__dataclass_fields__[name].metadata
             if value is not None:
@@ -155,20 +236,22 @@ class EnvConfig:
         if self.temperature_range is not None:
             rng = self.temperature_range
             if not isinstance(rng, (tuple, list)) or len(rng) != 2:
-                raise ValueError(f"temperature_range must be None or (low, high) [°C], got "
-                                 f"{rng!r}")
+                raise ValueError(f"temperature_range must be None or (low, high) [°C], got {rng!r}")
             lo, hi = (check_temperature("temperature_range", t) for t in rng)
             if not lo < hi:
                 raise ValueError(f"temperature_range must have low < high [°C], got {rng!r}")
             set_(self, "temperature_range", (lo, hi))
         check_choice("reward_scale", self.reward_scale, REWARD_SCALES)
         if not isinstance(self.observe_reward_scale, (bool, np.bool_)):
-            raise ValueError(f"observe_reward_scale must be True or False, got "
-                             f"{self.observe_reward_scale!r}")
+            raise ValueError(
+                f"observe_reward_scale must be True or False, got {self.observe_reward_scale!r}"
+            )
         set_(self, "observe_reward_scale", bool(self.observe_reward_scale))
         if self.observe_reward_scale and self.reward_scale is None:
-            raise ValueError("observe_reward_scale=True needs a reward_scale (e.g. "
-                             "reward_scale='passive'), got reward_scale=None")
+            raise ValueError(
+                "observe_reward_scale=True needs a reward_scale (e.g. "
+                "reward_scale='passive'), got reward_scale=None"
+            )
         if not isinstance(self.env_id, str) or not self.env_id:
             raise ValueError(f"env_id must be a non-empty string, got {self.env_id!r}")
         check_episode_size(self.episode_length, self.dt)
@@ -194,8 +277,9 @@ class EnvConfig:
         nominal_design`, cached)."""
         from acld_gym.design.nominal import nominal_design
 
-        return nominal_design(self.dt, 10, max(self.sensor_noise, 1e-9), mesh=self.mesh,
-                              model_std=self.model_std)
+        return nominal_design(
+            self.dt, 10, max(self.sensor_noise, 1e-9), mesh=self.mesh, model_std=self.model_std
+        )
 
     def harmonic_targets(self, nom) -> tuple[float, float]:
         """The random loads' harmonic targets [rad/s]: :attr:`harmonic_modes`, or the first
@@ -219,8 +303,10 @@ def make_config(config: EnvConfig | None = None, **kwargs) -> EnvConfig:
         raise TypeError(f"config must be an EnvConfig or None, got {type(config).__name__}")
     unknown = sorted(set(kwargs) - set(_FIELDS))
     if unknown:
-        raise TypeError(f"unexpected keyword argument(s) {unknown}; the env takes the fields of "
-                        f"EnvConfig: {', '.join(_FIELDS)}")
+        raise TypeError(
+            f"unexpected keyword argument(s) {unknown}; the env takes the fields of "
+            f"EnvConfig: {', '.join(_FIELDS)}"
+        )
     if config is None:
         return EnvConfig(**kwargs)
     return dataclasses.replace(config, **kwargs) if kwargs else config
@@ -233,9 +319,11 @@ def check_param_noise(value, mesh: str, bound: float | None = None) -> float:
     limit = bound if bound is not None else PARAM_NOISE_MAX.get(mesh, 0.0)
     v = check_real("param_noise", value, 0.0)
     if v > limit:
-        raise ValueError(f"param_noise must be at most {limit} for mesh={mesh!r} (relative std; "
-                         f"beyond it the nominal observer and baselines are not validated), got "
-                         f"{value!r}")
+        raise ValueError(
+            f"param_noise must be at most {limit} for mesh={mesh!r} (relative std; "
+            f"beyond it the nominal observer and baselines are not validated), got "
+            f"{value!r}"
+        )
     return v
 
 
@@ -246,12 +334,16 @@ def check_episode_size(episode_length: float, dt: float, num_envs: int = 1) -> i
     if steps < 1:
         raise ValueError(f"episode_length must be at least dt, got {episode_length!r}")
     if steps > MAX_EPISODE_STEPS:
-        raise ValueError(f"episode_length / dt = {steps} steps exceeds {MAX_EPISODE_STEPS} "
-                         "(an episode's noise is tabulated at reset, ~350 bytes per step)")
+        raise ValueError(
+            f"episode_length / dt = {steps} steps exceeds {MAX_EPISODE_STEPS} "
+            "(an episode's noise is tabulated at reset, ~350 bytes per step)"
+        )
     if num_envs * steps > MAX_TABLE_STEPS:
-        raise ValueError(f"num_envs x episode steps = {num_envs * steps} exceeds "
-                         f"{MAX_TABLE_STEPS} (the vector env tabulates every sub-env's "
-                         "episode, ~170 bytes per step)")
+        raise ValueError(
+            f"num_envs x episode steps = {num_envs * steps} exceeds "
+            f"{MAX_TABLE_STEPS} (the vector env tabulates every sub-env's "
+            "episode, ~170 bytes per step)"
+        )
     return steps
 
 
@@ -260,8 +352,11 @@ def config_table() -> str:
     rows = ["| field | default | unit | range | meaning |", "|---|---|---|---|---|"]
     for f in dataclasses.fields(EnvConfig):
         md = f.metadata
-        rng = ("" if md.get("low") is None else
-               f"[{md['low']:g}, {'inf' if md['high'] is None else format(md['high'], 'g')}]")
+        rng = (
+            ""
+            if md.get("low") is None
+            else f"[{md['low']:g}, {'inf' if md['high'] is None else format(md['high'], 'g')}]"
+        )
         rows.append(f"| `{f.name}` | `{f.default!r}` | {md['unit']} | {rng} | {md['doc']} |")
     return "\n".join(rows)
 

@@ -14,8 +14,16 @@ from acld_gym.physics.loads import TipLoad, case_load, check_load_case, random_l
 from acld_gym.physics.temperature import shifted_parameters
 from acld_gym.physics.uncertainty import randomized_parameters
 
-__all__ = ["reset_options", "draw_episode", "draw_noise", "fixed_plant", "sampled_plant",
-           "randomized_plant", "passive_plant", "RESET_OPTIONS"]
+__all__ = [
+    "reset_options",
+    "draw_episode",
+    "draw_noise",
+    "fixed_plant",
+    "sampled_plant",
+    "randomized_plant",
+    "passive_plant",
+    "RESET_OPTIONS",
+]
 
 #: The keys of ``reset(options=...)``: a named case or a TipLoad (``"load_case"``), or a
 #: TipLoad (``"load"``), for this episode only.
@@ -31,8 +39,9 @@ def reset_options(options, default_case):
     options = dict(options or {})
     unknown = sorted(set(options) - set(RESET_OPTIONS))
     if unknown:
-        raise ValueError(f"options: unknown key(s) {unknown}; expected one of "
-                         f"{list(RESET_OPTIONS)}")
+        raise ValueError(
+            f"options: unknown key(s) {unknown}; expected one of {list(RESET_OPTIONS)}"
+        )
     if len(options) > 1:
         raise ValueError("options: give 'load_case' or 'load', not both")
     if "load" in options:
@@ -42,8 +51,9 @@ def reset_options(options, default_case):
     return check_load_case(options.get("load_case", default_case))
 
 
-def draw_episode(rng: np.random.Generator, case, nom: NominalDesign, config,
-                 harmonic_modes: tuple[float, float]) -> tuple[TipLoad, SampledSystem | None]:
+def draw_episode(
+    rng: np.random.Generator, case, nom: NominalDesign, config, harmonic_modes: tuple[float, float]
+) -> tuple[TipLoad, SampledSystem | None]:
     """The load and the plant of an episode, drawn from ``rng`` in a fixed order: the load (a
     random one for ``"random"``, aimed at ``harmonic_modes`` [rad/s]), the parameters
     (``config.param_noise`` > 0), the temperature (``config.temperature_range``). The plant
@@ -51,8 +61,7 @@ def draw_episode(rng: np.random.Generator, case, nom: NominalDesign, config,
     plant = nom.plant
     load = case_load(case)
     if load is None:  # the random case
-        load = random_load(rng, config.episode_length, plant.dt / plant.substeps,
-                           harmonic_modes)
+        load = random_load(rng, config.episode_length, plant.dt / plant.substeps, harmonic_modes)
     if not config.randomized:
         return load, None
     params = nom.truth.params
@@ -61,8 +70,9 @@ def draw_episode(rng: np.random.Generator, case, nom: NominalDesign, config,
     temperature = config.temperature
     if config.temperature_range is not None:
         temperature = float(rng.uniform(*config.temperature_range))
-    return load, sampled_plant(nom, shifted_parameters(params, temperature),
-                               config.amplifier_bandwidth)
+    return load, sampled_plant(
+        nom, shifted_parameters(params, temperature), config.amplifier_bandwidth
+    )
 
 
 def fixed_plant(nom: NominalDesign, config) -> SampledSystem:
@@ -99,8 +109,9 @@ def sampled_plant(nom: NominalDesign, params, bandwidth: float | None) -> Sample
     return discretize(A, B, E, nom.plant.dt, nom.plant.substeps)
 
 
-def draw_noise(rng: np.random.Generator, std: float, n: int | None = None,
-               out: np.ndarray | None = None) -> np.ndarray:
+def draw_noise(
+    rng: np.random.Generator, std: float, n: int | None = None, out: np.ndarray | None = None
+) -> np.ndarray:
     """An episode's sensor noise, ``n`` (or ``out.size``) draws of N(0, std^2) [m] from
     ``rng`` (into ``out`` if given): the numbers of ``rng.normal(0.0, std, n)``, which is
     ``0.0 + std * z`` with z the generator's standard normals."""
@@ -109,8 +120,9 @@ def draw_noise(rng: np.random.Generator, std: float, n: int | None = None,
     return z
 
 
-def randomized_plant(rng: np.random.Generator, param_noise: float,
-                     nom: NominalDesign) -> SampledSystem:
+def randomized_plant(
+    rng: np.random.Generator, param_noise: float, nom: NominalDesign
+) -> SampledSystem:
     """The nominal truth plant with randomized material parameters
     (:func:`acld_gym.physics.uncertainty.randomized_parameters`), sampled like the nominal
     one (:func:`sampled_plant`)."""

@@ -28,9 +28,15 @@ def design_fingerprint(nom) -> dict[str, Any]:
     the reduced model's coordinates and the observation scales. Enough for a reference policy, which
     decodes the estimate with them and works with either observer."""
     r = nom.design.reduced
-    return {"mesh": nom.mesh, "basis": nom.basis, "dt": float(nom.plant.dt),
-            "reduced_A": r.A.tolist(), "reduced_B": r.B.ravel().tolist(),
-            "reduced_C": r.C.ravel().tolist(), "xr_scale": nom.xr_scale.tolist()}
+    return {
+        "mesh": nom.mesh,
+        "basis": nom.basis,
+        "dt": float(nom.plant.dt),
+        "reduced_A": r.A.tolist(),
+        "reduced_B": r.B.ravel().tolist(),
+        "reduced_C": r.C.ravel().tolist(),
+        "xr_scale": nom.xr_scale.tolist(),
+    }
 
 
 def observation_fingerprint(env) -> dict[str, Any]:
@@ -40,10 +46,14 @@ def observation_fingerprint(env) -> dict[str, Any]:
     e = getattr(env, "unwrapped", env)
     spec = getattr(e, "spec", None)
     obs = e.nom.observer(e.observer_kind)
-    return {"env_id": getattr(spec, "id", None) or e.env_id,
-            **design_fingerprint(e.nom), "obs_mode": e.obs_mode,
-            "observer": e.observer_kind, "observer_Lc": obs.Lc.ravel().tolist(),
-            "observer_Lp": obs.Lp.ravel().tolist()}
+    return {
+        "env_id": getattr(spec, "id", None) or e.env_id,
+        **design_fingerprint(e.nom),
+        "obs_mode": e.obs_mode,
+        "observer": e.observer_kind,
+        "observer_Lc": obs.Lc.ravel().tolist(),
+        "observer_Lp": obs.Lp.ravel().tolist(),
+    }
 
 
 def fingerprint_differences(expected: dict[str, Any], actual: dict[str, Any]) -> list[str]:
@@ -58,8 +68,9 @@ def fingerprint_differences(expected: dict[str, Any], actual: dict[str, Any]) ->
             a, b = np.asarray(want, dtype=float), np.asarray(got, dtype=float)
             if a.shape != b.shape:
                 out.append(f"{key}: shape {a.shape} recorded, {b.shape} in the env")
-            elif not np.allclose(b, a, rtol=RTOL,
-                                 atol=RTOL * float(np.max(np.abs(a), initial=0.0))):
+            elif not np.allclose(
+                b, a, rtol=RTOL, atol=RTOL * float(np.max(np.abs(a), initial=0.0))
+            ):
                 rel = float(np.max(np.abs(b - a)) / max(float(np.max(np.abs(a))), 1e-300))
                 out.append(f"{key}: differs by {rel:.2g} (relative)")
         elif want != got:

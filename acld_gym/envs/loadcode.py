@@ -67,7 +67,7 @@ class LoadCodes:
                 row[j] = (HARMONIC, c.start, c.end, c.amplitude, c.frequency, c.phase, 0.0, 0.0)
             else:
                 n = len(c.values)
-                pool[offset:offset + n] = c.values
+                pool[offset : offset + n] = c.values
                 row[j] = (SAMPLES, c.start, c.end, c.step, offset, n, 0.0, np.nan)
                 offset += n
         self.ncomp[i] = len(comps)

@@ -32,24 +32,39 @@ arguments of ``gym.make`` replace them). This module imports nothing heavy, so t
 
 from __future__ import annotations
 
-__all__ = ["PRESETS", "LAB", "HARD", "ENTRY_POINT", "VECTOR_ENTRY_POINT", "preset",
-           "register_presets"]
+__all__ = [
+    "PRESETS",
+    "LAB",
+    "HARD",
+    "ENTRY_POINT",
+    "VECTOR_ENTRY_POINT",
+    "preset",
+    "register_presets",
+]
 
 ENTRY_POINT = "acld_gym.envs.beam_env:ACLDBeamEnv"
 VECTOR_ENTRY_POINT = "acld_gym.envs.vector_env:ACLDBeamVectorEnv"
 
 #: The lab rig's actuator and sensor (module docstring, with the sources).
-LAB = {"actuator_delay": 1, "slew_rate": 4.18e6, "amplifier_bandwidth": 60e3,
-       "sensor_noise": 1.8e-7}
+LAB = {
+    "actuator_delay": 1,
+    "slew_rate": 4.18e6,
+    "amplifier_bandwidth": 60e3,
+    "sensor_noise": 1.8e-7,
+}
 #: The hard level: the lab rig, the temperature, parameter noise and partial observation.
-HARD = {**LAB, "temperature_range": (18.0, 28.0), "param_noise": 0.05,
-        "obs_mode": "measurement"}
+HARD = {**LAB, "temperature_range": (18.0, 28.0), "param_noise": 0.05, "obs_mode": "measurement"}
 
 #: id -> the EnvConfig fields it sets (JSON-able; the rest are EnvConfig's defaults).
 PRESETS: dict[str, dict] = {
     "ACLDBeam-v1": {},
-    "ACLDBeam-v0": {"mesh": "thesis", "harmonic_modes": (179.0, 1115.0), "model_std": 0.0,
-                    "param_noise_max": 0.5, "env_id": "ACLDBeam-v0"},
+    "ACLDBeam-v0": {
+        "mesh": "thesis",
+        "harmonic_modes": (179.0, 1115.0),
+        "model_std": 0.0,
+        "param_noise_max": 0.5,
+        "env_id": "ACLDBeam-v0",
+    },
     "ACLDBeamLab-v1": {**LAB, "env_id": "ACLDBeamLab-v1"},
     "ACLDBeamHard-v1": {**HARD, "env_id": "ACLDBeamHard-v1"},
 }
@@ -73,5 +88,9 @@ def register_presets() -> None:
 
     for env_id, kwargs in PRESETS.items():
         if env_id not in registry:
-            register(id=env_id, entry_point=ENTRY_POINT, vector_entry_point=VECTOR_ENTRY_POINT,
-                     kwargs=dict(kwargs))
+            register(
+                id=env_id,
+                entry_point=ENTRY_POINT,
+                vector_entry_point=VECTOR_ENTRY_POINT,
+                kwargs=dict(kwargs),
+            )

@@ -11,7 +11,7 @@ __all__ = ["render_frame", "show", "close", "FigureOwner"]
 def _beam_shape(env) -> tuple[np.ndarray, np.ndarray]:
     """Node positions [m] and transverse displacements [m] of the plant's mesh."""
     truth = env.nom.truth
-    return truth.node_x, truth.node_w @ np.asarray(env.x)[:truth.n_coordinates]
+    return truth.node_x, truth.node_w @ np.asarray(env.x)[: truth.n_coordinates]
 
 
 def render_frame(env, fig=None):
@@ -28,17 +28,32 @@ def render_frame(env, fig=None):
     ax0, ax1, ax2 = fig.subplots(3, 1, gridspec_kw={"height_ratios": [2, 1, 1]})
     p = env.nom.truth.params
     xs, w = _beam_shape(env)
-    ax0.plot(xs * 1e3, w * 1e3, "-", marker="o" if xs.size < 40 else None, ms=3, color="0.3",
-             label="beam")
-    ax0.axvspan(p.patch_start * 1e3, (p.patch_start + p.patch_length) * 1e3, color="C1",
-                alpha=0.3, label="ACLD patch")
+    ax0.plot(
+        xs * 1e3,
+        w * 1e3,
+        "-",
+        marker="o" if xs.size < 40 else None,
+        ms=3,
+        color="0.3",
+        label="beam",
+    )
+    ax0.axvspan(
+        p.patch_start * 1e3,
+        (p.patch_start + p.patch_length) * 1e3,
+        color="C1",
+        alpha=0.3,
+        label="ACLD patch",
+    )
     lim = max(1.0, 1.2 * float(np.max(np.abs(w))) * 1e3)
     ax0.set_ylim(-lim, lim)
     ax0.set_xlim(0, p.length * 1e3)
     ax0.set_xlabel("x [mm]")
     ax0.set_ylabel("w [mm]")
-    ax0.set_title(f"t = {env.k * env.dt:.3f} s   V = {env.v:+.0f} V   load = "
-                  f"{float(env.load(env.k * env.dt)):+.2f} N", fontsize=9)
+    ax0.set_title(
+        f"t = {env.k * env.dt:.3f} s   V = {env.v:+.0f} V   load = "
+        f"{float(env.load(env.k * env.dt)):+.2f} N",
+        fontsize=9,
+    )
     ax0.legend(loc="upper left", fontsize=7)
     if env.history:
         t, y, v = (np.array(c) for c in zip(*env.history, strict=True))

@@ -34,8 +34,19 @@ from acld_gym.physics.loads import check_load_case
 from acld_gym.util.validate import check_seed
 
 #: Attributes the env derives its tables and design from at construction.
-_CONFIGURED = ("config", "mesh", "dt", "episode_length", "observer_kind", "obs_mode",
-               "sensor_noise", "param_noise", "num_envs", "nom", "horizon")
+_CONFIGURED = (
+    "config",
+    "mesh",
+    "dt",
+    "episode_length",
+    "observer_kind",
+    "obs_mode",
+    "sensor_noise",
+    "param_noise",
+    "num_envs",
+    "nom",
+    "horizon",
+)
 
 __all__ = ["SB3VecEnv"]
 
@@ -50,15 +61,19 @@ class SB3VecEnv(VecEnv):
     configuration -- ``config=`` and/or its fields as keywords --, or an existing
     ``venv=``)."""
 
-    def __init__(self, num_envs: int = 1, venv: ACLDBeamVectorEnv | None = None,
-                 config: EnvConfig | None = None, **env_kwargs):
+    def __init__(
+        self,
+        num_envs: int = 1,
+        venv: ACLDBeamVectorEnv | None = None,
+        config: EnvConfig | None = None,
+        **env_kwargs,
+    ):
         if venv is None:
             venv = ACLDBeamVectorEnv(num_envs=num_envs, config=config, **env_kwargs)
         elif env_kwargs or config is not None:
             raise ValueError("pass either venv= or the env's configuration, not both")
         self.venv = venv
-        super().__init__(venv.num_envs, venv.single_observation_space,
-                         venv.single_action_space)
+        super().__init__(venv.num_envs, venv.single_observation_space, venv.single_action_space)
         self.render_mode = venv.render_mode
         self._actions: np.ndarray | None = None
         self._seed: int | None = None
@@ -85,7 +100,8 @@ class SB3VecEnv(VecEnv):
         done = terminated | truncated
         keys = INFO_KEYS + (("reward_scale",) if "reward_scale" in info else ())
         infos: list[dict[str, Any]] = [
-            {key: _scalar(info[key][i]) for key in keys} for i in range(self.num_envs)]
+            {key: _scalar(info[key][i]) for key in keys} for i in range(self.num_envs)
+        ]
         if done.any():
             ended = np.flatnonzero(done)
             for i in ended:
@@ -135,8 +151,9 @@ class SB3VecEnv(VecEnv):
         if attr_name == "load_case":
             check_load_case(value)
         elif attr_name in _CONFIGURED:
-            raise ValueError(f"SB3VecEnv: {attr_name} is fixed at construction; build a new "
-                             "env to change it")
+            raise ValueError(
+                f"SB3VecEnv: {attr_name} is fixed at construction; build a new env to change it"
+            )
         elif not hasattr(self.venv, attr_name):
             raise ValueError(f"SB3VecEnv: the vector env has no attribute {attr_name!r}")
         setattr(self.venv, attr_name, value)

@@ -70,8 +70,10 @@ class PassiveCost:
         self.plant = plant
         self.output = np.asarray(output, dtype=np.float64).reshape(-1)
         if self.output.shape != (plant.Ad.shape[0],):
-            raise ValueError(f"output must have {plant.Ad.shape[0]} entries (the plant's "
-                             f"states), got {self.output.shape}")
+            raise ValueError(
+                f"output must have {plant.Ad.shape[0]} entries (the plant's "
+                f"states), got {self.output.shape}"
+            )
         self.steps = int(steps)
         self.y_ref = float(y_ref)
         self._AT = np.ascontiguousarray(plant.Ad.T)
@@ -81,7 +83,7 @@ class PassiveCost:
         """c of each load in ``loads`` (len(loads),), at least :data:`SCALE_FLOOR`."""
         out = np.empty(len(loads))
         for a in range(0, len(loads), _CHUNK):
-            part = loads[a:a + _CHUNK]
+            part = loads[a : a + _CHUNK]
             F = np.stack([load_schedule(self.plant, load, 0, self.steps)[0] for load in part])
             x = np.zeros((len(part), self._AT.shape[0]))
             acc = np.zeros(len(part))
@@ -89,7 +91,7 @@ class PassiveCost:
                 x = x @ self._AT + F[:, k] @ self._WT
                 y = x @ self.output
                 acc += y * y
-            out[a:a + len(part)] = acc / (self.steps * self.y_ref**2)
+            out[a : a + len(part)] = acc / (self.steps * self.y_ref**2)
         return np.maximum(out, SCALE_FLOOR)
 
 
@@ -107,9 +109,14 @@ class LQRCost:
     """
 
     def __init__(self, config, steps: int):
-        self.config = config.replace(reward_scale=None, observe_reward_scale=False,
-                                     obs_mode="estimate", sensor_noise=0.0, param_noise=0.0,
-                                     temperature_range=None)
+        self.config = config.replace(
+            reward_scale=None,
+            observe_reward_scale=False,
+            obs_mode="estimate",
+            sensor_noise=0.0,
+            param_noise=0.0,
+            temperature_range=None,
+        )
         self.steps = int(steps)
         nom = self.config.nominal()
         #: The law (:meth:`acld_gym.design.nominal.NominalDesign.lqr_law`) on the reduced
@@ -133,8 +140,7 @@ class LQRCost:
         if b is None:
             b = self._batches[size] = BatchStep(self.config, size, self.steps)
         padded = list(loads) + [loads[-1]] * (size - n)
-        b.start_episodes(np.arange(size), padded, [None] * size,
-                         np.zeros((size, self.steps + 1)))
+        b.start_episodes(np.arange(size), padded, [None] * size, np.zeros((size, self.steps + 1)))
         k = self.xr_scale.shape[0]
         obs, acc = b.observations(), np.zeros(size)
         for _ in range(self.steps):

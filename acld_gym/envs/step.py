@@ -17,10 +17,22 @@ from acld_gym.physics.loads import TipLoad
 if TYPE_CHECKING:
     from acld_gym.design.nominal import NominalDesign
 
-__all__ = ["StepLayout", "Y_SCALE", "OBS_HIST", "INFO_KEYS", "TERMINATED_BY", "observation_size",
-           "estimate_slots",
-           "estimate_map", "output_matrix", "rest_output", "load_schedule",
-           "reward_terms", "reward_of", "termination_codes"]
+__all__ = [
+    "StepLayout",
+    "Y_SCALE",
+    "OBS_HIST",
+    "INFO_KEYS",
+    "TERMINATED_BY",
+    "observation_size",
+    "estimate_slots",
+    "estimate_map",
+    "output_matrix",
+    "rest_output",
+    "load_schedule",
+    "reward_terms",
+    "reward_of",
+    "termination_codes",
+]
 
 
 #: Deflection scale of the observations [m].
@@ -35,8 +47,18 @@ OBS_HIST = 8
 #: [N] and the time [s] at the end of the step, the true reduced state, why the episode
 #: ended (:data:`TERMINATED_BY`) and the reward's two terms (their sum is the reward, as
 #: Gymnasium's MuJoCo envs report ``reward_*`` terms).
-INFO_KEYS = ("tip_deflection", "voltage", "requested_voltage", "clipped", "tip_load", "time",
-             "xr_true", "terminated_by", "reward_deflection", "reward_voltage")
+INFO_KEYS = (
+    "tip_deflection",
+    "voltage",
+    "requested_voltage",
+    "clipped",
+    "tip_load",
+    "time",
+    "xr_true",
+    "terminated_by",
+    "reward_deflection",
+    "reward_voltage",
+)
 
 #: ``info["terminated_by"]`` by termination code (0: the episode goes on).
 TERMINATED_BY = (None, "deflection_limit", "non_finite_state")
@@ -76,9 +98,15 @@ class StepLayout:
     def of(cls, config, nom: NominalDesign, obs: DiscreteObserver) -> StepLayout:
         """The layout of a configuration (:class:`acld_gym.envs.config.EnvConfig`): the
         plant's and the observer's sizes, and the actuator options."""
-        return cls(n=nom.plant.Ad.shape[0], k=obs.n, r=nom.design.reduced.order,
-                   substeps=nom.plant.substeps, delay=config.actuator_delay,
-                   lag=config.amplifier_bandwidth is not None, slew=config.slew_rate is not None)
+        return cls(
+            n=nom.plant.Ad.shape[0],
+            k=obs.n,
+            r=nom.design.reduced.order,
+            substeps=nom.plant.substeps,
+            delay=config.actuator_delay,
+            lag=config.amplifier_bandwidth is not None,
+            slew=config.slew_rate is not None,
+        )
 
     @property
     def actuated(self) -> bool:
@@ -190,18 +218,30 @@ class StepLayout:
     def core_kwargs(self) -> dict[str, int]:
         """The layout as the compiled step takes it (``acld_gym.envs._stepcore``)."""
         none = -1
-        return {"n_state": self.state.stop, "i_voltage": self.voltage,
-                "i_loads": self.loads.start, "i_noise": self.noise, "o_ymeas": self.y_meas,
-                "o_y": self.out_y, "o_xr": self.out_xr.start, "o_obs": self.out_estimate.start,
-                "n_x": self.n, "n_xr": self.r,
-                "o_volt": none if self.out_voltage is None else self.out_voltage,
-                "i_cmd": self.command, "i_held": none if self.held is None else self.held,
-                "i_amp": none if self.amplifier is None else self.amplifier}
+        return {
+            "n_state": self.state.stop,
+            "i_voltage": self.voltage,
+            "i_loads": self.loads.start,
+            "i_noise": self.noise,
+            "o_ymeas": self.y_meas,
+            "o_y": self.out_y,
+            "o_xr": self.out_xr.start,
+            "o_obs": self.out_estimate.start,
+            "n_x": self.n,
+            "n_xr": self.r,
+            "o_volt": none if self.out_voltage is None else self.out_voltage,
+            "i_cmd": self.command,
+            "i_held": none if self.held is None else self.held,
+            "i_amp": none if self.amplifier is None else self.amplifier,
+        }
 
 
 def observation_size(nom: NominalDesign, obs_mode: str, hist: int = OBS_HIST) -> int:
-    return {"estimate": nom.design.reduced.order + 1, "measurement": hist + 1,
-            "full": nom.plant.Ad.shape[0]}[obs_mode]
+    return {
+        "estimate": nom.design.reduced.order + 1,
+        "measurement": hist + 1,
+        "full": nom.plant.Ad.shape[0],
+    }[obs_mode]
 
 
 def estimate_slots(order: int, modes: int) -> np.ndarray:
@@ -209,8 +249,9 @@ def estimate_slots(order: int, modes: int) -> np.ndarray:
     (cosine, sine)-like pair per mode in mode order, then the tip) that hold the first
     ``modes`` modes' pairs and the tip: ``[0, ..., 2 modes - 1, order]``."""
     if order % 2 or not 1 <= modes <= order // 2:
-        raise ValueError(f"modes must be in [1, {order // 2}] (the design model's modes), "
-                         f"got {modes!r}")
+        raise ValueError(
+            f"modes must be in [1, {order // 2}] (the design model's modes), got {modes!r}"
+        )
     return np.r_[np.arange(2 * modes), order]
 
 
@@ -222,9 +263,15 @@ def estimate_map(obs: DiscreteObserver, xr_scale: np.ndarray) -> np.ndarray:
     return M / xr_scale
 
 
-def output_matrix(plant: SampledSystem, nom_plant: SampledSystem, obs: DiscreteObserver,
-                  layout: StepLayout, output: np.ndarray, SL: np.ndarray,
-                  est: np.ndarray) -> np.ndarray:
+def output_matrix(
+    plant: SampledSystem,
+    nom_plant: SampledSystem,
+    obs: DiscreteObserver,
+    layout: StepLayout,
+    output: np.ndarray,
+    SL: np.ndarray,
+    est: np.ndarray,
+) -> np.ndarray:
     """The whole step as one matrix G, ``G z`` in the slots of ``layout``
     (:class:`StepLayout`):
 
@@ -266,14 +313,16 @@ def output_matrix(plant: SampledSystem, nom_plant: SampledSystem, obs: DiscreteO
     G[lay.y_meas] = y_meas
     G[lay.out_y] = y
     G[lay.out_xr] = SL.T @ X
-    G[lay.out_estimate.start:lay.out_estimate.stop - 1] = est[:k].T @ G[xh] + np.outer(est[k],
-                                                                                       y_meas)
+    G[lay.out_estimate.start : lay.out_estimate.stop - 1] = est[:k].T @ G[xh] + np.outer(
+        est[k], y_meas
+    )
     G[lay.out_estimate.stop - 1] = y_meas / Y_SCALE
     return G
 
 
-def load_schedule(plant: SampledSystem, load: TipLoad, start: int,
-                  stop: int) -> tuple[np.ndarray, np.ndarray]:
+def load_schedule(
+    plant: SampledSystem, load: TipLoad, start: int, stop: int
+) -> tuple[np.ndarray, np.ndarray]:
     """Load samples of periods ``start .. stop-1``: ``(F, tip)`` with F (steps, 2 substeps)
     ``[f0, f1]`` as :meth:`SampledSystem.load_samples` and tip (steps + 1,) the load at
     the period starts ``k dt`` (for ``info``)."""
@@ -298,8 +347,9 @@ def reward_of(y, v, y_ref: float, lam: float, v_max: float):
     return reward_terms(y, v, y_ref, lam, v_max)[0]
 
 
-def termination_codes(y: np.ndarray, reward: np.ndarray, out: np.ndarray,
-                      limit: float) -> np.ndarray:
+def termination_codes(
+    y: np.ndarray, reward: np.ndarray, out: np.ndarray, limit: float
+) -> np.ndarray:
     """Why each step ends the episode, as a code into :data:`TERMINATED_BY`: 2
     (``"non_finite_state"``) if the env's output row ``out`` (the new state and everything
     derived from it) or the reward is not finite -- never passed off as a normal step --,

@@ -59,15 +59,24 @@ class ACLDBeamVectorEnv(ConfigAttributes, FigureOwner, VectorEnv):
     with their ``_key`` masks. ``render()`` draws sub-env 0 (``render_mode="rgb_array"``).
     """
 
-    metadata = {"render_modes": ["rgb_array"], "render_fps": 30,
-                "autoreset_mode": AutoresetMode.NEXT_STEP}
+    metadata = {
+        "render_modes": ["rgb_array"],
+        "render_fps": 30,
+        "autoreset_mode": AutoresetMode.NEXT_STEP,
+    }
 
     #: Step in C where it can (``COMPILED_STEP``); set False on an instance to force the
     #: numpy reference step from the next reset on (benchmarks and tests compare the two).
     compiled_step = COMPILED_STEP
 
-    def __init__(self, num_envs: int = 1, max_episode_steps: int | None = None,
-                 config: EnvConfig | None = None, render_mode: str | None = None, **kwargs):
+    def __init__(
+        self,
+        num_envs: int = 1,
+        max_episode_steps: int | None = None,
+        config: EnvConfig | None = None,
+        render_mode: str | None = None,
+        **kwargs,
+    ):
         num_envs = check_int("num_envs", num_envs, 1)
         self.config = c = make_config(config, **kwargs)
         check_episode_size(c.episode_length, c.dt, num_envs)
@@ -89,11 +98,16 @@ class ACLDBeamVectorEnv(ConfigAttributes, FigureOwner, VectorEnv):
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self._default_case = c.load_case
         self._prev_done = np.zeros(num_envs, dtype=bool)
-        self._rngs: list[np.random.Generator] = [seeding.np_random(None)[0]
-                                                 for _ in range(num_envs)]
+        self._rngs: list[np.random.Generator] = [
+            seeding.np_random(None)[0] for _ in range(num_envs)
+        ]
         load = case_load(c.load_case) or thesis_load(1)
-        self._batch.start_episodes(np.arange(num_envs), [load] * num_envs, [None] * num_envs,
-                                   np.zeros((num_envs, steps + 1)))
+        self._batch.start_episodes(
+            np.arange(num_envs),
+            [load] * num_envs,
+            [None] * num_envs,
+            np.zeros((num_envs, steps + 1)),
+        )
         self._fig = None
         self._needs_reset = True
 
@@ -157,9 +171,18 @@ class ACLDBeamVectorEnv(ConfigAttributes, FigureOwner, VectorEnv):
         """The info of a reset of every sub-env (:data:`INFO_KEYS`, their masks)."""
         N, b = self.num_envs, self._batch
         ones = np.ones(N, dtype=bool)
-        vals = (np.zeros(N), np.zeros(N), np.zeros(N), np.zeros(N, dtype=bool), b.tip_loads(),
-                np.zeros(N), np.zeros((N, self.nom.design.reduced.order)), WHY[np.zeros(N, int)],
-                np.zeros(N), np.zeros(N))
+        vals = (
+            np.zeros(N),
+            np.zeros(N),
+            np.zeros(N),
+            np.zeros(N, dtype=bool),
+            b.tip_loads(),
+            np.zeros(N),
+            np.zeros((N, self.nom.design.reduced.order)),
+            WHY[np.zeros(N, int)],
+            np.zeros(N),
+            np.zeros(N),
+        )
         info: dict[str, Any] = {}
         for key, val in zip(INFO_KEYS, vals, strict=True):
             info[key] = val
@@ -168,8 +191,7 @@ class ACLDBeamVectorEnv(ConfigAttributes, FigureOwner, VectorEnv):
         return info
 
     # --- Gymnasium API --------------------------------------------------------------------
-    def reset(self, *, seed: int | list[int | None] | None = None,
-              options: dict | None = None):
+    def reset(self, *, seed: int | list[int | None] | None = None, options: dict | None = None):
         N = self.num_envs
         case = reset_options(options, self._default_case)  # validated before any seeding
         if seed is None or isinstance(seed, (list, tuple, np.ndarray)):
@@ -209,8 +231,16 @@ class ACLDBeamVectorEnv(ConfigAttributes, FigureOwner, VectorEnv):
         obs[rows] = b.observations(rows)
         reward[rows] = 0.0
         terminated[rows] = truncated[rows] = False
-        for key in ("tip_deflection", "voltage", "requested_voltage", "clipped", "time",
-                    "xr_true", "reward_deflection", "reward_voltage"):
+        for key in (
+            "tip_deflection",
+            "voltage",
+            "requested_voltage",
+            "clipped",
+            "time",
+            "xr_true",
+            "reward_deflection",
+            "reward_voltage",
+        ):
             info[key][rows] = 0
         info["tip_load"][rows] = b.tip_loads(rows)
         info["terminated_by"][rows] = None
@@ -230,8 +260,7 @@ class ACLDBeamVectorEnv(ConfigAttributes, FigureOwner, VectorEnv):
 
     def render(self):
         if self.render_mode is None:
-            gym.logger.warn("render() called without render_mode; pass render_mode= to "
-                            "make_vec()")
+            gym.logger.warn("render() called without render_mode; pass render_mode= to make_vec()")
             return None
         from acld_gym.envs.render import render_frame
 

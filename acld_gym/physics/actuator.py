@@ -33,8 +33,16 @@ import numpy as np
 from acld_gym.physics.params import BeamParameters
 from acld_gym.util.validate import check_real
 
-__all__ = ["V_LIMIT", "EPSILON_0", "PZT_PERMITTIVITY", "REFERENCE_CURRENT",
-           "REFERENCE_SLEW_RATE", "patch_capacitance", "slew_rate", "with_amplifier"]
+__all__ = [
+    "V_LIMIT",
+    "EPSILON_0",
+    "PZT_PERMITTIVITY",
+    "REFERENCE_CURRENT",
+    "REFERENCE_SLEW_RATE",
+    "patch_capacitance",
+    "slew_rate",
+    "with_amplifier",
+]
 
 #: Voltage limit of the PZT patch [V] (thesis sec. 5.3).
 V_LIMIT = 120.0
@@ -46,8 +54,9 @@ PZT_PERMITTIVITY = 1900.0
 REFERENCE_CURRENT = 0.095
 
 
-def patch_capacitance(params: BeamParameters | None = None,
-                      relative_permittivity: float = PZT_PERMITTIVITY) -> float:
+def patch_capacitance(
+    params: BeamParameters | None = None, relative_permittivity: float = PZT_PERMITTIVITY
+) -> float:
     r"""Capacitance of the PZT patch [F], :math:`K^T_3 \varepsilon_0 L_p b / t_c`.
 
     The free permittivity :math:`\varepsilon^T` is what a capacitance meter sees on an
@@ -73,8 +82,7 @@ def patch_capacitance(params: BeamParameters | None = None,
         raise ValueError(f"params must be a BeamParameters or None, got {params!r}")
     k = check_real("relative_permittivity", relative_permittivity, 0.0, low_open=True)
     if p.patch_length == 0:
-        raise ValueError("params: a bare beam (patch_length = 0) has no patch, so no "
-                         "capacitance")
+        raise ValueError("params: a bare beam (patch_length = 0) has no patch, so no capacitance")
     return k * EPSILON_0 * p.patch_length * p.width / p.pzt_thickness
 
 
@@ -88,8 +96,9 @@ def slew_rate(current: float, capacitance: float) -> float:
 REFERENCE_SLEW_RATE = slew_rate(REFERENCE_CURRENT, patch_capacitance())
 
 
-def with_amplifier(A: np.ndarray, B: np.ndarray, E: np.ndarray,
-                   bandwidth: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def with_amplifier(
+    A: np.ndarray, B: np.ndarray, E: np.ndarray, bandwidth: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     r"""The plant ``(A, B, E)`` (voltage input B, load input E) driven through a first-order
     amplifier of ``bandwidth`` [Hz]: the state gains the patch voltage :math:`V_p`,
     :math:`\dot V_p = \omega_a (V_c - V_p)`, :math:`\omega_a = 2\pi f_a`, and the input is

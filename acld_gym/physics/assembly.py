@@ -82,18 +82,22 @@ class DofMap:
 
 def number_dofs(p: BeamParameters, mesh: Mesh) -> DofMap:
     """Number the DOFs of the mesh in the thesis's (FEASMBL) order."""
-    sections = [("beam", p.patch_start, mesh.n_before, "n_before"),
-                ("acld", p.patch_length, mesh.n_patch, "n_patch"),
-                ("beam", p.length - p.patch_start - p.patch_length, mesh.n_after, "n_after")]
+    sections = [
+        ("beam", p.patch_start, mesh.n_before, "n_before"),
+        ("acld", p.patch_length, mesh.n_patch, "n_patch"),
+        ("beam", p.length - p.patch_start - p.patch_length, mesh.n_after, "n_after"),
+    ]
     kinds: list[str] = []
     lengths: list[float] = []
     for kind, span, count, name in sections:
         if count > 0 and span <= 1e-12 * p.length:
-            raise ValueError(f"Mesh.{name} = {count} but that section is {span:g} m long "
-                             f"(set {name}=0)")
+            raise ValueError(
+                f"Mesh.{name} = {count} but that section is {span:g} m long (set {name}=0)"
+            )
         if count == 0 and span > 1e-12 * p.length:
-            raise ValueError(f"Mesh.{name} = 0 but that section is {span:g} m long "
-                             f"(needs at least one element)")
+            raise ValueError(
+                f"Mesh.{name} = 0 but that section is {span:g} m long (needs at least one element)"
+            )
         kinds += [kind] * count
         lengths += [span / count] * count if count else []
     n_nodes = len(kinds) + 1
@@ -123,8 +127,13 @@ def number_dofs(p: BeamParameters, mesh: Mesh) -> DofMap:
             idx += list(elem_z[e])
         elements.append((kind, le, tuple(idx)))
     node_x = tuple(np.concatenate([[0.0], np.cumsum(lengths)]).tolist())
-    return DofMap(node_x=node_x, node_dofs=tuple(node_dofs), elements=tuple(elements),
-                  z_dofs=tuple(z_dofs), n_dofs=nxt)
+    return DofMap(
+        node_x=node_x,
+        node_dofs=tuple(node_dofs),
+        elements=tuple(elements),
+        z_dofs=tuple(z_dofs),
+        n_dofs=nxt,
+    )
 
 
 @dataclass(frozen=True, eq=False)
@@ -166,10 +175,13 @@ def assemble_terms(p: BeamParameters, dofs: DofMap) -> AssembledTerms:
             cols.setdefault(name, []).append(c)
             vals.setdefault(name, []).append(U.ravel())
         np.add.at(piezo, ii, et.piezo)
-    units = {name: sp.coo_matrix((np.concatenate(vals[name]), (np.concatenate(rows[name]),
-                                                               np.concatenate(cols[name]))),
-                                 shape=(n, n)).tocsr()
-             for name in rows}
+    units = {
+        name: sp.coo_matrix(
+            (np.concatenate(vals[name]), (np.concatenate(rows[name]), np.concatenate(cols[name]))),
+            shape=(n, n),
+        ).tocsr()
+        for name in rows
+    }
     return AssembledTerms(units=units, piezo=piezo)
 
 

@@ -28,16 +28,25 @@ from acld_gym.physics.krylov import damped_modes
 from acld_gym.physics.model import first_order, parametric_model
 from acld_gym.physics.params import BeamParameters, Mesh
 
-__all__ = ["ModeStudy", "mode_study", "frequency_responses", "richardson", "REFINEMENTS",
-           "response_grid", "converged_responses", "relative_hinf"]
+__all__ = [
+    "ModeStudy",
+    "mode_study",
+    "frequency_responses",
+    "richardson",
+    "REFINEMENTS",
+    "response_grid",
+    "converged_responses",
+    "relative_hinf",
+]
 
 #: Refinement factors of the default study (the finest is the converged plant's mesh).
 REFINEMENTS = (1, 2, 4, 8, 16, 32, 64, 128)
 _DENSE_UP_TO = 8  # dense eigenvalues up to this refinement, sparse inverse iteration beyond
 
 
-def richardson(coarse: np.ndarray, mid: np.ndarray,
-               fine: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def richardson(
+    coarse: np.ndarray, mid: np.ndarray, fine: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """Fitted rate p and extrapolated limit from three levels refined by 2 each
     (module docstring); elementwise."""
     coarse, mid, fine = (np.asarray(a, dtype=float) for a in (coarse, mid, fine))
@@ -94,29 +103,36 @@ class ModeStudy:
         head = "| k | states | " + " | ".join(f"mode {j + 1} [rad/s]" for j in range(n)) + " |"
         rows = [head, "|---|---|" + "---|" * n]
         for k, s, f in zip(self.refinements, self.states, self.frequencies, strict=True):
-            cells = [f"{fj:.2f} ({100 * (fj / lj - 1):+.3f} %)" for fj, lj in zip(f, self.limit,
-                                                                                   strict=True)]
+            cells = [
+                f"{fj:.2f} ({100 * (fj / lj - 1):+.3f} %)"
+                for fj, lj in zip(f, self.limit, strict=True)
+            ]
             rows.append(f"| {k} | {s} | " + " | ".join(cells) + " |")
-        rows.append("| limit (Richardson) | - | " + " | ".join(f"{x:.2f}" for x in self.limit)
-                    + " |")
+        rows.append(
+            "| limit (Richardson) | - | " + " | ".join(f"{x:.2f}" for x in self.limit) + " |"
+        )
         rows.append("| fitted rate p | - | " + " | ".join(f"{x:.2f}" for x in self.rate) + " |")
         return "\n".join(rows)
 
 
-def mode_study(n_modes: int = 4, refinements: tuple[int, ...] = REFINEMENTS,
-               params: BeamParameters | None = None) -> ModeStudy:
+def mode_study(
+    n_modes: int = 4,
+    refinements: tuple[int, ...] = REFINEMENTS,
+    params: BeamParameters | None = None,
+) -> ModeStudy:
     """The first ``n_modes`` damped modes on each refinement (a doubling sequence)."""
     refinements = tuple(int(k) for k in refinements)
     pairs = zip(refinements[:-1], refinements[1:], strict=True)
     if len(refinements) < 3 or any(b != 2 * a for a, b in pairs):
-        raise ValueError(f"refinements must double from level to level (at least three), got "
-                         f"{refinements!r}")
+        raise ValueError(
+            f"refinements must double from level to level (at least three), got {refinements!r}"
+        )
     if not isinstance(n_modes, int) or n_modes < 1:
         raise ValueError(f"n_modes must be a positive integer, got {n_modes!r}")
+
     def dense(pm):
         M, C, K, Pc = pm.combine()
-        A = first_order(M.toarray(), C.toarray(), K.toarray(), Pc, pm.Fd,
-                        np.zeros(pm.n_dofs))[0]
+        A = first_order(M.toarray(), C.toarray(), K.toarray(), Pc, pm.Fd, np.zeros(pm.n_dofs))[0]
         lam = np.linalg.eigvals(A)
         lam = lam[lam.imag > 1e-9 * np.abs(lam)]
         return lam[np.argsort(lam.imag)][:n_modes]
@@ -139,8 +155,9 @@ def mode_study(n_modes: int = 4, refinements: tuple[int, ...] = REFINEMENTS,
     return ModeStudy(refinements=refinements, states=tuple(states), eigenvalues=np.array(out))
 
 
-def frequency_responses(refinement: int, omega: np.ndarray,
-                        params: BeamParameters | None = None) -> np.ndarray:
+def frequency_responses(
+    refinement: int, omega: np.ndarray, params: BeamParameters | None = None
+) -> np.ndarray:
     """Voltage-to-tip [m/V] and load-to-tip [m/N] responses of the mesh refined
     ``refinement`` times at ``omega`` [rad/s]: complex array (len(omega), 2)."""
     pm = parametric_model(params, Mesh().refined(int(refinement)))
@@ -164,8 +181,11 @@ def response_grid(modes: np.ndarray, band: float, points: int = 400) -> np.ndarr
     return w[(w > 0) & (w <= band)]
 
 
-def converged_responses(omega: np.ndarray, refinements: tuple[int, int] = (64, 128),
-                        params: BeamParameters | None = None) -> np.ndarray:
+def converged_responses(
+    omega: np.ndarray,
+    refinements: tuple[int, int] = (64, 128),
+    params: BeamParameters | None = None,
+) -> np.ndarray:
     """The mesh-converged model's responses (len(omega), 2), voltage and load to tip:
     pointwise Richardson extrapolation of two refinements (rate 2, module docstring),
     valid where the finer mesh's resonance shift is small against its bandwidth (at

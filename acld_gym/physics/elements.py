@@ -31,9 +31,19 @@ import numpy as np
 
 from acld_gym.physics.params import BeamParameters
 
-__all__ = ["ElementMatrices", "ElementTerms", "timoshenko_element", "acld_element",
-           "timoshenko_terms", "acld_terms", "combine_terms", "TERM_COEFFICIENTS",
-           "PIEZO_COEFFICIENT", "BEAM_NODE_DOFS", "ACLD_NODE_DOFS"]
+__all__ = [
+    "ElementMatrices",
+    "ElementTerms",
+    "timoshenko_element",
+    "acld_element",
+    "timoshenko_terms",
+    "acld_terms",
+    "combine_terms",
+    "TERM_COEFFICIENTS",
+    "PIEZO_COEFFICIENT",
+    "BEAM_NODE_DOFS",
+    "ACLD_NODE_DOFS",
+]
 
 #: Nodal degrees of freedom of the plain Timoshenko element, in order.
 BEAM_NODE_DOFS = ("u", "w", "theta")
@@ -99,34 +109,44 @@ def _outer(row: np.ndarray) -> np.ndarray:
 #: term -> {"M" | "C" | "K": coefficient(p)}; Rayleigh damping C = a M + b K acts on the
 #: beam, PZT and VEM layers, not on the GHM dissipation coordinates.
 TERM_COEFFICIENTS: dict[str, dict[str, Callable[[BeamParameters], float]]] = {
-    "beam.inertia": {"M": lambda p: p.beam_density,
-                     "C": lambda p: p.rayleigh_mass * p.beam_density},
-    "beam.stiffness": {"K": lambda p: p.beam_youngs_modulus,
-                       "C": lambda p: p.rayleigh_stiffness * p.beam_youngs_modulus},
-    "beam.shear": {"K": lambda p: p.shear_correction * p.beam_shear_modulus,
-                   "C": lambda p: p.rayleigh_stiffness * p.shear_correction
-                   * p.beam_shear_modulus},
-    "pzt.inertia": {"M": lambda p: p.pzt_density,
-                    "C": lambda p: p.rayleigh_mass * p.pzt_density},
-    "pzt.stiffness": {"K": lambda p: p.pzt_youngs_modulus,
-                      "C": lambda p: p.rayleigh_stiffness * p.pzt_youngs_modulus},
-    "pzt.shear": {"K": lambda p: p.shear_correction * p.pzt_shear_modulus,
-                  "C": lambda p: p.rayleigh_stiffness * p.shear_correction
-                  * p.pzt_shear_modulus},
-    "vem.inertia": {"M": lambda p: p.vem_density,
-                    "C": lambda p: p.rayleigh_mass * p.vem_density},
-    "vem.stiffness": {"K": lambda p: p.vem_youngs_modulus,
-                      "C": lambda p: p.rayleigh_stiffness * p.vem_youngs_modulus},
-    "vem.shear": {"K": lambda p: p.ghm_kappa * (1.0 + p.ghm_alpha),
-                  "C": lambda p: p.rayleigh_stiffness * p.ghm_kappa * (1.0 + p.ghm_alpha)},
+    "beam.inertia": {
+        "M": lambda p: p.beam_density,
+        "C": lambda p: p.rayleigh_mass * p.beam_density,
+    },
+    "beam.stiffness": {
+        "K": lambda p: p.beam_youngs_modulus,
+        "C": lambda p: p.rayleigh_stiffness * p.beam_youngs_modulus,
+    },
+    "beam.shear": {
+        "K": lambda p: p.shear_correction * p.beam_shear_modulus,
+        "C": lambda p: p.rayleigh_stiffness * p.shear_correction * p.beam_shear_modulus,
+    },
+    "pzt.inertia": {"M": lambda p: p.pzt_density, "C": lambda p: p.rayleigh_mass * p.pzt_density},
+    "pzt.stiffness": {
+        "K": lambda p: p.pzt_youngs_modulus,
+        "C": lambda p: p.rayleigh_stiffness * p.pzt_youngs_modulus,
+    },
+    "pzt.shear": {
+        "K": lambda p: p.shear_correction * p.pzt_shear_modulus,
+        "C": lambda p: p.rayleigh_stiffness * p.shear_correction * p.pzt_shear_modulus,
+    },
+    "vem.inertia": {"M": lambda p: p.vem_density, "C": lambda p: p.rayleigh_mass * p.vem_density},
+    "vem.stiffness": {
+        "K": lambda p: p.vem_youngs_modulus,
+        "C": lambda p: p.rayleigh_stiffness * p.vem_youngs_modulus,
+    },
+    "vem.shear": {
+        "K": lambda p: p.ghm_kappa * (1.0 + p.ghm_alpha),
+        "C": lambda p: p.rayleigh_stiffness * p.ghm_kappa * (1.0 + p.ghm_alpha),
+    },
     "ghm.coupling": {"K": lambda p: p.ghm_alpha * p.ghm_kappa},
-    "ghm.dissipation": {"M": lambda p: p.ghm_alpha * p.ghm_kappa / p.ghm_omega**2,
-                        "C": lambda p: 2.0 * p.ghm_zeta * p.ghm_alpha * p.ghm_kappa
-                        / p.ghm_omega},
+    "ghm.dissipation": {
+        "M": lambda p: p.ghm_alpha * p.ghm_kappa / p.ghm_omega**2,
+        "C": lambda p: 2.0 * p.ghm_zeta * p.ghm_alpha * p.ghm_kappa / p.ghm_omega,
+    },
 }
 #: Coefficient of the piezo unit vector: E_c d_31 [N/(V m)] (the width is geometry).
-PIEZO_COEFFICIENT: Callable[[BeamParameters], float] = \
-    lambda p: p.pzt_youngs_modulus * p.d31  # noqa: E731
+PIEZO_COEFFICIENT: Callable[[BeamParameters], float] = lambda p: p.pzt_youngs_modulus * p.d31  # noqa: E731
 
 
 @dataclass(frozen=True)
@@ -152,8 +172,9 @@ def combine_terms(units: dict, piezo, p: BeamParameters):
     return out["M"], out["C"], out["K"], PIEZO_COEFFICIENT(p) * piezo
 
 
-def _layer_units(sh: _Shape, area: float, inertia: float, axial=None,
-                 axial_rate=None) -> tuple[np.ndarray, np.ndarray]:
+def _layer_units(
+    sh: _Shape, area: float, inertia: float, axial=None, axial_rate=None
+) -> tuple[np.ndarray, np.ndarray]:
     """Inertia and axial/bending stiffness units of one layer,
 
     .. math::
@@ -166,8 +187,13 @@ def _layer_units(sh: _Shape, area: float, inertia: float, axial=None,
     """
     axial = axial or (lambda x: sh.N("u", x))
     axial_rate = axial_rate or (lambda: sh.dN("u"))
-    Um = sh.integrate(lambda x: area * _outer(sh.N("w", x)) + inertia * _outer(sh.N("theta", x))
-                      + area * _outer(axial(x)))
+    Um = sh.integrate(
+        lambda x: (
+            area * _outer(sh.N("w", x))
+            + inertia * _outer(sh.N("theta", x))
+            + area * _outer(axial(x))
+        )
+    )
     Uk = sh.integrate(lambda x: inertia * _outer(sh.dN("theta")) + area * _outer(axial_rate()))
     return Um, Uk
 
@@ -187,9 +213,14 @@ def timoshenko_terms(p: BeamParameters, length: float) -> ElementTerms:
     """
     sh = _Shape(BEAM_NODE_DOFS, length)
     Um, Uk = _layer_units(sh, p.beam_area, p.beam_inertia)
-    return ElementTerms(units={"beam.inertia": Um, "beam.stiffness": Uk,
-                               "beam.shear": _shear_unit(sh, p.beam_area)},
-                        piezo=np.zeros(sh.n))
+    return ElementTerms(
+        units={
+            "beam.inertia": Um,
+            "beam.stiffness": Uk,
+            "beam.shear": _shear_unit(sh, p.beam_area),
+        },
+        piezo=np.zeros(sh.n),
+    )
 
 
 def timoshenko_element(p: BeamParameters, length: float) -> ElementMatrices:

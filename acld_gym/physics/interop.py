@@ -19,13 +19,27 @@ INPUTS = ("V[V]", "f[N]")
 OUTPUTS = ("y[m]",)
 
 
-def statespace(A: np.ndarray, B: np.ndarray, E: np.ndarray | None, C: np.ndarray,
-               name: str, states: list[str] | None = None):
+def statespace(
+    A: np.ndarray,
+    B: np.ndarray,
+    E: np.ndarray | None,
+    C: np.ndarray,
+    name: str,
+    states: list[str] | None = None,
+):
     """``control.ss`` of ``x' = A x + B V + E f``, ``y = C x`` (without E: voltage only)."""
     import control
 
     Bm = np.hstack([B, E]) if E is not None and E.size else B
-    inputs = list(INPUTS[:Bm.shape[1]])
+    inputs = list(INPUTS[: Bm.shape[1]])
     n = A.shape[0]
-    return control.ss(A, Bm, C, np.zeros((C.shape[0], Bm.shape[1])), name=name, inputs=inputs,
-                      outputs=list(OUTPUTS), states=states or [f"x{i}" for i in range(n)])
+    return control.ss(
+        A,
+        Bm,
+        C,
+        np.zeros((C.shape[0], Bm.shape[1])),
+        name=name,
+        inputs=inputs,
+        outputs=list(OUTPUTS),
+        states=states or [f"x{i}" for i in range(n)],
+    )

@@ -34,8 +34,9 @@ def _qep(M, C, K, s: complex):
     return (K + s * C + (s * s) * M).tocsc()
 
 
-def damped_modes(pm: ParametricModel, guesses: np.ndarray, iterations: int = 3,
-                 inner: int = 4) -> np.ndarray:
+def damped_modes(
+    pm: ParametricModel, guesses: np.ndarray, iterations: int = 3, inner: int = 4
+) -> np.ndarray:
     r"""The damped eigenvalues of the (sparse) model nearest to ``guesses`` [1/s].
 
     Inverse iteration on the linearized pencil
@@ -70,8 +71,9 @@ def _mode_guesses(params: BeamParameters, band: float) -> np.ndarray:
     a coarse mesh's frequencies are too high by a few percent)."""
     coarse = parametric_model(params, Mesh().refined(_GUESS_REFINEMENT))
     M, C, K, Pc = coarse.combine()
-    A = first_order(M.toarray(), C.toarray(), K.toarray(), Pc, coarse.Fd,
-                    np.zeros(coarse.n_dofs))[0]
+    A = first_order(M.toarray(), C.toarray(), K.toarray(), Pc, coarse.Fd, np.zeros(coarse.n_dofs))[
+        0
+    ]
     lam = np.linalg.eigvals(A)
     lam = lam[(lam.imag > 1e-9 * np.abs(lam)) & (lam.imag < 1.3 * band)]
     return lam[np.argsort(lam.imag)]
@@ -99,25 +101,34 @@ def build_converged_plant(dt: float, params: BeamParameters, refinement: int) ->
     Q, R = np.linalg.qr(X)
     d = np.abs(np.diag(R))
     if d.min() < 1e-8 * d.max():
-        raise np.linalg.LinAlgError("converged_plant: the Krylov vectors are linearly "
-                                    "dependent (a shift repeats?)")
+        raise np.linalg.LinAlgError(
+            "converged_plant: the Krylov vectors are linearly dependent (a shift repeats?)"
+        )
     Mq, Kq = Q.T @ (M @ Q), Q.T @ (K @ Q)
     ritz, Phi = sla.eigh(0.5 * (Kq + Kq.T), 0.5 * (Mq + Mq.T))
     gaps = np.diff(ritz) / ritz[1:]
     if gaps.min() < RITZ_RTOL:
-        raise np.linalg.LinAlgError("converged_plant: two Ritz values are too close for a "
-                                    "unique Ritz basis")
+        raise np.linalg.LinAlgError(
+            "converged_plant: two Ritz values are too close for a unique Ritz basis"
+        )
     V = Q @ Phi
     part = V.T @ F.sum(axis=1)
     if np.min(np.abs(part)) < 1e-8 * np.max(np.abs(part)):
-        raise np.linalg.LinAlgError("converged_plant: a Ritz vector has no participation in "
-                                    "the inputs; its sign is undefined")
+        raise np.linalg.LinAlgError(
+            "converged_plant: a Ritz vector has no participation in "
+            "the inputs; its sign is undefined"
+        )
     V *= np.sign(part)[None, :]
     coarse = parametric_model(params, Mesh())
     physical = _restriction(coarse, fine, refinement) @ V
-    provenance = {"mesh": "converged", "refinement": refinement, "fe_dofs": fine.n_dofs,
-                  "elements": " + ".join(str(x) for x in dataclasses.astuple(fine.mesh)),
-                  "band_rad_s": band, "shifts_rad_s": [0.0, *shifts.tolist()],
-                  "fine_modes": [[z.real, z.imag] for z in lam.tolist()],
-                  "ritz_rad_s": np.sqrt(ritz).tolist()}
+    provenance = {
+        "mesh": "converged",
+        "refinement": refinement,
+        "fe_dofs": fine.n_dofs,
+        "elements": " + ".join(str(x) for x in dataclasses.astuple(fine.mesh)),
+        "band_rad_s": band,
+        "shifts_rad_s": [0.0, *shifts.tolist()],
+        "fine_modes": [[z.real, z.imag] for z in lam.tolist()],
+        "ritz_rad_s": np.sqrt(ritz).tolist(),
+    }
     return _project(fine, V, "converged", physical, provenance)

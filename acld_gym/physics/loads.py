@@ -31,10 +31,26 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Pulse", "Harmonic", "Samples", "TipLoad", "LoadPiece", "thesis_load", "THESIS_CASES",
-           "RANDOM", "LOAD_CASES", "check_load_case", "parse_load_case", "case_load",
-           "case_label", "random_load", "band_limited_noise", "sine_sweep", "half_sine_shock",
-           "recorded_load"]
+__all__ = [
+    "Pulse",
+    "Harmonic",
+    "Samples",
+    "TipLoad",
+    "LoadPiece",
+    "thesis_load",
+    "THESIS_CASES",
+    "RANDOM",
+    "LOAD_CASES",
+    "check_load_case",
+    "parse_load_case",
+    "case_load",
+    "case_label",
+    "random_load",
+    "band_limited_noise",
+    "sine_sweep",
+    "half_sine_shock",
+    "recorded_load",
+]
 
 
 def _finite(cls: str, names: str, *values) -> None:
@@ -46,9 +62,11 @@ def _finite(cls: str, names: str, *values) -> None:
         ok = False
     if not ok:
         for name, value in zip(names.split(", "), values, strict=True):
-            if type(value) is bool or not isinstance(value, (int, float, np.floating,
-                                                               np.integer)) \
-                    or not math.isfinite(value):
+            if (
+                type(value) is bool
+                or not isinstance(value, (int, float, np.floating, np.integer))
+                or not math.isfinite(value)
+            ):
                 raise ValueError(f"{cls}.{name} must be a finite real number, got {value!r}")
 
 
@@ -81,8 +99,15 @@ class Harmonic:
     phase: float = 0.0
 
     def __post_init__(self):
-        _finite("Harmonic", "amplitude, frequency, start, duration, phase", self.amplitude,
-                self.frequency, self.start, self.duration, self.phase)
+        _finite(
+            "Harmonic",
+            "amplitude, frequency, start, duration, phase",
+            self.amplitude,
+            self.frequency,
+            self.start,
+            self.duration,
+            self.phase,
+        )
         if not self.duration > 0:
             raise ValueError(f"Harmonic.duration must be positive [s], got {self.duration!r}")
         if not self.frequency > 0:
@@ -133,8 +158,11 @@ class Samples:
     def __eq__(self, other) -> bool:
         if not isinstance(other, Samples):
             return NotImplemented
-        return (self.start == other.start and self.step == other.step
-                and np.array_equal(self.values, other.values))
+        return (
+            self.start == other.start
+            and self.step == other.step
+            and np.array_equal(self.values, other.values)
+        )
 
     def __hash__(self) -> int:
         return hash((self.start, self.step, self.values.tobytes()))
@@ -160,9 +188,12 @@ class TipLoad:
 
     def __post_init__(self):
         if not isinstance(self.components, tuple) or not all(
-                isinstance(c, (Pulse, Harmonic, Samples)) for c in self.components):
-            raise ValueError("TipLoad.components must be a tuple of Pulse, Harmonic and Samples, "
-                             f"got {self.components!r}")
+            isinstance(c, (Pulse, Harmonic, Samples)) for c in self.components
+        ):
+            raise ValueError(
+                "TipLoad.components must be a tuple of Pulse, Harmonic and Samples, "
+                f"got {self.components!r}"
+            )
 
     def scaled(self, factor: float) -> TipLoad:
         """The same load times ``factor`` (every amplitude and sample scaled)."""
@@ -174,8 +205,9 @@ class TipLoad:
             elif isinstance(c, Pulse):
                 out.append(Pulse(c.start, c.duration, factor * c.amplitude))
             else:
-                out.append(Harmonic(factor * c.amplitude, c.frequency, c.start, c.duration,
-                                    c.phase))
+                out.append(
+                    Harmonic(factor * c.amplitude, c.frequency, c.start, c.duration, c.phase)
+                )
         return TipLoad(tuple(out))
 
     def __call__(self, t) -> np.ndarray:
@@ -190,8 +222,9 @@ class TipLoad:
                 grid = c.start + c.step * np.arange(len(c.values))
                 f = f + np.where(on, np.interp(t, grid, c.values), 0.0)
             else:
-                f = f + np.where(on, c.amplitude * np.sin(c.frequency * (t - c.start) + c.phase),
-                                 0.0)
+                f = f + np.where(
+                    on, c.amplitude * np.sin(c.frequency * (t - c.start) + c.phase), 0.0
+                )
         return f
 
     def breakpoints(self) -> np.ndarray:
@@ -211,7 +244,8 @@ class TipLoad:
             elif isinstance(c, Samples):
                 raise NotImplementedError(
                     "load: the continuous simulator takes pulses and harmonics only; sample "
-                    "Samples loads with acld_gym.design.discrete")
+                    "Samples loads with acld_gym.design.discrete"
+                )
             else:
                 harms.append((c.amplitude, c.frequency, c.phase - c.frequency * c.start))
         return LoadPiece(const=const, harmonics=tuple(harms))
@@ -245,8 +279,11 @@ def check_load_case(value, name: str = "load_case"):
     returned as ``int``) or a :class:`TipLoad`; else ``ValueError`` naming ``name``."""
     if isinstance(value, TipLoad):
         return value
-    if isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_)) \
-            and int(value) in THESIS_CASES:
+    if (
+        isinstance(value, (int, np.integer))
+        and not isinstance(value, (bool, np.bool_))
+        and int(value) in THESIS_CASES
+    ):
         return int(value)
     if isinstance(value, str) and value == RANDOM:
         return RANDOM
@@ -260,8 +297,9 @@ def parse_load_case(value) -> int | str:
         return int(value)
     if type(value) in (int, str) and value in LOAD_CASES:  # not bool, not 1.0
         return value
-    raise ValueError(f"load case must be {', '.join(map(str, THESIS_CASES))} or {RANDOM!r}, "
-                     f"got {value!r}")
+    raise ValueError(
+        f"load case must be {', '.join(map(str, THESIS_CASES))} or {RANDOM!r}, got {value!r}"
+    )
 
 
 def case_load(case) -> TipLoad | None:
@@ -283,8 +321,12 @@ def case_label(case) -> str:
 _BOX = np.ones(4) / 2.0  # the noise's moving sum (times 1/2)
 
 
-def random_load(rng: np.random.Generator, duration: float, grid: float,
-                modes: tuple[float, float] = (179.0, 1115.0)) -> TipLoad:
+def random_load(
+    rng: np.random.Generator,
+    duration: float,
+    grid: float,
+    modes: tuple[float, float] = (179.0, 1115.0),
+) -> TipLoad:
     """A bounded random tip load drawn from ``rng`` (the ``"random"`` case).
 
     Always one to three pulses (amplitude U(-1.5, 1.5) N, width 0.5-3 ms,
@@ -307,15 +349,22 @@ def random_load(rng: np.random.Generator, duration: float, grid: float,
     n_pulses = int(rng.integers(1, 4))
     u = rng.random(3 * n_pulses + 1).tolist()
     for p in range(n_pulses):
-        a, b, c = u[3 * p:3 * p + 3]
+        a, b, c = u[3 * p : 3 * p + 3]
         start = round((0.7 * duration) * a / grid) * grid
         width = max(round((5e-4 + (3e-3 - 5e-4) * b) / grid), 1) * grid
         comps.append(Pulse(float(start), float(width), -1.5 + 3.0 * c))
     if u[-1] < 0.5:
         m, a, w, s, d, ph, noise_coin = rng.random(7).tolist()
         w0 = modes[0] if m < 0.7 else modes[1]
-        comps.append(Harmonic(0.08 * a, w0 * (0.95 + (1.05 - 0.95) * w), (0.5 * duration) * s,
-                              0.05 + (0.3 - 0.05) * d, (2 * np.pi) * ph))
+        comps.append(
+            Harmonic(
+                0.08 * a,
+                w0 * (0.95 + (1.05 - 0.95) * w),
+                (0.5 * duration) * s,
+                0.05 + (0.3 - 0.05) * d,
+                (2 * np.pi) * ph,
+            )
+        )
     else:
         noise_coin = float(rng.random())
     if noise_coin < 0.5:
@@ -335,8 +384,15 @@ def _check_positive(name: str, value) -> float:
     return float(value)
 
 
-def band_limited_noise(rng: np.random.Generator, duration: float, std: float, cutoff: float,
-                       step: float = 1e-4, start: float = 0.0, order: int = 4) -> TipLoad:
+def band_limited_noise(
+    rng: np.random.Generator,
+    duration: float,
+    std: float,
+    cutoff: float,
+    step: float = 1e-4,
+    start: float = 0.0,
+    order: int = 4,
+) -> TipLoad:
     """A band-limited random force: white Gaussian samples every ``step`` [s] over
     ``duration`` [s], low-passed at ``cutoff`` [Hz] by an ``order``-th order Butterworth
     filter run forward and backward (zero phase, :func:`scipy.signal.sosfiltfilt`), scaled
@@ -344,24 +400,36 @@ def band_limited_noise(rng: np.random.Generator, duration: float, std: float, cu
     must lie below the Nyquist frequency ``1 / (2 step)``."""
     from scipy.signal import butter, sosfiltfilt
 
-    duration, std, step = (_check_positive(n, v) for n, v in
-                           (("duration", duration), ("std", std), ("step", step)))
+    duration, std, step = (
+        _check_positive(n, v) for n, v in (("duration", duration), ("std", std), ("step", step))
+    )
     cutoff = _check_positive("cutoff", cutoff)
     if not cutoff < 0.5 / step:
-        raise ValueError(f"cutoff must be below the Nyquist frequency 1/(2 step) = "
-                         f"{0.5 / step:g} Hz, got {cutoff!r}")
+        raise ValueError(
+            f"cutoff must be below the Nyquist frequency 1/(2 step) = "
+            f"{0.5 / step:g} Hz, got {cutoff!r}"
+        )
     n = int(round(duration / step)) + 1
     if n < 3 * (2 * order + 1):
-        raise ValueError(f"duration must hold at least {3 * (2 * order + 1)} samples of "
-                         f"step {step:g} s for the filter, got {duration!r}")
+        raise ValueError(
+            f"duration must hold at least {3 * (2 * order + 1)} samples of "
+            f"step {step:g} s for the filter, got {duration!r}"
+        )
     sos = butter(order, cutoff, fs=1.0 / step, output="sos")
     x = sosfiltfilt(sos, rng.normal(0.0, 1.0, n))
     x *= std / float(np.std(x))
     return TipLoad((Samples(float(start), step, x),))
 
 
-def sine_sweep(amplitude: float, f_start: float, f_stop: float, duration: float,
-               start: float = 0.0, step: float = 1e-4, spacing: str = "linear") -> TipLoad:
+def sine_sweep(
+    amplitude: float,
+    f_start: float,
+    f_stop: float,
+    duration: float,
+    start: float = 0.0,
+    step: float = 1e-4,
+    spacing: str = "linear",
+) -> TipLoad:
     r"""A sine sweep (chirp) ``amplitude sin(phi(t))`` [N] from ``f_start`` to ``f_stop``
     [Hz] over ``duration`` [s], starting at ``start`` [s]:
     :math:`\phi = 2\pi (f_0 \tau + (f_1 - f_0) \tau^2 / 2T)` (``"linear"``) or
@@ -370,14 +438,22 @@ def sine_sweep(amplitude: float, f_start: float, f_stop: float, duration: float,
     interpolation error is about :math:`(2\pi f h)^2 / 8` of the amplitude at frequency f,
     so ``step`` must be at most ``1 / (20 max(f_start, f_stop))`` (error < 1.3 %)."""
     _finite("sine_sweep", "amplitude, start", amplitude, start)
-    f0, f1, T, step = (_check_positive(n, v) for n, v in
-                       (("f_start", f_start), ("f_stop", f_stop), ("duration", duration),
-                        ("step", step)))
+    f0, f1, T, step = (
+        _check_positive(n, v)
+        for n, v in (
+            ("f_start", f_start),
+            ("f_stop", f_stop),
+            ("duration", duration),
+            ("step", step),
+        )
+    )
     if spacing not in ("linear", "log"):
         raise ValueError(f"spacing must be 'linear' or 'log', got {spacing!r}")
     if step > 1.0 / (20.0 * max(f0, f1)):
-        raise ValueError(f"step must be at most 1/(20 max(f_start, f_stop)) = "
-                         f"{1.0 / (20.0 * max(f0, f1)):g} s, got {step!r}")
+        raise ValueError(
+            f"step must be at most 1/(20 max(f_start, f_stop)) = "
+            f"{1.0 / (20.0 * max(f0, f1)):g} s, got {step!r}"
+        )
     tau = np.arange(int(round(T / step)) + 1) * step
     if spacing == "linear":
         phi = 2 * np.pi * (f0 * tau + (f1 - f0) * tau**2 / (2 * T))
@@ -404,6 +480,7 @@ def recorded_load(values, step: float, start: float = 0.0) -> TipLoad:
     step = _check_positive("step", step)
     arr = np.asarray(values)
     if arr.ndim != 1 or arr.dtype.kind not in "iuf":
-        raise ValueError(f"values must be a 1-D array of real numbers [N], got shape "
-                         f"{arr.shape} of {arr.dtype}")
+        raise ValueError(
+            f"values must be a 1-D array of real numbers [N], got shape {arr.shape} of {arr.dtype}"
+        )
     return TipLoad((Samples(float(start), step, arr),))

@@ -26,8 +26,15 @@ import scipy.linalg as sla
 from acld_gym.physics.assembly import AssembledTerms, DofMap, assemble_terms, number_dofs
 from acld_gym.physics.params import PRESETS, BeamParameters, Mesh, split_overrides
 
-__all__ = ["BeamModel", "ParametricModel", "first_order", "oscillatory_modes", "build_model",
-           "parametric_model", "resolve"]
+__all__ = [
+    "BeamModel",
+    "ParametricModel",
+    "first_order",
+    "oscillatory_modes",
+    "build_model",
+    "parametric_model",
+    "resolve",
+]
 
 
 def oscillatory_modes(A: np.ndarray) -> np.ndarray:
@@ -38,8 +45,9 @@ def oscillatory_modes(A: np.ndarray) -> np.ndarray:
     return lam[np.argsort(lam.imag)]
 
 
-def first_order(M: np.ndarray, C: np.ndarray, K: np.ndarray, Pc: np.ndarray, Fd: np.ndarray,
-                c: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def first_order(
+    M: np.ndarray, C: np.ndarray, K: np.ndarray, Pc: np.ndarray, Fd: np.ndarray, c: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     r"""First-order form of :math:`M\ddot q + C\dot q + Kq = P_c V + F_d f`,
     :math:`y = c^T q`, with state :math:`x = [q; \dot q]` (module docstring).
 
@@ -51,7 +59,7 @@ def first_order(M: np.ndarray, C: np.ndarray, K: np.ndarray, Pc: np.ndarray, Fd:
     A = np.zeros((2 * n, 2 * n))
     A[:n, n:] = np.eye(n)
     A[n:, :n] = -minv[:, :n]
-    A[n:, n:] = -minv[:, n:2 * n]
+    A[n:, n:] = -minv[:, n : 2 * n]
     B = np.zeros((2 * n, 1))
     B[n:, 0] = minv[:, 2 * n]
     E = np.zeros((2 * n, 1))
@@ -177,8 +185,13 @@ class ParametricModel:
         return self.terms.combine(self.params if params is None else params)
 
 
-def resolve(params: BeamParameters | None = None, mesh: Mesh | None = None, *,
-            preset: str | None = None, **overrides: Any) -> tuple[BeamParameters, Mesh]:
+def resolve(
+    params: BeamParameters | None = None,
+    mesh: Mesh | None = None,
+    *,
+    preset: str | None = None,
+    **overrides: Any,
+) -> tuple[BeamParameters, Mesh]:
     """The ``(params, mesh)`` that :func:`build_model` would use for these arguments."""
     if preset is not None:
         if params is not None:
@@ -196,8 +209,13 @@ def resolve(params: BeamParameters | None = None, mesh: Mesh | None = None, *,
     return params, mesh
 
 
-def parametric_model(params: BeamParameters | None = None, mesh: Mesh | None = None, *,
-                     preset: str | None = None, **overrides: Any) -> ParametricModel:
+def parametric_model(
+    params: BeamParameters | None = None,
+    mesh: Mesh | None = None,
+    *,
+    preset: str | None = None,
+    **overrides: Any,
+) -> ParametricModel:
     """Assemble the clamped model's unit matrices (arguments as :func:`build_model`)."""
     params, mesh = resolve(params, mesh, preset=preset, **overrides)
     dofs = number_dofs(params, mesh)
@@ -205,14 +223,26 @@ def parametric_model(params: BeamParameters | None = None, mesh: Mesh | None = N
     free = dofs.free
     Fd = np.zeros(dofs.n_dofs)
     Fd[dofs.node_dofs[-1]["w"]] = 1.0
-    clamped = AssembledTerms(units={k: U[free][:, free] for k, U in terms.units.items()},
-                             piezo=terms.piezo[free])
-    return ParametricModel(params=params, mesh=mesh, dofs=dofs, terms=clamped, Fd=Fd[free],
-                           tip_index=dofs.reduced_index(len(dofs.node_x) - 1, "w"))
+    clamped = AssembledTerms(
+        units={k: U[free][:, free] for k, U in terms.units.items()}, piezo=terms.piezo[free]
+    )
+    return ParametricModel(
+        params=params,
+        mesh=mesh,
+        dofs=dofs,
+        terms=clamped,
+        Fd=Fd[free],
+        tip_index=dofs.reduced_index(len(dofs.node_x) - 1, "w"),
+    )
 
 
-def build_model(params: BeamParameters | None = None, mesh: Mesh | None = None, *,
-                preset: str | None = None, **overrides: Any) -> BeamModel:
+def build_model(
+    params: BeamParameters | None = None,
+    mesh: Mesh | None = None,
+    *,
+    preset: str | None = None,
+    **overrides: Any,
+) -> BeamModel:
     """Assemble the clamped ACLD beam.
 
     Parameters
@@ -235,5 +265,14 @@ def build_model(params: BeamParameters | None = None, mesh: Mesh | None = None, 
     """
     pm = parametric_model(params, mesh, preset=preset, **overrides)
     M, C, K, Pc = pm.combine()
-    return BeamModel(params=pm.params, mesh=pm.mesh, dofs=pm.dofs, M=M.toarray(), C=C.toarray(),
-                     K=K.toarray(), Pc=Pc, Fd=pm.Fd, tip_index=pm.tip_index)
+    return BeamModel(
+        params=pm.params,
+        mesh=pm.mesh,
+        dofs=pm.dofs,
+        M=M.toarray(),
+        C=C.toarray(),
+        K=K.toarray(),
+        Pc=Pc,
+        Fd=pm.Fd,
+        tip_index=pm.tip_index,
+    )

@@ -181,16 +181,26 @@ def _restriction(coarse: ParametricModel, fine: ParametricModel, factor: int) ->
     return S
 
 
-def _project(pm: ParametricModel, V: np.ndarray, name: str, physical: np.ndarray,
-             provenance: dict) -> Plant:
+def _project(
+    pm: ParametricModel, V: np.ndarray, name: str, physical: np.ndarray, provenance: dict
+) -> Plant:
     units = {k: V.T @ (U @ V) for k, U in pm.terms.units.items()}
     units = {k: 0.5 * (U + U.T) for k, U in units.items()}  # exactly symmetric
     nodes = range(1, len(pm.dofs.node_x))
     W = np.zeros((len(pm.dofs.node_x), V.shape[1]))
     W[1:] = V[[pm.dofs.reduced_index(j, "w") for j in nodes]]
-    return Plant(name=name, params=pm.params, units=units, piezo=V.T @ pm.terms.piezo,
-                 Fd=V.T @ pm.Fd, c=V[pm.tip_index].copy(), physical=physical,
-                 node_x=np.asarray(pm.dofs.node_x), node_w=W, provenance=provenance)
+    return Plant(
+        name=name,
+        params=pm.params,
+        units=units,
+        piezo=V.T @ pm.terms.piezo,
+        Fd=V.T @ pm.Fd,
+        c=V[pm.tip_index].copy(),
+        physical=physical,
+        node_x=np.asarray(pm.dofs.node_x),
+        node_w=W,
+        provenance=provenance,
+    )
 
 
 @lru_cache(maxsize=8)
@@ -200,10 +210,17 @@ def fe_plant(params: BeamParameters | None = None, mesh: Mesh | None = None) -> 
     pm = parametric_model(params, mesh)
     eye = np.eye(pm.n_dofs)
     default = pm.mesh == Mesh()
-    return _project(pm, eye, "thesis" if default else "fe", eye,
-                    {"mesh": "thesis" if default else "custom",
-                     "elements": " + ".join(str(x) for x in dataclasses.astuple(pm.mesh)),
-                     "fe_dofs": pm.n_dofs})
+    return _project(
+        pm,
+        eye,
+        "thesis" if default else "fe",
+        eye,
+        {
+            "mesh": "thesis" if default else "custom",
+            "elements": " + ".join(str(x) for x in dataclasses.astuple(pm.mesh)),
+            "fe_dofs": pm.n_dofs,
+        },
+    )
 
 
 def thesis_plant() -> Plant:

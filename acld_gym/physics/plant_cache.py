@@ -37,10 +37,17 @@ SHIPPED_DIR = Path(__file__).resolve().parent / "data"
 
 def key(params: BeamParameters, dt: float, refinement: int) -> str:
     """16 hex digits of the SHA-256 of the plant's inputs."""
-    fields = {f.name: repr(float(getattr(params, f.name)))
-              for f in dataclasses.fields(params)}
-    blob = json.dumps({"format": FORMAT, "plant": "converged", "params": fields,
-                       "dt": repr(float(dt)), "refinement": int(refinement)}, sort_keys=True)
+    fields = {f.name: repr(float(getattr(params, f.name))) for f in dataclasses.fields(params)}
+    blob = json.dumps(
+        {
+            "format": FORMAT,
+            "plant": "converged",
+            "params": fields,
+            "dt": repr(float(dt)),
+            "refinement": int(refinement),
+        },
+        sort_keys=True,
+    )
     return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
 
@@ -58,11 +65,19 @@ def _filename(k: str) -> str:
 def save(plant: Plant, path: Path) -> None:
     """Write ``plant`` to ``path`` atomically (temporary file in the same directory)."""
     arrays = {f"unit:{name}": U for name, U in plant.units.items()}
-    arrays.update(piezo=plant.piezo, Fd=plant.Fd, c=plant.c, physical=plant.physical,
-                  node_x=plant.node_x, node_w=plant.node_w)
-    meta = {"name": plant.name, "provenance": plant.provenance,
-            "params": {f.name: getattr(plant.params, f.name)
-                       for f in dataclasses.fields(plant.params)}}
+    arrays.update(
+        piezo=plant.piezo,
+        Fd=plant.Fd,
+        c=plant.c,
+        physical=plant.physical,
+        node_x=plant.node_x,
+        node_w=plant.node_w,
+    )
+    meta = {
+        "name": plant.name,
+        "provenance": plant.provenance,
+        "params": {f.name: getattr(plant.params, f.name) for f in dataclasses.fields(plant.params)},
+    }
     arrays["meta"] = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
     write_atomic(path, lambda fh: np.savez(fh, **arrays))
 
@@ -72,13 +87,21 @@ def load(path: Path) -> Plant:
     with np.load(path, allow_pickle=False) as z:
         meta = json.loads(bytes(z["meta"]).decode())
         units = {k.split(":", 1)[1]: z[k] for k in z.files if k.startswith("unit:")}
-        return Plant(name=meta["name"], params=BeamParameters(**meta["params"]), units=units,
-                     piezo=z["piezo"], Fd=z["Fd"], c=z["c"], physical=z["physical"],
-                     node_x=z["node_x"], node_w=z["node_w"], provenance=meta["provenance"])
+        return Plant(
+            name=meta["name"],
+            params=BeamParameters(**meta["params"]),
+            units=units,
+            piezo=z["piezo"],
+            Fd=z["Fd"],
+            c=z["c"],
+            physical=z["physical"],
+            node_x=z["node_x"],
+            node_w=z["node_w"],
+            provenance=meta["provenance"],
+        )
 
 
-def cached(params: BeamParameters, dt: float, refinement: int,
-           build: Callable[[], Plant]) -> Plant:
+def cached(params: BeamParameters, dt: float, refinement: int, build: Callable[[], Plant]) -> Plant:
     """The plant for these inputs: the shipped file, else the user cache, else ``build()``
     (then written to the user cache when possible)."""
     name = _filename(key(params, dt, refinement))
@@ -88,8 +111,7 @@ def cached(params: BeamParameters, dt: float, refinement: int,
             try:
                 return load(path)
             except (OSError, ValueError, KeyError) as exc:  # a damaged file: rebuild
-                print(f"acld_gym: ignoring unreadable plant file {path}: {exc}",
-                      file=sys.stderr)
+                print(f"acld_gym: ignoring unreadable plant file {path}: {exc}", file=sys.stderr)
     plant = build()
     try:
         save(plant, user_cache_dir() / name)

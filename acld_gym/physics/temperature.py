@@ -57,9 +57,19 @@ import numpy as np
 
 from acld_gym.physics.params import BeamParameters
 
-__all__ = ["T_REF", "T_GLASS", "WLF_C1", "WLF_C2", "LOSS_PEAK_HZ", "TEMPERATURE_RANGE",
-           "log_shift", "shift_factor", "shifted_parameters", "ghm_modulus",
-           "check_temperature"]
+__all__ = [
+    "T_REF",
+    "T_GLASS",
+    "WLF_C1",
+    "WLF_C2",
+    "LOSS_PEAK_HZ",
+    "TEMPERATURE_RANGE",
+    "log_shift",
+    "shift_factor",
+    "shifted_parameters",
+    "ghm_modulus",
+    "check_temperature",
+]
 
 #: WLF "universal" constants (Williams, Landel & Ferry 1955): C1 [-] and C2 [K] at T_g.
 WLF_C1 = 17.44
@@ -72,8 +82,9 @@ def ghm_modulus(params: BeamParameters, omega) -> np.ndarray:
     """The GHM shear modulus ``G(j omega)`` [Pa] of ``params`` at ``omega`` [rad/s]."""
     s = 1j * np.asarray(omega, dtype=float)
     w, z = params.ghm_omega, params.ghm_zeta
-    return params.ghm_kappa * (1.0 + params.ghm_alpha * (s * s + 2 * z * w * s)
-                               / (s * s + 2 * z * w * s + w * w))
+    return params.ghm_kappa * (
+        1.0 + params.ghm_alpha * (s * s + 2 * z * w * s) / (s * s + 2 * z * w * s + w * w)
+    )
 
 
 def _loss_peak_hz(params: BeamParameters) -> float:

@@ -18,8 +18,9 @@ MESHES = ("converged", "thesis")
 
 
 @lru_cache(maxsize=4)
-def converged_plant(dt: float = 1e-3, params: BeamParameters | None = None,
-                    refinement: int = REFINEMENT) -> Plant:
+def converged_plant(
+    dt: float = 1e-3, params: BeamParameters | None = None, refinement: int = REFINEMENT
+) -> Plant:
     """The mesh-converged plant for control period ``dt`` [s] (module docstring).
 
     Read from its versioned file when one exists (:mod:`acld_gym.physics.plant_cache`: the
@@ -39,8 +40,12 @@ def converged_plant(dt: float = 1e-3, params: BeamParameters | None = None,
     refinement : refinement factor of the thesis mesh (default :data:`REFINEMENT`).
     """
     params = BeamParameters() if params is None else params
-    return cached(params, float(dt), int(refinement),
-                  lambda: build_converged_plant(float(dt), params, int(refinement)))
+    return cached(
+        params,
+        float(dt),
+        int(refinement),
+        lambda: build_converged_plant(float(dt), params, int(refinement)),
+    )
 
 
 def plant(mesh: str = "converged", dt: float = 1e-3) -> Plant:

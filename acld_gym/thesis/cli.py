@@ -51,24 +51,34 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
         plot_frequency_response(plots / "frequency_response.png", d)
 
     def on_start(case, controller, saturation):
-        bar.stage(f"case {case} · {controller} · "
-                  f"{'saturated' if saturation else 'unsaturated'}")
+        bar.stage(f"case {case} · {controller} · {'saturated' if saturation else 'unsaturated'}")
 
     def on_result(row, res):
         if plots is not None:
             sat = "sat" if row.saturation else "nosat"
-            title = (f"Case {row.case}: {row.controller.upper()} "
-                     f"{'with' if row.saturation else 'without'} saturation")
-            plot_response(plots / f"case{row.case}_{row.controller}_{sat}.png", res.t, res.y,
-                          res.voltage, title, load=res.load)
+            title = (
+                f"Case {row.case}: {row.controller.upper()} "
+                f"{'with' if row.saturation else 'without'} saturation"
+            )
+            plot_response(
+                plots / f"case{row.case}_{row.controller}_{sat}.png",
+                res.t,
+                res.y,
+                res.voltage,
+                title,
+                load=res.load,
+            )
 
     with Progress(2 * len(THESIS_CASES) * len(CONTROLLERS), "reproduce", args.quiet) as bar:
-        rows = run_cases(d, observer=args.observer, t_end=args.t_end, on_result=on_result,
-                         on_start=on_start)
+        rows = run_cases(
+            d, observer=args.observer, t_end=args.t_end, on_result=on_result, on_start=on_start
+        )
     print(format_table2(rows, t_end=args.t_end))
-    print(f"\n{len(rows)} rows in {time.perf_counter() - t0:.2f} s "
-          f"(observer: {args.observer}; settling = last exit from the 5% band of the peak "
-          f"within {args.t_end:g} s)")
+    print(
+        f"\n{len(rows)} rows in {time.perf_counter() - t0:.2f} s "
+        f"(observer: {args.observer}; settling = last exit from the 5% band of the peak "
+        f"within {args.t_end:g} s)"
+    )
     if args.json:
         _write_json(args.json, [r.as_dict() for r in rows])
         print(f"wrote {args.json}")
@@ -81,8 +91,9 @@ def cmd_model(args: argparse.Namespace) -> int:
     d = design(preset=args.preset)
     m = d.truth
     A, B, E, Cy = d.plant
-    res = simulate(A, B, E, Cy, d.observer("thesis"), d.passive, thesis_load(1), t_end=T_END,
-                   v_max=None)
+    res = simulate(
+        A, B, E, Cy, d.observer("thesis"), d.passive, thesis_load(1), t_end=T_END, v_max=None
+    )
     out = {
         "preset": args.preset,
         "n_states": m.n_states,
@@ -90,9 +101,11 @@ def cmd_model(args: argparse.Namespace) -> int:
         "hankel_singular_values": d.reduced.hsv.tolist(),
         "passive_case1_peak_mm": peak(res.y) * 1e3,
     }
-    print(f"preset {args.preset}: {m.n_states} states; first natural frequencies "
-          f"{np.array2string(m.natural_frequencies()[:4], precision=1)} rad/s; "
-          f"passive case-1 peak {out['passive_case1_peak_mm']:.4f} mm")
+    print(
+        f"preset {args.preset}: {m.n_states} states; first natural frequencies "
+        f"{np.array2string(m.natural_frequencies()[:4], precision=1)} rad/s; "
+        f"passive case-1 peak {out['passive_case1_peak_mm']:.4f} mm"
+    )
     if args.json:
         _write_json(args.json, out)
         print(f"wrote {args.json}")
@@ -126,18 +139,29 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--json", metavar="PATH", help="write the rows as JSON")
     r.add_argument("--plots", metavar="DIR", help="write figures (PNG) to DIR")
     r.add_argument("--preset", choices=sorted(PRESETS), default="matlab")
-    r.add_argument("--observer", choices=["thesis", "thesis-unfed", "kalman"], default="thesis",
-                   help="'thesis' = the thesis observer fed the tip load (reproduces Table 2)")
-    r.add_argument("--t-end", type=arg_type(float, 0.0, 100.0, low_open=True), default=T_END,
-                   help="simulated window [s]")
+    r.add_argument(
+        "--observer",
+        choices=["thesis", "thesis-unfed", "kalman"],
+        default="thesis",
+        help="'thesis' = the thesis observer fed the tip load (reproduces Table 2)",
+    )
+    r.add_argument(
+        "--t-end",
+        type=arg_type(float, 0.0, 100.0, low_open=True),
+        default=T_END,
+        help="simulated window [s]",
+    )
     r.add_argument("--quiet", action="store_true", help="no progress bar")
     r.set_defaults(func=cmd_reproduce)
     m = sub.add_parser("model", help="natural frequencies, Hankel values, passive peak")
     m.add_argument("--json", metavar="PATH", help="write the facts as JSON")
     m.add_argument("--preset", choices=sorted(PRESETS), default="matlab")
     m.set_defaults(func=cmd_model)
-    me = sub.add_parser("mesh", help="mesh convergence; the thesis mesh against the converged "
-                                     "plant (the tables of docs/mesh.md)")
+    me = sub.add_parser(
+        "mesh",
+        help="mesh convergence; the thesis mesh against the converged "
+        "plant (the tables of docs/mesh.md)",
+    )
     me.add_argument("--json", metavar="PATH", help="write the numbers as JSON")
     me.set_defaults(func=cmd_mesh)
     pa = sub.add_parser("params", help="print the parameter table (Markdown)")

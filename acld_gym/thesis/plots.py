@@ -44,8 +44,7 @@ def plot_hankel(path: Path, d: Design) -> None:
     fig, ax = plt.subplots(figsize=(7, 4))
     idx = np.arange(1, hsv.size + 1)
     ax.semilogy(idx[:k], hsv[:k], "o", color="C0", label=f"kept ({k})")
-    ax.semilogy(idx[k:], np.maximum(hsv[k:], 1e-20), "o", mfc="none", color="C7",
-                label="discarded")
+    ax.semilogy(idx[k:], np.maximum(hsv[k:], 1e-20), "o", mfc="none", color="C7", label="discarded")
     ax.set_xlabel("state")
     ax.set_ylabel("Hankel singular value")
     ax.set_title("Hankel singular values, voltage -> tip deflection (thesis Fig. 5)")
@@ -65,8 +64,12 @@ def plot_frequency_response(path: Path, d: Design) -> None:
     channels = ((B, r.B, "voltage [m/V]"), (E, r.E, "tip load [m/N]"))
     for a, (bf, br, lab) in zip(ax, channels, strict=True):
         a.loglog(w, np.abs(frequency_response(A, bf, Cy, w)), label="full (38 states)")
-        a.loglog(w, np.abs(frequency_response(r.A, br, r.C, w)), "--",
-                 label=f"reduced ({r.order} states)")
+        a.loglog(
+            w,
+            np.abs(frequency_response(r.A, br, r.C, w)),
+            "--",
+            label=f"reduced ({r.order} states)",
+        )
         a.set_ylabel(f"|y / {lab.split()[0]}| {lab.split()[-1]}")
         a.grid(alpha=0.3, which="both")
         a.legend()

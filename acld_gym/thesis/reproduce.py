@@ -22,9 +22,14 @@ T_END = 1.0
 CONTROLLERS = ("passive", "lqr", "smc")
 
 
-def run_cases(d: Design, cases: Iterable[int] = THESIS_CASES, observer: str = "thesis",
-              t_end: float = T_END, on_result: Callable | None = None,
-              on_start: Callable | None = None) -> list[Table2Row]:
+def run_cases(
+    d: Design,
+    cases: Iterable[int] = THESIS_CASES,
+    observer: str = "thesis",
+    t_end: float = T_END,
+    on_result: Callable | None = None,
+    on_start: Callable | None = None,
+) -> list[Table2Row]:
     """Simulate every (case, controller, saturation) and return the rows.
 
     The passive beam does not depend on the limit: it is simulated once and
@@ -43,10 +48,17 @@ def run_cases(d: Design, cases: Iterable[int] = THESIS_CASES, observer: str = "t
                 if on_start is not None:
                     on_start(case, name, sat)
                 if res is None or name != "passive":
-                    res = simulate(A, B, E, Cy, obs, fb, load, t_end=t_end,
-                                   v_max=V_LIMIT if sat else None)
-                row = Table2Row(case, name, sat, peak(res.y) * 1e3, settling_time(res.t, res.y),
-                          max_abs(res.voltage))
+                    res = simulate(
+                        A, B, E, Cy, obs, fb, load, t_end=t_end, v_max=V_LIMIT if sat else None
+                    )
+                row = Table2Row(
+                    case,
+                    name,
+                    sat,
+                    peak(res.y) * 1e3,
+                    settling_time(res.t, res.y),
+                    max_abs(res.voltage),
+                )
                 rows.append(row)
                 if on_result is not None:
                     on_result(row, res)
@@ -59,10 +71,14 @@ def _pct(ours: float, ref: float) -> str:
 
 def format_table2(rows: list[Table2Row], t_end: float = T_END) -> str:
     """Table 2 with thesis value, ours and the difference per cell."""
-    head = (f"{'case':>4} {'ctrl':>7} {'sat':>4} | {'peak [mm]':^25} | {'settling [s]':^27} | "
-            f"{'max |V| [V]':^25}")
-    sub = (f"{'':>4} {'':>7} {'':>4} | {'thesis':>7} {'ours':>7} {'diff':>8} | "
-           f"{'thesis':>7} {'ours':>8} {'diff':>8} | {'thesis':>7} {'ours':>7} {'diff':>8}")
+    head = (
+        f"{'case':>4} {'ctrl':>7} {'sat':>4} | {'peak [mm]':^25} | {'settling [s]':^27} | "
+        f"{'max |V| [V]':^25}"
+    )
+    sub = (
+        f"{'':>4} {'':>7} {'':>4} | {'thesis':>7} {'ours':>7} {'diff':>8} | "
+        f"{'thesis':>7} {'ours':>8} {'diff':>8} | {'thesis':>7} {'ours':>7} {'diff':>8}"
+    )
     out = [head, sub, "-" * len(sub)]
     for r in rows:
         ref = thesis_row(r.case, r.controller, r.saturation)
@@ -71,13 +87,17 @@ def format_table2(rows: list[Table2Row], t_end: float = T_END) -> str:
             passive1 = r.case == 1 and r.controller == "passive"
             ref_pk = f"{PASSIVE_CASE1_PEAK_MM:.3f}" if passive1 else "-"
             d_pk = _pct(r.peak_mm, PASSIVE_CASE1_PEAK_MM) if passive1 else ""
-            out.append(f"{r.case:>4} {r.controller:>7} {('on' if r.saturation else 'off'):>4} | "
-                       f"{ref_pk:>7} {r.peak_mm:7.3f} {d_pk:>8} | {'-':>7} {ts} {'':>8} | "
-                       f"{'-':>7} {r.max_voltage_V:7.0f} {'':>8}")
+            out.append(
+                f"{r.case:>4} {r.controller:>7} {('on' if r.saturation else 'off'):>4} | "
+                f"{ref_pk:>7} {r.peak_mm:7.3f} {d_pk:>8} | {'-':>7} {ts} {'':>8} | "
+                f"{'-':>7} {r.max_voltage_V:7.0f} {'':>8}"
+            )
             continue
-        out.append(f"{r.case:>4} {r.controller:>7} {('on' if r.saturation else 'off'):>4} | "
-                   f"{ref.peak_mm:7.3f} {r.peak_mm:7.3f} {_pct(r.peak_mm, ref.peak_mm):>8} | "
-                   f"{ref.settling_s:7.4f} {ts} {_pct(r.settling_s, ref.settling_s):>8} | "
-                   f"{ref.max_voltage_V:7.0f} {r.max_voltage_V:7.0f} "
-                   f"{_pct(r.max_voltage_V, ref.max_voltage_V):>8}")
+        out.append(
+            f"{r.case:>4} {r.controller:>7} {('on' if r.saturation else 'off'):>4} | "
+            f"{ref.peak_mm:7.3f} {r.peak_mm:7.3f} {_pct(r.peak_mm, ref.peak_mm):>8} | "
+            f"{ref.settling_s:7.4f} {ts} {_pct(r.settling_s, ref.settling_s):>8} | "
+            f"{ref.max_voltage_V:7.0f} {r.max_voltage_V:7.0f} "
+            f"{_pct(r.max_voltage_V, ref.max_voltage_V):>8}"
+        )
     return "\n".join(out)

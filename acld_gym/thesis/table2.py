@@ -10,8 +10,14 @@ from dataclasses import asdict, dataclass
 
 from acld_gym.physics.actuator import V_LIMIT  # the saturated runs' limit (sec. 5.3)
 
-__all__ = ["Table2Row", "TABLE2", "PASSIVE_CASE1_PEAK_MM", "FIRST_RESONANCE_RAD_S",
-           "V_LIMIT", "thesis_row"]
+__all__ = [
+    "Table2Row",
+    "TABLE2",
+    "PASSIVE_CASE1_PEAK_MM",
+    "FIRST_RESONANCE_RAD_S",
+    "V_LIMIT",
+    "thesis_row",
+]
 
 #: Passive (PCLD) peak tip deflection for case 1 [mm] (sec. 5.3, Fig. 9).
 PASSIVE_CASE1_PEAK_MM = 0.675

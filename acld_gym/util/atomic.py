@@ -17,8 +17,14 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import IO, Any
 
-__all__ = ["write_atomic", "write_text", "write_json", "check_writable", "check_directory",
-           "save_figure"]
+__all__ = [
+    "write_atomic",
+    "write_text",
+    "write_json",
+    "check_writable",
+    "check_directory",
+    "save_figure",
+]
 
 
 def write_atomic(path: str | Path, write: Callable[[IO[bytes]], Any]) -> Path:
@@ -66,8 +72,9 @@ def check_writable(path: str | Path, what: str = "output") -> Path:
     for p in (parent, *parent.parents):
         if p.exists():
             if not p.is_dir():
-                raise ValueError(f"{what}: cannot write {str(path)!r} ({str(p)!r} is not a "
-                                 "directory)")
+                raise ValueError(
+                    f"{what}: cannot write {str(path)!r} ({str(p)!r} is not a directory)"
+                )
             break
     try:
         parent.mkdir(parents=True, exist_ok=True)

@@ -30,16 +30,18 @@ class Progress:
         Where the bar goes; ``sys.stderr`` by default. Shown only if ``stream.isatty()``.
     """
 
-    def __init__(self, total: int, desc: str = "", quiet: bool = False,
-                 stream: TextIO | None = None):
+    def __init__(
+        self, total: int, desc: str = "", quiet: bool = False, stream: TextIO | None = None
+    ):
         stream = sys.stderr if stream is None else stream
         self._bar = None
         self._running = False
         if not quiet and stream.isatty():
             from tqdm import tqdm
 
-            self._bar = tqdm(total=total, desc=desc, unit="stage", file=stream,
-                             leave=False, dynamic_ncols=True)
+            self._bar = tqdm(
+                total=total, desc=desc, unit="stage", file=stream, leave=False, dynamic_ncols=True
+            )
 
     @property
     def shown(self) -> bool:

@@ -9,12 +9,26 @@ import numbers
 
 import numpy as np
 
-__all__ = ["check_real", "check_int", "check_choice", "check_seed", "arg_type",
-           "closed_pipe_is_fine", "run_main"]
+__all__ = [
+    "check_real",
+    "check_int",
+    "check_choice",
+    "check_seed",
+    "arg_type",
+    "closed_pipe_is_fine",
+    "run_main",
+]
 
 
-def check_real(name: str, value, low: float | None = None, high: float | None = None, *,
-               low_open: bool = False, unit: str = "") -> float:
+def check_real(
+    name: str,
+    value,
+    low: float | None = None,
+    high: float | None = None,
+    *,
+    low_open: bool = False,
+    unit: str = "",
+) -> float:
     """``float(value)`` if ``value`` is a finite real number (any numpy real, not a bool or
     a string) in [low, high] (``low_open``: (low, high]); else ``ValueError`` naming it."""
     u = f" {unit}" if unit and unit != "-" else ""

@@ -49,23 +49,38 @@ class ComplianceTest:
     def peak_reduction_db(self) -> list[float] | None:
         if self.closed_peaks is None:
             return None
-        return [float(20.0 * np.log10(p[0] / c[0]))
-                for p, c in zip(self.passive_peaks, self.closed_peaks, strict=True)]
+        return [
+            float(20.0 * np.log10(p[0] / c[0]))
+            for p, c in zip(self.passive_peaks, self.closed_peaks, strict=True)
+        ]
 
     def as_dict(self) -> dict:
-        return {"valid": self.valid, "reason": self.reason, "rms_N": self.rms_N,
-                "max_voltage_V": self.max_voltage_V,
-                "resolution_rad_s": float(self.omega[1] - self.omega[0]),
-                "lines": int(self.omega.size), "transient_residual": self.transient_residual,
-                "passive_peaks": [{"compliance_m_per_N": p, "frequency_rad_s": w}
-                                  for p, w in self.passive_peaks],
-                "closed_loop_peaks": None if self.closed_peaks is None else
-                [{"compliance_m_per_N": p, "frequency_rad_s": w} for p, w in self.closed_peaks]}
+        return {
+            "valid": self.valid,
+            "reason": self.reason,
+            "rms_N": self.rms_N,
+            "max_voltage_V": self.max_voltage_V,
+            "resolution_rad_s": float(self.omega[1] - self.omega[0]),
+            "lines": int(self.omega.size),
+            "transient_residual": self.transient_residual,
+            "passive_peaks": [
+                {"compliance_m_per_N": p, "frequency_rad_s": w} for p, w in self.passive_peaks
+            ],
+            "closed_loop_peaks": None
+            if self.closed_peaks is None
+            else [{"compliance_m_per_N": p, "frequency_rad_s": w} for p, w in self.closed_peaks],
+        }
 
 
-def compliance_test(policy, rig: PulseSuperposition, ms: Multisine, edges: np.ndarray,
-                    v_max: float, rest_voltage: float | None,
-                    decay_rates=()) -> ComplianceTest:
+def compliance_test(
+    policy,
+    rig: PulseSuperposition,
+    ms: Multisine,
+    edges: np.ndarray,
+    v_max: float,
+    rest_voltage: float | None,
+    decay_rates=(),
+) -> ComplianceTest:
     """The test of the module docstring. ``rest_voltage`` [V] is the policy's voltage at
     rest (from the modal test; None: it does not come to rest, and the test is not run:
     its own oscillation would be read as the response); ``decay_rates`` [1/s] of its
@@ -98,9 +113,22 @@ def compliance_test(policy, rig: PulseSuperposition, ms: Multisine, edges: np.nd
             break
         rms *= 0.5
     else:
-        return failed(f"a multisine of {2 * rms:.3g} N RMS already drives the patch to the "
-                      f"{v_max:g} V limit", 2 * rms, vmax)
+        return failed(
+            f"a multisine of {2 * rms:.3g} N RMS already drives the patch to the {v_max:g} V limit",
+            2 * rms,
+            vmax,
+        )
     hc = frequency_response(ms, f, run.y)
     closed_peaks = [band_peak(w, hc, lo, hi) for lo, hi in bands]
-    return ComplianceTest(True, "measured", w, hp, hc, passive_peaks, closed_peaks, rms, vmax,
-                          transient_residual(decay_rates, ms) if len(decay_rates) else None)
+    return ComplianceTest(
+        True,
+        "measured",
+        w,
+        hp,
+        hc,
+        passive_peaks,
+        closed_peaks,
+        rms,
+        vmax,
+        transient_residual(decay_rates, ms) if len(decay_rates) else None,
+    )

@@ -70,19 +70,30 @@ class Analysis:
     def as_dict(self) -> dict:
         """The JSON form: ``"closed_loop_modes"`` ordered by frequency (null values where
         the modal test found none), ``"peak_reduction_db"`` per mode, ``"score"``, ..."""
+
         def modes(ms):
-            return None if ms is None else [
-                m.as_dict() if m is not None else {"frequency_rad_s": None,
-                                                   "damping_ratio": None} for m in ms]
+            return (
+                None
+                if ms is None
+                else [
+                    m.as_dict()
+                    if m is not None
+                    else {"frequency_rad_s": None, "damping_ratio": None}
+                    for m in ms
+                ]
+            )
 
         comp = self.compliance
         return {
-            "policy": self.policy, "env_id": self.env_id,
+            "policy": self.policy,
+            "env_id": self.env_id,
             "closed_loop_modes": modes(self.modal.modes),
             "open_loop_modes": modes(self.open_loop_modes),
-            "peak_reduction_db": comp.peak_reduction_db if comp.valid else [None] * len(
-                self.open_loop_modes),
-            "linear": self.law is not None, "small_signal_law": self.law_reason,
+            "peak_reduction_db": comp.peak_reduction_db
+            if comp.valid
+            else [None] * len(self.open_loop_modes),
+            "linear": self.law is not None,
+            "small_signal_law": self.law_reason,
             "exact_closed_loop_modes": modes(self.exact_modes),
             "margins": self.margins,
             "identification": self.modal.as_dict(),
@@ -99,16 +110,34 @@ def _case_record(policy, env_id: str, case, env_kwargs: dict, capacitance: float
     env = gym.make(env_id, load_case=case, **env_kwargs)
     ep = rollout(policy, env, seed=0)
     row = metrics_row(case, "policy", ep)
-    e: Effort = effort(ep.voltage, ep.y, float(env.unwrapped.dt), settled_from(case),
-                       float(env.unwrapped.v_max), capacitance)
-    return {"ise": row.ise, "peak_mm": row.peak_mm, "settling_s": row.settling_s,
-            "max_voltage_V": row.max_voltage_V, **e.as_dict()}
+    e: Effort = effort(
+        ep.voltage,
+        ep.y,
+        float(env.unwrapped.dt),
+        settled_from(case),
+        float(env.unwrapped.v_max),
+        capacitance,
+    )
+    return {
+        "ise": row.ise,
+        "peak_mm": row.peak_mm,
+        "settling_s": row.settling_s,
+        "max_voltage_V": row.max_voltage_V,
+        **e.as_dict(),
+    }
 
 
-def analyze(policy, env_id: str = acld_gym.ENV_ID, name: str | None = None,
-            env_kwargs: dict | None = None, score_episodes: int | None = None,
-            refs: References | None = None, basis_seeds: int = BASIS_SEEDS,
-            resolution: float = RESOLUTION, quiet: bool = True) -> Analysis:
+def analyze(
+    policy,
+    env_id: str = acld_gym.ENV_ID,
+    name: str | None = None,
+    env_kwargs: dict | None = None,
+    score_episodes: int | None = None,
+    refs: References | None = None,
+    basis_seeds: int = BASIS_SEEDS,
+    resolution: float = RESOLUTION,
+    quiet: bool = True,
+) -> Analysis:
     """Every test of the module docstring on ``policy``.
 
     Parameters
@@ -142,11 +171,13 @@ def analyze(policy, env_id: str = acld_gym.ENV_ID, name: str | None = None,
     if preset(env_id, **kwargs).randomized:  # each seed draws its own plant
         basis_seeds = 1
     test = None if score_episodes == 0 else evaluation_set(env_id)  # (an id without a
-    if test is not None and score_episodes:                          # test set: no score)
+    if test is not None and score_episodes:  # test set: no score)
         test = test.first(score_episodes)
     n_score = 0 if test is None else len(test.seeds)
-    with one_blas_thread(), Progress(4 + (n_score + 1 if n_score else 0), f"analyze {name}",
-                                     quiet) as progress:
+    with (
+        one_blas_thread(),
+        Progress(4 + (n_score + 1 if n_score else 0), f"analyze {name}", quiet) as progress,
+    ):
         progress.stage("modal test")
         rig = PulseSuperposition(env_id, RECORD_STEPS, basis_seeds=basis_seeds, **kwargs)
         env = rig.env.unwrapped
@@ -156,11 +187,13 @@ def analyze(policy, env_id: str = acld_gym.ENV_ID, name: str | None = None,
 
         progress.stage("compliance test")
         ms = multisine(rig.dt, resolution)
-        frig = PulseSuperposition(env_id, 2 * ms.n_period, basis_seeds=basis_seeds if
-                                  modal.rests else 1, **kwargs)  # (no run without a rest)
+        frig = PulseSuperposition(
+            env_id, 2 * ms.n_period, basis_seeds=basis_seeds if modal.rests else 1, **kwargs
+        )  # (no run without a rest)
         decay = [-np.log(abs(m.pole)) / rig.dt for m in modal.modes if m is not None]
-        comp = compliance_test(policy, frig, ms, edges, v_max,
-                               modal.rest_voltage_V if modal.rests else None, decay)
+        comp = compliance_test(
+            policy, frig, ms, edges, v_max, modal.rest_voltage_V if modal.rests else None, decay
+        )
 
         progress.stage("small-signal law")
         law, why = small_signal_law(policy, obs_size, v_max)
@@ -185,9 +218,22 @@ def analyze(policy, env_id: str = acld_gym.ENV_ID, name: str | None = None,
             if refs is None:
                 refs = references(test, kwargs)
             elif refs.seeds != test.seeds:
-                raise ValueError(f"refs: references of other episodes than {test.name}'s "
-                                 f"first {n_score}")
+                raise ValueError(
+                    f"refs: references of other episodes than {test.name}'s first {n_score}"
+                )
             score = score_of(policy_ises(policy, test, kwargs, progress), refs)
-    return Analysis(policy=name, env_id=env_id, open_loop_modes=open_modes, edges=edges,
-                    modal=modal, compliance=comp, law=law, law_reason=why, exact_modes=exact,
-                    margins=marg, exact_compliance=exact_h, cases=cases, score=score)
+    return Analysis(
+        policy=name,
+        env_id=env_id,
+        open_loop_modes=open_modes,
+        edges=edges,
+        modal=modal,
+        compliance=comp,
+        law=law,
+        law_reason=why,
+        exact_modes=exact,
+        margins=marg,
+        exact_compliance=exact_h,
+        cases=cases,
+        score=score,
+    )

@@ -71,8 +71,10 @@ class Effort:
 
     def as_dict(self) -> dict:
         """JSON form: NaN as None."""
-        return {k: (None if isinstance(v, float) and math.isnan(v) else v)
-                for k, v in asdict(self).items()}
+        return {
+            k: (None if isinstance(v, float) and math.isnan(v) else v)
+            for k, v in asdict(self).items()
+        }
 
 
 def settled_from(case) -> float:
@@ -82,16 +84,23 @@ def settled_from(case) -> float:
     return float("nan")
 
 
-def effort(voltage: np.ndarray, y: np.ndarray, dt: float, settle_s: float,
-           v_max: float = V_LIMIT, capacitance: float | None = None) -> Effort:
+def effort(
+    voltage: np.ndarray,
+    y: np.ndarray,
+    dt: float,
+    settle_s: float,
+    v_max: float = V_LIMIT,
+    capacitance: float | None = None,
+) -> Effort:
     """The effort of an episode: ``voltage[k]`` [V] held over period k, ``y[k]`` [m] the tip
     at its end; the settled window holds the periods that start at or after ``settle_s``
     [s] (NaN: none); ``capacitance`` [F] of the patch (default: the default patch's)."""
     v = np.asarray(voltage, dtype=float)
     y = np.asarray(y, dtype=float)
     if v.ndim != 1 or v.size < 1 or y.shape != v.shape:
-        raise ValueError(f"voltage and y must be 1-D of the same length, got {v.shape} and "
-                         f"{y.shape}")
+        raise ValueError(
+            f"voltage and y must be 1-D of the same length, got {v.shape} and {y.shape}"
+        )
     if not dt > 0:
         raise ValueError(f"dt must be positive [s], got {dt!r}")
     c = patch_capacitance() if capacitance is None else float(capacitance)
@@ -108,7 +117,12 @@ def effort(voltage: np.ndarray, y: np.ndarray, dt: float, settle_s: float,
         settled_rms = float(np.sqrt(np.mean(vw**2)))
     else:
         tv = at_limit_share = tip = settled_rms = float("nan")
-    return Effort(rms_voltage_V=v_rms, reactive_power_var=v_rms * i_rms,
-                  total_variation_V_per_s=tv, limit_fraction=at_limit_share,
-                  residual_tip_rms_m=tip, settled_rms_voltage_V=settled_rms,
-                  settled_from_s=float(settle_s))
+    return Effort(
+        rms_voltage_V=v_rms,
+        reactive_power_var=v_rms * i_rms,
+        total_variation_V_per_s=tv,
+        limit_fraction=at_limit_share,
+        residual_tip_rms_m=tip,
+        settled_rms_voltage_V=settled_rms,
+        settled_from_s=float(settle_s),
+    )

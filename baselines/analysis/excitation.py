@@ -83,7 +83,7 @@ def causal_convolution(load: np.ndarray, g: np.ndarray) -> np.ndarray:
     load = np.asarray(load, dtype=float)
     g = np.asarray(g, dtype=float)
     n = load.size
-    g1 = g[1:n + 1]
+    g1 = g[1 : n + 1]
     full = fftconvolve(load.reshape((n,) + (1,) * (g.ndim - 1)), g1, axes=0)[:n]
     return np.concatenate([np.zeros((1,) + g.shape[1:]), full], axis=0)
 
@@ -108,8 +108,14 @@ class PulseSuperposition:
         Further env arguments (``load_case`` and ``episode_length`` are set here).
     """
 
-    def __init__(self, env_id: str = acld_gym.ENV_ID, n_steps: int = 2000, seed: int = 0,
-                 basis_seeds: int = 64, **env_kwargs):
+    def __init__(
+        self,
+        env_id: str = acld_gym.ENV_ID,
+        n_steps: int = 2000,
+        seed: int = 0,
+        basis_seeds: int = 64,
+        **env_kwargs,
+    ):
         self.n_steps = check_int("n_steps", n_steps, 2, 1_000_000)
         self.seed = check_seed(seed)
         if self.seed is None:
@@ -123,10 +129,13 @@ class PulseSuperposition:
         probe.close()
         pulse = thesis_load(1).components[0]
         if abs(pulse.duration - self.dt) > 1e-12 * self.dt:
-            raise ValueError(f"env_kwargs: the excitation needs dt equal to load case 1's "
-                             f"pulse ({pulse.duration:g} s), got dt = {self.dt:g} s")
-        self.env = gym.make(env_id, load_case=1, episode_length=self.n_steps * self.dt,
-                            **env_kwargs)
+            raise ValueError(
+                f"env_kwargs: the excitation needs dt equal to load case 1's "
+                f"pulse ({pulse.duration:g} s), got dt = {self.dt:g} s"
+            )
+        self.env = gym.make(
+            env_id, load_case=1, episode_length=self.n_steps * self.dt, **env_kwargs
+        )
         self.limit = float(self.env.unwrapped.deflection_limit)
         self._zero = np.zeros(self.env.action_space.shape, self.env.action_space.dtype)
         self.own_obs, self.g_y = self._unit_pulse(self.seed)
@@ -134,8 +143,10 @@ class PulseSuperposition:
         for j in range(1, m):
             obs, y = self._unit_pulse(self.seed + j)
             if not np.array_equal(y, self.g_y):
-                raise ValueError(f"basis_seeds: seed {self.seed + j} draws another plant "
-                                 f"(param_noise, temperature_range); use basis_seeds=1")
+                raise ValueError(
+                    f"basis_seeds: seed {self.seed + j} draws another plant "
+                    f"(param_noise, temperature_range); use basis_seeds=1"
+                )
             total += obs
         self.basis_seeds = m
         #: The unit pulse's observation response, averaged over the basis seeds.
@@ -153,24 +164,29 @@ class PulseSuperposition:
         for k in range(self.n_steps):
             obs, _, term, _, info = self.env.step(self._zero)
             if term:
-                raise RuntimeError(f"env: the passive episode ended at step {k + 1} "
-                                   f"({info['terminated_by']})")
+                raise RuntimeError(
+                    f"env: the passive episode ended at step {k + 1} ({info['terminated_by']})"
+                )
             g[k + 1], y[k + 1] = obs, info["tip_deflection"]
         return g, y
 
     def _check_load(self, load) -> np.ndarray:
         f = np.asarray(load, dtype=float)
         if f.ndim != 1 or not 1 <= f.size <= self.n_steps or not np.all(np.isfinite(f)):
-            raise ValueError(f"load must be 1 to {self.n_steps} finite values [N], one per "
-                             f"period, got shape {f.shape}")
+            raise ValueError(
+                f"load must be 1 to {self.n_steps} finite values [N], one per "
+                f"period, got shape {f.shape}"
+            )
         return f
 
     def _checked(self, f: np.ndarray, y: np.ndarray, v: np.ndarray, req: np.ndarray) -> Response:
         k = int(np.argmax(np.abs(y) > self.limit))
         if abs(y[k]) > self.limit:
-            raise ValueError(f"load: the tip reaches {abs(y[k]) * 1e3:.3g} mm at "
-                             f"t = {k * self.dt:.4g} s, beyond the env's deflection limit "
-                             f"({self.limit * 1e3:g} mm); reduce the load")
+            raise ValueError(
+                f"load: the tip reaches {abs(y[k]) * 1e3:.3g} mm at "
+                f"t = {k * self.dt:.4g} s, beyond the env's deflection limit "
+                f"({self.limit * 1e3:g} mm); reduce the load"
+            )
         return Response(load=f, y=y, voltage=v, requested=req, dt=self.dt)
 
     def passive(self, load) -> Response:
@@ -197,13 +213,13 @@ class PulseSuperposition:
         state, start = None, np.ones(1, dtype=bool)  # SB3's recurrent-policy protocol
         for k in range(n):
             o = (obs - own[k] + of[k]).astype(dtype)
-            action, state = policy.predict(o, state=state, episode_start=start,
-                                           deterministic=True)
+            action, state = policy.predict(o, state=state, episode_start=start, deterministic=True)
             start = np.zeros(1, dtype=bool)
             obs, _, term, _, info = self.env.step(action)
             if term:
-                raise RuntimeError(f"env: the episode ended at step {k + 1} "
-                                   f"({info['terminated_by']})")
+                raise RuntimeError(
+                    f"env: the episode ended at step {k + 1} ({info['terminated_by']})"
+                )
             y[k + 1] = info["tip_deflection"] - gy[k + 1] + yf[k + 1]
             v[k], req[k] = info["voltage"], info["requested_voltage"]
         return self._checked(f, y, v, req)

@@ -31,8 +31,16 @@ import numpy as np
 
 from acld_gym.util.validate import check_int, check_real
 
-__all__ = ["Multisine", "multisine", "frequency_response", "band_peak", "transient_residual",
-           "LOW", "HIGH_FRACTION", "RESOLUTION"]
+__all__ = [
+    "Multisine",
+    "multisine",
+    "frequency_response",
+    "band_peak",
+    "transient_residual",
+    "LOW",
+    "HIGH_FRACTION",
+    "RESOLUTION",
+]
 
 #: Lowest excited frequency [rad/s] (below mode 1, 177 rad/s).
 LOW = 20.0
@@ -75,8 +83,12 @@ class Multisine:
         return np.tile(rms * self.period(), periods)
 
 
-def multisine(dt: float, resolution: float = RESOLUTION, low: float = LOW,
-              high_fraction: float = HIGH_FRACTION) -> Multisine:
+def multisine(
+    dt: float,
+    resolution: float = RESOLUTION,
+    low: float = LOW,
+    high_fraction: float = HIGH_FRACTION,
+) -> Multisine:
     """Every DFT line from ``low`` [rad/s] to ``high_fraction`` of the Nyquist frequency
     for a period that resolves ``resolution`` [rad/s] (rounded to whole steps)."""
     check_real("dt", dt, 0.0, low_open=True, unit="s")
@@ -87,8 +99,9 @@ def multisine(dt: float, resolution: float = RESOLUTION, low: float = LOW,
     j0 = max(1, int(np.ceil(check_real("low", low, 0.0, unit="rad/s") / dw)))
     j1 = min(int(np.floor(high_fraction * np.pi / dt / dw)), n // 2 - 1)
     if j1 < j0:
-        raise ValueError(f"low: no DFT line between {low:g} rad/s and {high_fraction:g} of "
-                         "the Nyquist frequency")
+        raise ValueError(
+            f"low: no DFT line between {low:g} rad/s and {high_fraction:g} of the Nyquist frequency"
+        )
     return Multisine(n_period=n, bins=np.arange(j0, j1 + 1), dt=float(dt))
 
 
@@ -98,11 +111,13 @@ def frequency_response(ms: Multisine, load: np.ndarray, y: np.ndarray) -> np.nda
     n = ms.n_period
     periods = load.size // n
     if periods < 2 or y.size != load.size + 1:
-        raise ValueError(f"load must hold at least two periods of {n} steps and y one more "
-                         f"sample, got {load.size} and {y.size}")
+        raise ValueError(
+            f"load must hold at least two periods of {n} steps and y one more "
+            f"sample, got {load.size} and {y.size}"
+        )
     k = (periods - 1) * n
-    F = np.fft.rfft(load[k:k + n])[ms.bins]
-    Y = np.fft.rfft(y[k:k + n])[ms.bins]
+    F = np.fft.rfft(load[k : k + n])[ms.bins]
+    Y = np.fft.rfft(y[k : k + n])[ms.bins]
     return Y / F
 
 
@@ -117,7 +132,7 @@ def band_peak(omega: np.ndarray, H: np.ndarray, low: float, high: float) -> tupl
     i = inside[np.argmax(mag[inside])]
     if i - 1 not in inside or i + 1 not in inside:
         return float(mag[i]), float(omega[i])
-    q = 1.0 / mag[i - 1:i + 2] ** 2
+    q = 1.0 / mag[i - 1 : i + 2] ** 2
     step = omega[i + 1] - omega[i]
     curv = q[2] - 2.0 * q[1] + q[0]
     if curv <= 0:

@@ -65,8 +65,15 @@ from acld_gym.envs.step import Y_SCALE, estimate_map
 
 from .modes import Mode, poles_and_residues, select_modes
 
-__all__ = ["LinearLaw", "small_signal_law", "ObserverLoop", "frequency_response", "margins",
-           "LINEARITY_RTOL", "MIN_PROBE"]
+__all__ = [
+    "LinearLaw",
+    "small_signal_law",
+    "ObserverLoop",
+    "frequency_response",
+    "margins",
+    "LINEARITY_RTOL",
+    "MIN_PROBE",
+]
 
 #: Relative tolerance of the linearity checks of :func:`small_signal_law` (an MPC's QP is
 #: solved to about 1e-5 V, 1e-4 of the probes' voltage changes).
@@ -99,16 +106,19 @@ def _declared_gain(policy, obs_size: int) -> np.ndarray | None:
     return -np.asarray(policy.reduced_state(np.eye(obs_size)), dtype=float) @ K
 
 
-def small_signal_law(policy, obs_size: int, v_max: float,
-                     seed: int = 0) -> tuple[LinearLaw | None, str]:
+def small_signal_law(
+    policy, obs_size: int, v_max: float, seed: int = 0
+) -> tuple[LinearLaw | None, str]:
     """The policy's affine law about the zero observation, or None and why not (module
     docstring). The probes stay within a quarter of the room to the +/-``v_max`` limit and
     are at least :data:`MIN_PROBE` in observation units, so that a law affine only in a
     sliver about zero (a norm floor, a dead zone) is not taken for a linear one."""
     _, state = policy.predict(np.zeros(obs_size, np.float32), deterministic=True)
     if state is not None:
-        return None, ("the policy has a state (a dynamic law, e.g. its own observer on the "
-                      "measurements): no static law of the observation")
+        return None, (
+            "the policy has a state (a dynamic law, e.g. its own observer on the "
+            "measurements): no static law of the observation"
+        )
     v0 = float(_voltages(policy, np.zeros((1, obs_size)))[0])
     room = v_max - abs(v0)
     if room <= 1e-9 * v_max:
@@ -118,8 +128,10 @@ def small_signal_law(policy, obs_size: int, v_max: float,
     while np.abs(_voltages(policy, h * eye) - v0).max() > 0.25 * room:
         h *= 0.25
         if h < MIN_PROBE:
-            return None, (f"the voltage leaves a quarter of the room to the limit for "
-                          f"observation changes below {MIN_PROBE:g}: no linear region")
+            return None, (
+                f"the voltage leaves a quarter of the room to the limit for "
+                f"observation changes below {MIN_PROBE:g}: no linear region"
+            )
     declared = _declared_gain(policy, obs_size)
     if declared is not None:
         gain = declared
@@ -136,8 +148,10 @@ def small_signal_law(policy, obs_size: int, v_max: float,
         ref = np.maximum(np.abs(want - v0), 1e-3 * max(1.0, abs(v0)))
         worst = max(worst, float(np.max(np.abs(got - want) / ref)))
     if worst > LINEARITY_RTOL:
-        return None, (f"predict is not affine about rest: the linear prediction misses by "
-                      f"{100 * worst:.3g} % (tolerance {100 * LINEARITY_RTOL:g} %)")
+        return None, (
+            f"predict is not affine about rest: the linear prediction misses by "
+            f"{100 * worst:.3g} % (tolerance {100 * LINEARITY_RTOL:g} %)"
+        )
     return LinearLaw(gain=gain, offset=v0), "affine about rest"
 
 
@@ -160,8 +174,9 @@ class ObserverLoop:
         unless it observes the ``"estimate"``."""
         e = env.unwrapped
         if e.obs_mode != "estimate":
-            raise ValueError(f"env: the exact loop is built for obs_mode='estimate', got "
-                             f"{e.obs_mode!r}")
+            raise ValueError(
+                f"env: the exact loop is built for obs_mode='estimate', got {e.obs_mode!r}"
+            )
         nom = e.nom
         obs = nom.observer(e.observer_kind)
         M = estimate_map(obs, nom.xr_scale)  # [xhat, y] @ M: the scaled reduced estimate
@@ -170,9 +185,15 @@ class ObserverLoop:
         e_o = nom.plant.Ed[:, 0] if obs.fed_load else np.zeros(obs.n)
         plant = e.episode_plant
         c = np.zeros(plant.Ad.shape[0])  # the lag's state, if any, does not reach the tip
-        c[:nom.output.size] = nom.output
-        return cls(plant=plant, output=c, observer=obs, obs_map=np.hstack([M, tip]),
-                   observer_load=e_o, delay=int(e.config.actuator_delay))
+        c[: nom.output.size] = nom.output
+        return cls(
+            plant=plant,
+            output=c,
+            observer=obs,
+            obs_map=np.hstack([M, tip]),
+            observer_load=e_o,
+            delay=int(e.config.actuator_delay),
+        )
 
     @property
     def n_states(self) -> int:
@@ -191,7 +212,7 @@ class ObserverLoop:
         A[:n, :n] = p.Ad
         if d:
             A[:n, m - 1] = p.Bd[:, 0]  # the plant is driven by the command d periods old
-            A[n + 1:m, n:m - 1] = np.eye(d - 1)  # s_{j+1} <- s_j
+            A[n + 1 : m, n : m - 1] = np.eye(d - 1)  # s_{j+1} <- s_j
             b[n] = 1.0  # s_1 <- V
         else:
             b[:n] = p.Bd[:, 0]
@@ -227,22 +248,22 @@ class ObserverLoop:
             p = self.plant
             return frequency_response(p.Ad, p.Ed[:, 0], self.output, omega, p.dt)
         _, _, _, ef = self.open_loop(law)
-        return frequency_response(self.closed_loop(law), ef, self.tip_row(), omega,
-                                  self.plant.dt)
+        return frequency_response(self.closed_loop(law), ef, self.tip_row(), omega, self.plant.dt)
 
 
-def frequency_response(A: np.ndarray, b: np.ndarray, c: np.ndarray, omega: np.ndarray,
-                       dt: float) -> np.ndarray:
+def frequency_response(
+    A: np.ndarray, b: np.ndarray, c: np.ndarray, omega: np.ndarray, dt: float
+) -> np.ndarray:
     r""":math:`c\,(zI - A)^{-1} b` at :math:`z = e^{i\omega\Delta}` (complex, by solves)."""
     omega = np.asarray(omega, dtype=float)
     n = A.shape[0]
     out = np.empty(omega.size, dtype=complex)
     eye = np.eye(n)
     for i in range(0, omega.size, 512):
-        z = np.exp(1j * omega[i:i + 512] * dt)
+        z = np.exp(1j * omega[i : i + 512] * dt)
         M = z[:, None, None] * eye - A
         rhs = np.broadcast_to(b.astype(complex), (z.size, n))[..., None]
-        out[i:i + 512] = np.linalg.solve(M, rhs)[..., 0] @ c
+        out[i : i + 512] = np.linalg.solve(M, rhs)[..., 0] @ c
     return out
 
 
@@ -291,8 +312,9 @@ def margins(loop: ObserverLoop, law: LinearLaw) -> dict:
     frd = control.frd(resp, w, dt=dt)
     gms, pms, _, wpcs, wgcs, _ = control.stability_margins(frd, returnall=True)
     _, _, sm, _, _, wms = control.stability_margins(frd)
-    crossings = [(float(g), float(x)) for g, x in zip(np.atleast_1d(gms), np.atleast_1d(wpcs),
-                                                       strict=True)]
+    crossings = [
+        (float(g), float(x)) for g, x in zip(np.atleast_1d(gms), np.atleast_1d(wpcs), strict=True)
+    ]
     ends = np.array([0.0, np.pi / dt])
     for x, value in zip(ends, -frequency_response(A, b, cv, ends, dt).real, strict=True):
         if value < 0:
@@ -301,20 +323,26 @@ def margins(loop: ObserverLoop, law: LinearLaw) -> dict:
     down = [c for c in crossings if np.isfinite(c[0]) and 0.0 < c[0] < 1.0]
     gm_up = min(up) if up else None
     gm_down = max(down) if down else None
-    pm = [(abs(float(p)), float(x)) for p, x in zip(np.atleast_1d(pms), np.atleast_1d(wgcs),
-                                                    strict=True) if np.isfinite(p)]
+    pm = [
+        (abs(float(p)), float(x))
+        for p, x in zip(np.atleast_1d(pms), np.atleast_1d(wgcs), strict=True)
+        if np.isfinite(p)
+    ]
     pm_min = min(pm) if pm else None
 
     def num(x):
         return float(x) if x is not None and np.isfinite(x) else None
 
     rho = loop.spectral_radius(law)
-    return {"gain_margin_db": None if gm_up is None else float(20 * np.log10(gm_up[0])),
-            "gain_margin_rad_s": None if gm_up is None else gm_up[1],
-            "gain_reduction_margin_db": None if gm_down is None else
-            float(20 * np.log10(gm_down[0])),
-            "gain_reduction_margin_rad_s": None if gm_down is None else gm_down[1],
-            "phase_margin_deg": None if pm_min is None else pm_min[0],
-            "phase_margin_rad_s": None if pm_min is None else pm_min[1],
-            "stability_margin": num(sm), "stability_margin_rad_s": num(wms),
-            "closed_loop_spectral_radius": rho, "closed_loop_stable": bool(rho < 1.0)}
+    return {
+        "gain_margin_db": None if gm_up is None else float(20 * np.log10(gm_up[0])),
+        "gain_margin_rad_s": None if gm_up is None else gm_up[1],
+        "gain_reduction_margin_db": None if gm_down is None else float(20 * np.log10(gm_down[0])),
+        "gain_reduction_margin_rad_s": None if gm_down is None else gm_down[1],
+        "phase_margin_deg": None if pm_min is None else pm_min[0],
+        "phase_margin_rad_s": None if pm_min is None else pm_min[1],
+        "stability_margin": num(sm),
+        "stability_margin_rad_s": num(wms),
+        "closed_loop_spectral_radius": rho,
+        "closed_loop_stable": bool(rho < 1.0),
+    }

@@ -27,8 +27,15 @@ from .excitation import PulseSuperposition, Response
 from .modes import Mode, band_edges, poles_and_residues, select_modes, window_energy
 from .sysid import Identification, identify, order_check
 
-__all__ = ["ModalTest", "passive_modes", "modal_test", "RECORD_STEPS", "PILOT", "HEADROOM",
-           "N_MODES"]
+__all__ = [
+    "ModalTest",
+    "passive_modes",
+    "modal_test",
+    "RECORD_STEPS",
+    "PILOT",
+    "HEADROOM",
+    "N_MODES",
+]
 
 #: Length of the pulse records [control periods].
 RECORD_STEPS = 2000
@@ -59,16 +66,25 @@ class ModalTest:
 
     def as_dict(self) -> dict:
         ident = self.identification
-        hsv = (None if ident is None else
-               (ident.singular_values[:40] / ident.singular_values[0]).tolist())
-        return {"valid": self.valid, "reason": self.reason, "rests": self.rests,
-                "pulse_N": self.pulse_N,
-                "max_voltage_V": self.max_voltage_V, "rest_voltage_V": self.rest_voltage_V,
-                "linearity_error": self.linearity_error,
-                "order": None if ident is None else ident.order,
-                "fit_error": None if ident is None else ident.fit_error,
-                "order_check": self.check or None, "hankel_singular_values": hsv,
-                "samples": None if ident is None else ident.n_samples}
+        hsv = (
+            None
+            if ident is None
+            else (ident.singular_values[:40] / ident.singular_values[0]).tolist()
+        )
+        return {
+            "valid": self.valid,
+            "reason": self.reason,
+            "rests": self.rests,
+            "pulse_N": self.pulse_N,
+            "max_voltage_V": self.max_voltage_V,
+            "rest_voltage_V": self.rest_voltage_V,
+            "linearity_error": self.linearity_error,
+            "order": None if ident is None else ident.order,
+            "fit_error": None if ident is None else ident.fit_error,
+            "order_check": self.check or None,
+            "hankel_singular_values": hsv,
+            "samples": None if ident is None else ident.n_samples,
+        }
 
 
 def passive_modes(rig: PulseSuperposition) -> tuple[list[Mode], np.ndarray, Identification]:
@@ -79,8 +95,9 @@ def passive_modes(rig: PulseSuperposition) -> tuple[list[Mode], np.ndarray, Iden
     energy = np.where(z.imag > 0, window_energy(z, r, ident.n_samples), -np.inf)
     top = np.argsort(-energy)[:N_MODES]
     if not np.all(np.isfinite(energy[top])):
-        raise ValueError("env: the passive pulse response shows fewer than "
-                         f"{N_MODES} oscillatory modes")
+        raise ValueError(
+            f"env: the passive pulse response shows fewer than {N_MODES} oscillatory modes"
+        )
     freqs = sorted(Mode.of_pole(z[i], rig.dt).frequency_rad_s for i in top)
     edges = band_edges(freqs, rig.dt)
     return select_modes(z, r, rig.dt, edges, ident.n_samples), edges, ident
@@ -96,15 +113,22 @@ def modal_test(policy, rig: PulseSuperposition, edges: np.ndarray, v_max: float)
     rest = rig.run(policy, np.zeros(n))
     v0 = rest.voltage
     at_limit_share = float(np.mean(at_limit(v0, v_max)))
-    tail = v0[-n // 10:]
+    tail = v0[-n // 10 :]
     if at_limit_share > 0:
-        return _invalid(f"without any load the policy holds the patch at the {v_max:g} V "
-                        f"limit in {100 * at_limit_share:.0f} % of the steps: no small-signal "
-                        "modes", rests=False, rest_voltage_V=float(v0[-1]))
+        return _invalid(
+            f"without any load the policy holds the patch at the {v_max:g} V "
+            f"limit in {100 * at_limit_share:.0f} % of the steps: no small-signal "
+            "modes",
+            rests=False,
+            rest_voltage_V=float(v0[-1]),
+        )
     if np.ptp(tail) > 1e-3 * v_max:
-        return _invalid(f"without any load the voltage does not come to rest (it still "
-                        f"swings by {np.ptp(tail):.3g} V at the end of {n * rig.dt:g} s)",
-                        rests=False, rest_voltage_V=float(v0[-1]))
+        return _invalid(
+            f"without any load the voltage does not come to rest (it still "
+            f"swings by {np.ptp(tail):.3g} V at the end of {n * rig.dt:g} s)",
+            rests=False,
+            rest_voltage_V=float(v0[-1]),
+        )
     room = HEADROOM * (v_max - float(np.max(np.abs(v0))))
 
     def pulse(a: float) -> Response:
@@ -127,16 +151,29 @@ def modal_test(policy, rig: PulseSuperposition, edges: np.ndarray, v_max: float)
     h = (r.y - rest.y)[1:] / a
     half = (pulse(0.5 * a).y - rest.y)[1:] / (0.5 * a)
     lin = float(np.linalg.norm(h - half) / np.linalg.norm(h))
-    common = {"pulse_N": a, "max_voltage_V": vmax, "rest_voltage_V": float(v0[-1]),
-              "linearity_error": lin, "response": h}
+    common = {
+        "pulse_N": a,
+        "max_voltage_V": vmax,
+        "rest_voltage_V": float(v0[-1]),
+        "linearity_error": lin,
+        "response": h,
+    }
     if at_limit(vmax, v_max):
-        return _invalid(f"even a {a:.3g} N pulse drives the patch to the {v_max:g} V limit",
-                        **common)
+        return _invalid(
+            f"even a {a:.3g} N pulse drives the patch to the {v_max:g} V limit", **common
+        )
     ident = identify(h, rig.dt)
     modes = ident.modes(edges)
     check = order_check(ident, edges)
     if any(m is None for m in modes):
-        return ModalTest(valid=False, reason="no oscillatory mode in a band", modes=modes,
-                         identification=ident, check=check, **common)
-    return ModalTest(valid=True, reason="identified", modes=modes, identification=ident,
-                     check=check, **common)
+        return ModalTest(
+            valid=False,
+            reason="no oscillatory mode in a band",
+            modes=modes,
+            identification=ident,
+            check=check,
+            **common,
+        )
+    return ModalTest(
+        valid=True, reason="identified", modes=modes, identification=ident, check=check, **common
+    )

@@ -25,8 +25,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Mode", "poles_and_residues", "band_edges", "select_modes", "window_energy",
-           "MAX_DAMPING"]
+__all__ = [
+    "Mode",
+    "poles_and_residues",
+    "band_edges",
+    "select_modes",
+    "window_energy",
+    "MAX_DAMPING",
+]
 
 #: Largest damping ratio of a pole that counts as a mode.
 MAX_DAMPING = 0.5
@@ -49,16 +55,21 @@ class Mode:
     @classmethod
     def of_pole(cls, z: complex, dt: float, energy: float = float("nan")) -> Mode:
         s = np.log(complex(z)) / dt
-        return cls(frequency_rad_s=float(abs(s)), damping_ratio=float(-s.real / abs(s)),
-                   pole=complex(z), energy=float(energy))
+        return cls(
+            frequency_rad_s=float(abs(s)),
+            damping_ratio=float(-s.real / abs(s)),
+            pole=complex(z),
+            energy=float(energy),
+        )
 
     def as_dict(self) -> dict:
         """``{"frequency_rad_s", "damping_ratio"}`` (the JSON form)."""
         return {"frequency_rad_s": self.frequency_rad_s, "damping_ratio": self.damping_ratio}
 
 
-def poles_and_residues(A: np.ndarray, B: np.ndarray, C: np.ndarray
-                       ) -> tuple[np.ndarray, np.ndarray]:
+def poles_and_residues(
+    A: np.ndarray, B: np.ndarray, C: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """Poles z (n,) and residues r (n,) of :math:`C (zI - A)^{-1} B` (single input and
     output; distinct poles)."""
     z, V = np.linalg.eig(np.asarray(A, dtype=float))
@@ -72,8 +83,7 @@ def window_energy(z: np.ndarray, r: np.ndarray, n: int) -> np.ndarray:
     (finite for unstable poles too)."""
     q = np.abs(z) ** 2
     with np.errstate(over="ignore", invalid="ignore"):
-        geo = np.where(np.isclose(q, 1.0, rtol=0, atol=1e-14), float(n),
-                       (1.0 - q**n) / (1.0 - q))
+        geo = np.where(np.isclose(q, 1.0, rtol=0, atol=1e-14), float(n), (1.0 - q**n) / (1.0 - q))
     return np.abs(r) ** 2 * geo
 
 
@@ -88,8 +98,9 @@ def band_edges(frequencies, dt: float) -> np.ndarray:
     return np.concatenate([[0.0], inner, [nyquist]])
 
 
-def select_modes(z: np.ndarray, r: np.ndarray, dt: float, edges: np.ndarray,
-                 n_window: int) -> list[Mode | None]:
+def select_modes(
+    z: np.ndarray, r: np.ndarray, dt: float, edges: np.ndarray, n_window: int
+) -> list[Mode | None]:
     """Mode i: the oscillatory pole (Im z > 0, damping ratio below :data:`MAX_DAMPING`) with
     frequency in [edges[i], edges[i+1])
     (the last band open above: a heavily damped pole's :math:`|s|` can exceed the Nyquist

@@ -36,8 +36,15 @@ from acld_gym.physics.plant_cache import user_cache_dir
 from acld_gym.util.atomic import write_json
 from acld_gym.util.progress import Progress
 
-__all__ = ["References", "references", "reference_episode", "make_env", "cache_path",
-           "FORMAT", "SPOT_RTOL"]
+__all__ = [
+    "References",
+    "references",
+    "reference_episode",
+    "make_env",
+    "cache_path",
+    "FORMAT",
+    "SPOT_RTOL",
+]
 
 #: Version of the cache files' layout and of the way references are computed.
 FORMAT = 1
@@ -72,11 +79,20 @@ def reference_episode(env, seed: int) -> tuple[float, float]:
 
 
 def _key(test: EvaluationSet, env_kwargs: dict, env) -> str:
-    blob = json.dumps({"format": FORMAT, "test_set": test.name, "env_id": test.env_id,
-                       "seeds": list(test.seeds), "load_case": test.load_case,
-                       "env_kwargs": env_kwargs, "acld_gym": acld_gym.__version__,
-                       "config": repr(env.unwrapped.config),  # actuator, temperature, ...
-                       "observation": observation_fingerprint(env)}, sort_keys=True)
+    blob = json.dumps(
+        {
+            "format": FORMAT,
+            "test_set": test.name,
+            "env_id": test.env_id,
+            "seeds": list(test.seeds),
+            "load_case": test.load_case,
+            "env_kwargs": env_kwargs,
+            "acld_gym": acld_gym.__version__,
+            "config": repr(env.unwrapped.config),  # actuator, temperature, ...
+            "observation": observation_fingerprint(env),
+        },
+        sort_keys=True,
+    )
     return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
 
@@ -88,9 +104,11 @@ def cache_path(test: EvaluationSet, key: str) -> Path:
 def _validated(path: Path, test: EvaluationSet, key: str, env) -> References | None:
     """The file's references if every check of the module docstring passes, else None
     (with the reason on stderr)."""
+
     def reject(why: str) -> None:
-        print(f"baselines: recomputing the references of {test.name} ({path}: {why})",
-              file=sys.stderr)
+        print(
+            f"baselines: recomputing the references of {test.name} ({path}: {why})", file=sys.stderr
+        )
 
     try:
         rec = json.loads(path.read_text())
@@ -126,8 +144,9 @@ def _validated(path: Path, test: EvaluationSet, key: str, env) -> References | N
     return References(test.name, test.seeds, lqr, bound)
 
 
-def references(test: EvaluationSet, env_kwargs: dict | None = None, cache: bool = True,
-               quiet: bool = True) -> References:
+def references(
+    test: EvaluationSet, env_kwargs: dict | None = None, cache: bool = True, quiet: bool = True
+) -> References:
     """The references of ``test`` (from the validated cache, else computed and cached);
     a progress line on a terminal unless ``quiet``."""
     kwargs = dict(env_kwargs or {})
@@ -146,9 +165,17 @@ def references(test: EvaluationSet, env_kwargs: dict | None = None, cache: bool 
             lqr[i], bound[i] = reference_episode(env, s)
     if cache:
         try:
-            write_json(path, {"format": FORMAT, "key": key, "test_set": test.name,
-                              "seeds": list(test.seeds), "lqr_ise": lqr.tolist(),
-                              "bound_ise": bound.tolist()})
+            write_json(
+                path,
+                {
+                    "format": FORMAT,
+                    "key": key,
+                    "test_set": test.name,
+                    "seeds": list(test.seeds),
+                    "lqr_ise": lqr.tolist(),
+                    "bound_ise": bound.tolist(),
+                },
+            )
         except OSError:
             pass  # a read-only cache: computed again next time
     return References(test.name, test.seeds, lqr, bound)

@@ -29,8 +29,15 @@ from acld_gym.util.stats import iqm_with_ci
 
 from .references import References, make_env, references
 
-__all__ = ["Score", "episode_scores", "score_of", "score_policy", "policy_ises",
-           "score_policies", "format_scores"]
+__all__ = [
+    "Score",
+    "episode_scores",
+    "score_of",
+    "score_policy",
+    "policy_ises",
+    "score_policies",
+    "format_scores",
+]
 
 
 @dataclass(frozen=True)
@@ -50,9 +57,14 @@ class Score:
     def as_dict(self) -> dict:
         """``{"iqm", "ci_low", "ci_high", "n_episodes", "test_set", "mean_ise"}`` (the mean
         ISE over the episodes [m^2 s], the ordering of the ISE tables)."""
-        return {"iqm": self.iqm, "ci_low": self.ci_low, "ci_high": self.ci_high,
-                "n_episodes": self.n_episodes, "test_set": self.test_set,
-                "mean_ise": float(np.mean(self.ise))}
+        return {
+            "iqm": self.iqm,
+            "ci_low": self.ci_low,
+            "ci_high": self.ci_high,
+            "n_episodes": self.n_episodes,
+            "test_set": self.test_set,
+            "mean_ise": float(np.mean(self.ise)),
+        }
 
 
 def episode_scores(ise, lqr_ise, bound_ise) -> np.ndarray:
@@ -60,8 +72,10 @@ def episode_scores(ise, lqr_ise, bound_ise) -> np.ndarray:
     unless every bound is strictly below its LQR (else the score is undefined)."""
     ise, lqr, bound = (np.asarray(a, dtype=float) for a in (ise, lqr_ise, bound_ise))
     if not ise.shape == lqr.shape == bound.shape or ise.ndim != 1:
-        raise ValueError(f"ise, lqr_ise and bound_ise must be 1-D of one length, got "
-                         f"{ise.shape}, {lqr.shape}, {bound.shape}")
+        raise ValueError(
+            f"ise, lqr_ise and bound_ise must be 1-D of one length, got "
+            f"{ise.shape}, {lqr.shape}, {bound.shape}"
+        )
     gap = lqr - bound
     if not np.all(np.isfinite(ise)) or not np.all(gap > 0):
         raise ValueError("ise must be finite and every bound strictly below LQR's ISE")
@@ -72,13 +86,24 @@ def score_of(ise, refs: References, reps: int = 2000, seed: int = 0) -> Score:
     """The score of per-episode ISE ``ise`` against ``refs`` (as many episodes)."""
     s = episode_scores(ise, refs.lqr_ise, refs.bound_ise)
     stats = iqm_with_ci(s, reps=reps, seed=seed)
-    return Score(iqm=stats["iqm"], ci_low=stats["ci_low"], ci_high=stats["ci_high"],
-                 n_episodes=int(s.size), test_set=refs.name, scores=s,
-                 ise=np.asarray(ise, dtype=float))
+    return Score(
+        iqm=stats["iqm"],
+        ci_low=stats["ci_low"],
+        ci_high=stats["ci_high"],
+        n_episodes=int(s.size),
+        test_set=refs.name,
+        scores=s,
+        ise=np.asarray(ise, dtype=float),
+    )
 
 
-def policy_ises(policy, test: EvaluationSet, env_kwargs: dict | None = None,
-                progress: Progress | None = None, label: str = "") -> np.ndarray:
+def policy_ises(
+    policy,
+    test: EvaluationSet,
+    env_kwargs: dict | None = None,
+    progress: Progress | None = None,
+    label: str = "",
+) -> np.ndarray:
     """The policy's ISE [m^2 s] on each episode of ``test`` (:func:`baselines.evaluate.rollout`)."""
     from baselines.evaluate import metrics_row, rollout
 
@@ -91,9 +116,14 @@ def policy_ises(policy, test: EvaluationSet, env_kwargs: dict | None = None,
     return out
 
 
-def score_policy(policy, env_id: str = acld_gym.ENV_ID, n_episodes: int | None = None,
-                 env_kwargs: dict | None = None, refs: References | None = None,
-                 quiet: bool = True) -> Score:
+def score_policy(
+    policy,
+    env_id: str = acld_gym.ENV_ID,
+    n_episodes: int | None = None,
+    env_kwargs: dict | None = None,
+    refs: References | None = None,
+    quiet: bool = True,
+) -> Score:
     """The score of ``policy`` (SB3 ``predict``, volts) on the test set of ``env_id`` (its
     first ``n_episodes``: a reduced run; None: all of it)."""
     test = evaluation_set(env_id)
@@ -102,16 +132,21 @@ def score_policy(policy, env_id: str = acld_gym.ENV_ID, n_episodes: int | None =
     if refs is None:
         refs = references(test, env_kwargs, quiet=quiet)
     elif refs.seeds != test.seeds:
-        raise ValueError(f"refs: references of other episodes than {test.name}'s first "
-                         f"{len(test.seeds)}")
+        raise ValueError(
+            f"refs: references of other episodes than {test.name}'s first {len(test.seeds)}"
+        )
     with Progress(len(test.seeds), "score", quiet) as progress:
         ise = policy_ises(policy, test, env_kwargs, progress)
     return score_of(ise, refs)
 
 
-def score_policies(policies: dict, env_id: str = acld_gym.ENV_ID,
-                   n_episodes: int | None = None, env_kwargs: dict | None = None,
-                   quiet: bool = True) -> dict[str, Score]:
+def score_policies(
+    policies: dict,
+    env_id: str = acld_gym.ENV_ID,
+    n_episodes: int | None = None,
+    env_kwargs: dict | None = None,
+    quiet: bool = True,
+) -> dict[str, Score]:
     """The score of each policy (name -> ``predict`` object) on the same test episodes, and
     of the bound itself (``"bound"``, 1 on every episode by construction)."""
     test = evaluation_set(env_id)
@@ -121,8 +156,7 @@ def score_policies(policies: dict, env_id: str = acld_gym.ENV_ID,
     out = {}
     with Progress(len(policies) * len(test.seeds), "score", quiet) as progress:
         for name, pol in policies.items():
-            out[name] = score_of(policy_ises(pol, test, env_kwargs, progress, f" · {name}"),
-                                 refs)
+            out[name] = score_of(policy_ises(pol, test, env_kwargs, progress, f" · {name}"), refs)
     out["bound"] = score_of(refs.bound_ise, refs)
     return out
 
@@ -135,17 +169,23 @@ def format_scores(scores: dict[str, Score], labels: dict | None = None) -> str:
     ref = scores.get("lqr")
     lqr_mean = None if ref is None else float(np.mean(ref.ise))
     full = {t.name: len(t.seeds) for t in TEST_SETS.values()}.get(first.test_set)
-    reduced = ("" if full is None or first.n_episodes >= full else
-               f", the first of its {full}: a reduced score, not the published one")
-    head = (f"\nscore on {first.test_set} ({first.n_episodes} random loads{reduced}; LQR 0, "
-            "clairvoyant bound 1): IQM of (ISE_LQR - ISE) / (ISE_LQR - ISE_bound), 95 % "
-            "bootstrap CI")
+    reduced = (
+        ""
+        if full is None or first.n_episodes >= full
+        else f", the first of its {full}: a reduced score, not the published one"
+    )
+    head = (
+        f"\nscore on {first.test_set} ({first.n_episodes} random loads{reduced}; LQR 0, "
+        "clairvoyant bound 1): IQM of (ISE_LQR - ISE) / (ISE_LQR - ISE_bound), 95 % "
+        "bootstrap CI"
+    )
     trained = "" if labels is None else f" {'trained':>22}"
-    out = [head, f"{'policy':>12}{trained} {'IQM':>8} {'CI low':>8} {'CI high':>8} "
-                 f"{'mean ISE / LQR':>15}"]
+    out = [
+        head,
+        f"{'policy':>12}{trained} {'IQM':>8} {'CI low':>8} {'CI high':>8} {'mean ISE / LQR':>15}",
+    ]
     for name, s in scores.items():
         rel = "-" if lqr_mean is None else f"{np.mean(s.ise) / lqr_mean:.4f}"
         label = "" if labels is None else f" {labels.get(name, ''):>22}"
-        out.append(f"{name:>12}{label} {s.iqm:8.4f} {s.ci_low:8.4f} {s.ci_high:8.4f} "
-                   f"{rel:>15}")
+        out.append(f"{name:>12}{label} {s.iqm:8.4f} {s.ci_low:8.4f} {s.ci_high:8.4f} {rel:>15}")
     return "\n".join(out)

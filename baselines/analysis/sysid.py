@@ -40,8 +40,17 @@ from acld_gym.util.blas import one_blas_thread
 
 from .modes import Mode, poles_and_residues, select_modes
 
-__all__ = ["EraRealization", "Identification", "identify", "order_check", "FIT_TOL",
-           "PLATEAU", "RANK_TOL", "MAX_ORDER", "CHECK_STEP"]
+__all__ = [
+    "EraRealization",
+    "Identification",
+    "identify",
+    "order_check",
+    "FIT_TOL",
+    "PLATEAU",
+    "RANK_TOL",
+    "MAX_ORDER",
+    "CHECK_STEP",
+]
 
 #: Relative RMS error of the realization's pulse response that selects the order.
 FIT_TOL = 1e-4
@@ -63,14 +72,16 @@ class EraRealization:
         h = np.asarray(h, dtype=float).ravel()
         n = h.size
         if n < 8 or not np.all(np.isfinite(h)) or not np.any(h):
-            raise ValueError(f"h must be a finite, non-zero pulse response of at least 8 "
-                             f"samples, got {n} samples")
+            raise ValueError(
+                f"h must be a finite, non-zero pulse response of at least 8 "
+                f"samples, got {n} samples"
+            )
         r = min(n // 3, 600) if rows is None else int(rows)
         if not 2 <= r <= n - 2:
             raise ValueError(f"rows must be in [2, {n - 2}], got {rows!r}")
         self.h = h
-        H0 = sla.hankel(h[:r], h[r - 1:n - 1])
-        H1 = sla.hankel(h[1:r + 1], h[r:n])
+        H0 = sla.hankel(h[:r], h[r - 1 : n - 1])
+        H1 = sla.hankel(h[1 : r + 1], h[r:n])
         with one_blas_thread():
             try:
                 U, S, Vt = sla.svd(H0, full_matrices=False, lapack_driver="gesdd")
@@ -86,8 +97,7 @@ class EraRealization:
         """``(A, B, C)`` of the realization of ``order`` (at most the ``max_order`` given
         at construction)."""
         if not isinstance(order, int) or not 1 <= order <= self.max_order:
-            raise ValueError(f"order must be an integer in [1, {self.max_order}], got "
-                             f"{order!r}")
+            raise ValueError(f"order must be an integer in [1, {self.max_order}], got {order!r}")
         q = np.sqrt(self._S[:order])
         A = self._P[:order, :order] / q[:, None] / q[None, :]
         return A, q * self._Vt[:order, 0], self._U[0, :order] * q
@@ -128,30 +138,47 @@ class Identification:
         return select_modes(z, r, self.dt, edges, self.n_samples)
 
 
-def identify(h: np.ndarray, dt: float, rows: int | None = None, max_order: int = MAX_ORDER,
-             fit_tol: float = FIT_TOL) -> Identification:
+def identify(
+    h: np.ndarray,
+    dt: float,
+    rows: int | None = None,
+    max_order: int = MAX_ORDER,
+    fit_tol: float = FIT_TOL,
+) -> Identification:
     """ERA on the pulse response ``h`` (``h[k]`` the output k + 1 periods of ``dt`` after
     the pulse), at the order chosen as in the module docstring."""
     era = EraRealization(h, rows, max_order)
     if era.max_order < 2:
-        raise ValueError("h: the pulse response has fewer than two significant Hankel "
-                         "singular values; nothing to identify")
+        raise ValueError(
+            "h: the pulse response has fewer than two significant Hankel "
+            "singular values; nothing to identify"
+        )
     errors = {n: era.fit_error(n) for n in range(1, era.max_order + 1)}
     best = min(errors.values())
     order = min(n for n, e in errors.items() if e <= max(fit_tol, PLATEAU * best))
     check = era.model(order + CHECK_STEP) if order + CHECK_STEP <= era.max_order else None
-    return Identification(*era.model(order), dt=float(dt), order=order,
-                          fit_error=errors[order], fit_errors=errors,
-                          singular_values=era.singular_values, n_samples=era.h.size,
-                          check=check)
+    return Identification(
+        *era.model(order),
+        dt=float(dt),
+        order=order,
+        fit_error=errors[order],
+        fit_errors=errors,
+        singular_values=era.singular_values,
+        n_samples=era.h.size,
+        check=check,
+    )
 
 
 def order_check(ident: Identification, edges: np.ndarray) -> dict:
     """The chosen order's modes against those of order + :data:`CHECK_STEP`: the largest
     relative change of frequency and of damping ratio over the bands (None without a
     check realization or where a band has no mode at either order)."""
-    out = {"order": ident.order, "check_order": None, "frequency_change": None,
-           "damping_change": None}
+    out = {
+        "order": ident.order,
+        "check_order": None,
+        "frequency_change": None,
+        "damping_change": None,
+    }
     if ident.check is None:
         return out
     z, r = poles_and_residues(*ident.check)
@@ -160,8 +187,8 @@ def order_check(ident: Identification, edges: np.ndarray) -> dict:
     pairs = [(a, b) for a, b in zip(mine, other, strict=True) if a is not None and b is not None]
     out["check_order"] = ident.order + CHECK_STEP
     if len(pairs) == len(mine):
-        out["frequency_change"] = max(abs(b.frequency_rad_s / a.frequency_rad_s - 1)
-                                      for a, b in pairs)
-        out["damping_change"] = max(abs(b.damping_ratio / a.damping_ratio - 1)
-                                    for a, b in pairs)
+        out["frequency_change"] = max(
+            abs(b.frequency_rad_s / a.frequency_rad_s - 1) for a, b in pairs
+        )
+        out["damping_change"] = max(abs(b.damping_ratio / a.damping_ratio - 1) for a, b in pairs)
     return out

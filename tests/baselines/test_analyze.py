@@ -27,8 +27,14 @@ def _check_schema(rec):
     assert len(rec["peak_reduction_db"]) == 3
     assert set(rec["effort"]) == {"1", "2", "3"}
     for case in rec["effort"].values():
-        assert {"rms_voltage_V", "reactive_power_var", "total_variation_V_per_s",
-                "limit_fraction", "residual_tip_rms_m", "settled_from_s"} <= set(case)
+        assert {
+            "rms_voltage_V",
+            "reactive_power_var",
+            "total_variation_V_per_s",
+            "limit_fraction",
+            "residual_tip_rms_m",
+            "settled_from_s",
+        } <= set(case)
         assert case["rms_voltage_V"] <= 120.0
     if rec["score"] is not None:
         assert {"iqm", "ci_low", "ci_high", "n_episodes"} <= set(rec["score"])
@@ -47,7 +53,11 @@ def test_lqr_in_control_terms(tmp_path):
     assert rec["linear"] and rec["margins"]["closed_loop_stable"]
     assert rec["margins"]["gain_margin_db"] > 0 and rec["margins"]["phase_margin_deg"] > 0
     assert {k: rec["score"][k] for k in ("iqm", "ci_low", "ci_high", "n_episodes")} == {
-        "iqm": 0.0, "ci_low": 0.0, "ci_high": 0.0, "n_episodes": 3}
+        "iqm": 0.0,
+        "ci_low": 0.0,
+        "ci_high": 0.0,
+        "n_episodes": 3,
+    }
     assert (tmp_path / "compliance_lqr.png").stat().st_size > 10_000
 
 
@@ -73,10 +83,14 @@ def test_the_library_takes_any_predict():
     assert a.modal.modes[0].damping_ratio == pytest.approx(0.0623, rel=0.01)
 
 
-@pytest.mark.parametrize("argv, word", [
-    (["bogus"], "POLICY"), (["lqr", "--score-episodes", "101"], "--score-episodes"),
-    (["lqr", "--env-id", "ACLDBeam-v9"], "--env-id"),
-])
+@pytest.mark.parametrize(
+    "argv, word",
+    [
+        (["bogus"], "POLICY"),
+        (["lqr", "--score-episodes", "101"], "--score-episodes"),
+        (["lqr", "--env-id", "ACLDBeam-v9"], "--env-id"),
+    ],
+)
 def test_bad_arguments_exit_2_before_computing(argv, word, capsys):
     with pytest.raises(SystemExit) as e:
         main(argv)
@@ -110,8 +124,22 @@ def test_the_command_runs_on_every_baseline_and_agent(tmp_path, policy):
 
 def test_several_policies_give_a_list_and_the_comparison_tables(tmp_path):
     js, md = tmp_path / "all.json", tmp_path / "all.md"
-    assert main(["passive", str(FIXTURES / "ppo_dagger") + "/", "--score-episodes", "0",
-                 "--quiet", "--json", str(js), "--markdown", str(md)]) == 0
+    assert (
+        main(
+            [
+                "passive",
+                str(FIXTURES / "ppo_dagger") + "/",
+                "--score-episodes",
+                "0",
+                "--quiet",
+                "--json",
+                str(js),
+                "--markdown",
+                str(md),
+            ]
+        )
+        == 0
+    )
     recs = json.loads(js.read_text())
     assert [r["policy"] for r in recs] == ["passive", "ppo_dagger"]
     text = md.read_text()

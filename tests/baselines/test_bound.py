@@ -92,8 +92,11 @@ def test_kkt_conditions_hold_and_voltages_in_box(which):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("which", [1, 2, 3] + [("random", s) for s in range(5)],
-                         ids=[f"thesis{c}" for c in (1, 2, 3)] + [f"random{s}" for s in range(5)])
+@pytest.mark.parametrize(
+    "which",
+    [1, 2, 3] + [("random", s) for s in range(5)],
+    ids=[f"thesis{c}" for c in (1, 2, 3)] + [f"random{s}" for s in range(5)],
+)
 def test_ise_equals_bvls(which):
     plant, tip = plant_and_tip()
     load = episode_load(which)
@@ -140,8 +143,9 @@ def test_free_and_impulse_responses_match_stepping():
         h_ref[k] = c @ xb
         xb = plant.Ad @ xb
     for system, out in ((plant, tip), ((plant.Ad, plant.Bd), c), ((plant.Ad, plant.Bd[:, 0]), c)):
-        np.testing.assert_allclose(impulse_response(system, out, 300), h_ref, rtol=0,
-                                   atol=1e-10 * np.abs(h_ref).max())
+        np.testing.assert_allclose(
+            impulse_response(system, out, 300), h_ref, rtol=0, atol=1e-10 * np.abs(h_ref).max()
+        )
 
 
 @pytest.mark.parametrize("n", [1, 2, 7, 64])
@@ -170,10 +174,12 @@ def test_bad_input_names_the_argument():
 
 
 # --- the bound of each actuator option (issue 21) ------------------------------------------
-OPTIONS = {"delay": dict(actuator_delay=2), "lag": dict(amplifier_bandwidth=300.0),
-           "slew": dict(slew_rate=2e4),
-           "all": dict(actuator_delay=1, amplifier_bandwidth=500.0, slew_rate=3e4,
-                       temperature=23.0)}
+OPTIONS = {
+    "delay": dict(actuator_delay=2),
+    "lag": dict(amplifier_bandwidth=300.0),
+    "slew": dict(slew_rate=2e4),
+    "all": dict(actuator_delay=1, amplifier_bandwidth=500.0, slew_rate=3e4, temperature=23.0),
+}
 
 
 @pytest.mark.parametrize("name", list(OPTIONS))
@@ -195,7 +201,7 @@ def test_with_each_option_the_bound_is_below_every_policy_and_certified(name):
     # the bound's voltages are feasible for this actuator
     assert np.all(np.abs(ep.voltage) <= 120.0 + 1e-9)
     if "actuator_delay" in OPTIONS[name]:
-        assert np.all(ep.voltage[:OPTIONS[name]["actuator_delay"]] == 0.0)
+        assert np.all(ep.voltage[: OPTIONS[name]["actuator_delay"]] == 0.0)
 
 
 def test_slew_certificate_is_a_lower_bound_of_every_feasible_point():
@@ -216,5 +222,5 @@ def test_slew_certificate_is_a_lower_bound_of_every_feasible_point():
     assert loose.lower <= cert.objective
     # the slew limit binds: without it the optimum is lower
     free = clairvoyant_bound(nom.plant, nom.output, thesis_load(1), n)
-    assert np.sum(free.y ** 2) < np.sum((y + np.convolve(h, w)[:n]) ** 2) * 1e-6
+    assert np.sum(free.y**2) < np.sum((y + np.convolve(h, w)[:n]) ** 2) * 1e-6
     assert np.abs(np.diff(np.r_[0.0, w])).max() == pytest.approx(rho)

@@ -9,8 +9,13 @@ from baselines.evaluate import evaluate, format_tables, main
 from baselines.policies import LQRPolicy, PassivePolicy
 
 KEYS = {"case", "policy", "peak_mm", "settling_s", "ise", "max_voltage_V", "return"}
-EFFORT = {"rms_voltage_V", "reactive_power_var", "total_variation_V_per_s", "limit_fraction",
-          "residual_tip_rms_m"}
+EFFORT = {
+    "rms_voltage_V",
+    "reactive_power_var",
+    "total_variation_V_per_s",
+    "limit_fraction",
+    "residual_tip_rms_m",
+}
 
 
 def test_rows_and_relative_figures():
@@ -54,13 +59,17 @@ def test_cli_bad_argument_exits_2(capsys):
 def test_thesis_comparison_lists_saturated_lqr_smc_rows_only():
     from baselines.evaluate import EvalRow, format_thesis_comparison
 
-    rows = [EvalRow(1, "lqr", 0.666 * 1.05, 0.34 * 0.9, 1e-8, 120.0, -1.0, 0.01),
-            EvalRow(2, "smc", 0.952, 0.461, 1e-8, 120.0, -1.0, 0.01),
-            EvalRow(1, "mpc", 0.6, 0.3, 1e-8, 120.0, -1.0, 0.1),
-            EvalRow("random", "lqr", 0.6, 0.3, 1e-8, 120.0, -1.0, 0.1)]
+    rows = [
+        EvalRow(1, "lqr", 0.666 * 1.05, 0.34 * 0.9, 1e-8, 120.0, -1.0, 0.01),
+        EvalRow(2, "smc", 0.952, 0.461, 1e-8, 120.0, -1.0, 0.01),
+        EvalRow(1, "mpc", 0.6, 0.3, 1e-8, 120.0, -1.0, 0.1),
+        EvalRow("random", "lqr", 0.6, 0.3, 1e-8, 120.0, -1.0, 0.1),
+    ]
     lines = format_thesis_comparison(rows).strip().splitlines()[2:]
-    assert [ln.split() for ln in lines] == [["LQR", "case", "1", "+5.0%", "-10.0%"],
-                                            ["SMC", "case", "2", "+0.0%", "+0.0%"]]
+    assert [ln.split() for ln in lines] == [
+        ["LQR", "case", "1", "+5.0%", "-10.0%"],
+        ["SMC", "case", "2", "+0.0%", "+0.0%"],
+    ]
 
 
 def test_evaluate_takes_any_registered_id(capsys):

@@ -35,8 +35,7 @@ def rollout(policy, case, seed=0, mesh="converged"):
 @pytest.fixture(scope="module")
 def results():
     nom = nominal_design()
-    pols = {"passive": PassivePolicy(), "lqr": LQRPolicy(), "smc": SMCPolicy(),
-            "mpc": MPCPolicy()}
+    pols = {"passive": PassivePolicy(), "lqr": LQRPolicy(), "smc": SMCPolicy(), "mpc": MPCPolicy()}
     out = {}
     for case in (1, 2, 3):
         b = clairvoyant_bound(nom.plant, nom.output, thesis_load(case), 1000)
@@ -49,8 +48,11 @@ def results():
 @pytest.fixture(scope="module")
 def thesis_results():
     pols = {"lqr": LQRPolicy(mesh="thesis"), "smc": SMCPolicy(mesh="thesis")}
-    return {(case, name): rollout(p, case, mesh="thesis") for case in (1, 2, 3)
-            for name, p in pols.items()}
+    return {
+        (case, name): rollout(p, case, mesh="thesis")
+        for case in (1, 2, 3)
+        for name, p in pols.items()
+    }
 
 
 def ise(y):

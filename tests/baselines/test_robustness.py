@@ -45,8 +45,9 @@ def test_stable_on_the_stiffness_and_actuator_corners(mesh):
         for eb in (1 / f, f):
             for d in (1 / f, f):
                 for rest in (1 / f, f):
-                    others = {k: rest for k in RANDOMIZED if k not in ("beam_youngs_modulus",
-                                                                         "d31")}
+                    others = {
+                        k: rest for k in RANDOMIZED if k not in ("beam_youngs_modulus", "d31")
+                    }
                     plant = _plant(nom, beam_youngs_modulus=eb, d31=d, **others)
                     assert spectral_radius(plant, nom, g) < 1.0, (name, eb, d, rest)
 

@@ -53,8 +53,14 @@ def _rel(a, b) -> float:
 def _transformed(p: Plant, T: np.ndarray) -> Plant:
     """The same plant in coordinates q' = T q (T orthogonal): M' = T M T^T, ..."""
     return dataclasses.replace(
-        p, units={k: T @ U @ T.T for k, U in p.units.items()}, piezo=T @ p.piezo,
-        Fd=T @ p.Fd, c=T @ p.c, physical=p.physical @ T.T, node_w=p.node_w @ T.T)
+        p,
+        units={k: T @ U @ T.T for k, U in p.units.items()},
+        piezo=T @ p.piezo,
+        Fd=T @ p.Fd,
+        c=T @ p.c,
+        physical=p.physical @ T.T,
+        node_w=p.node_w @ T.T,
+    )
 
 
 def _signed_permutation(n: int, rng) -> np.ndarray:
@@ -99,8 +105,11 @@ def _transforms(mesh: str):
 
 #: The designs behind the observations: v1 on both meshes and v0 (thesis mesh, Kalman
 #: filter driven by the load alone).
-DESIGNS = {"v1-converged": ("converged", MODEL_STD), "v1-thesis": ("thesis", MODEL_STD),
-           "v0": ("thesis", preset("ACLDBeam-v0").model_std)}
+DESIGNS = {
+    "v1-converged": ("converged", MODEL_STD),
+    "v1-thesis": ("thesis", MODEL_STD),
+    "v0": ("thesis", preset("ACLDBeam-v0").model_std),
+}
 
 
 @pytest.fixture
@@ -109,8 +118,9 @@ def transformed_nominal(monkeypatch):
     original = design_module.truth_plant
 
     def build(mesh: str, T: np.ndarray, model_std: float = MODEL_STD):
-        monkeypatch.setattr(design_module, "truth_plant",
-                            lambda m, dt: _transformed(original(m, dt), T))
+        monkeypatch.setattr(
+            design_module, "truth_plant", lambda m, dt: _transformed(original(m, dt), T)
+        )
         nominal_design.cache_clear()
         return nominal_design(mesh=mesh, model_std=model_std)
 
@@ -163,8 +173,11 @@ def _episode(seed=0, **kw):
 
 
 #: The configurations of the episodes (v0: its preset, the thesis mesh its own).
-EPISODES = {"v1-converged": {"mesh": "converged"}, "v1-thesis": {"mesh": "thesis"},
-            "v0": {"config": preset("ACLDBeam-v0")}}
+EPISODES = {
+    "v1-converged": {"mesh": "converged"},
+    "v1-thesis": {"mesh": "thesis"},
+    "v0": {"config": preset("ACLDBeam-v0")},
+}
 
 
 @pytest.mark.parametrize("which", list(EPISODES))

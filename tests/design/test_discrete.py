@@ -32,8 +32,9 @@ def test_sampled_passive_matches_exact_simulation(d, case, tol):
     sd = discretize(A, B, E, 1e-3, substeps=10)
     load = thesis_load(case)
     y = _run_sampled(sd, load, 250)
-    ref = simulate(A, B, E, Cy, d.observer("thesis"), d.passive, load, t_end=0.25, v_max=None,
-                   dt=1e-3)
+    ref = simulate(
+        A, B, E, Cy, d.observer("thesis"), d.passive, load, t_end=0.25, v_max=None, dt=1e-3
+    )
     assert np.abs(y - ref.y).max() / np.abs(ref.y).max() < tol
 
 
@@ -43,8 +44,9 @@ def test_pulse_edges_inside_a_period_are_exact(d):
     sd = discretize(A, B, E, 1e-3, substeps=10)
     load = TipLoad((Pulse(3e-4, 1.4e-3, 0.7),))
     y = _run_sampled(sd, load, 100)
-    ref = simulate(A, B, E, Cy, d.observer("thesis"), d.passive, load, t_end=0.1, v_max=None,
-                   dt=1e-3)
+    ref = simulate(
+        A, B, E, Cy, d.observer("thesis"), d.passive, load, t_end=0.1, v_max=None, dt=1e-3
+    )
     # The simulator adds the edges to its output grid; compare at the period instants.
     at_periods = np.isclose(ref.t / 1e-3, np.round(ref.t / 1e-3), atol=1e-6)
     yref = ref.y[at_periods]
@@ -71,9 +73,16 @@ def test_zoh_matrices(d):
     assert sd.substeps == 4 and np.isclose(sd.times[-1], 1e-3)
 
 
-@pytest.mark.parametrize("kw, name", [({"dt": 0.0}, "dt"), ({"dt": -1e-3}, "dt"),
-                                      ({"dt": float("nan")}, "dt"), ({"substeps": 0}, "substeps"),
-                                      ({"substeps": 2.5}, "substeps")])
+@pytest.mark.parametrize(
+    "kw, name",
+    [
+        ({"dt": 0.0}, "dt"),
+        ({"dt": -1e-3}, "dt"),
+        ({"dt": float("nan")}, "dt"),
+        ({"substeps": 0}, "substeps"),
+        ({"substeps": 2.5}, "substeps"),
+    ],
+)
 def test_bad_arguments(d, kw, name):
     A, B, E, _ = d.plant
     args = {"dt": 1e-3, "substeps": 10, **kw}

@@ -26,8 +26,9 @@ def d():
 
 def _transformed(r: ReducedModel, T: np.ndarray) -> ReducedModel:
     Ti = np.linalg.inv(T)
-    return ReducedModel(A=T @ r.A @ Ti, B=T @ r.B, C=r.C @ Ti, E=T @ r.E, SL=r.SL @ T.T,
-                        SR=r.SR @ Ti, hsv=r.hsv)
+    return ReducedModel(
+        A=T @ r.A @ Ti, B=T @ r.B, C=r.C @ Ti, E=T @ r.E, SL=r.SL @ T.T, SR=r.SR @ Ti, hsv=r.hsv
+    )
 
 
 def test_lqr_closed_loop_stable(d):
@@ -98,8 +99,9 @@ def test_smc_reaching_condition(d):
         sdot = float(f.s @ (r.A @ x + r.B[:, 0] * u))
         assert sigma * sdot < 0
         sb = float(f.s @ r.B[:, 0])
-        assert sdot == pytest.approx(-sb * f.c * np.sign(sigma),
-                                     rel=1e-6, abs=1e-9 * abs(float(f.s @ r.A @ x)))
+        assert sdot == pytest.approx(
+            -sb * f.c * np.sign(sigma), rel=1e-6, abs=1e-9 * abs(float(f.s @ r.A @ x))
+        )
         n_checked += 1
     assert n_checked == 200
 

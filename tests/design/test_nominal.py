@@ -28,8 +28,9 @@ def test_lqr_gain_is_python_controls_dlqr(nom):
 
 def test_lqr_gain_stabilizes_and_follows_its_weight(nom):
     sr = nom.reduced
-    rho = [np.max(np.abs(np.linalg.eigvals(sr.Ad - sr.Bd @ nom.lqr_gain(w))))
-           for w in (THESIS_LQR_WEIGHT / 100, THESIS_LQR_WEIGHT)]
+    rho = [
+        np.max(np.abs(np.linalg.eigvals(sr.Ad - sr.Bd @ nom.lqr_gain(w))))
+        for w in (THESIS_LQR_WEIGHT / 100, THESIS_LQR_WEIGHT)
+    ]
     assert max(rho) < 1.0
-    assert np.linalg.norm(nom.lqr_gain(THESIS_LQR_WEIGHT / 100)) < \
-        np.linalg.norm(nom.lqr_gain())
+    assert np.linalg.norm(nom.lqr_gain(THESIS_LQR_WEIGHT / 100)) < np.linalg.norm(nom.lqr_gain())

@@ -62,10 +62,15 @@ def test_thesis_gain_solves_filter_riccati(d):
     assert_allclose(Lt.T, X @ Cy.T, rtol=1e-8, atol=1e-14 * np.abs(Lt).max())
 
 
-@pytest.mark.parametrize("kw,name", [({"load_std": 0.0}, "load_std"),
-                                     ({"load_std": -1.0}, "load_std"),
-                                     ({"sensor_std": 0.0}, "sensor_std"),
-                                     ({"sensor_std": -1e-6}, "sensor_std")])
+@pytest.mark.parametrize(
+    "kw,name",
+    [
+        ({"load_std": 0.0}, "load_std"),
+        ({"load_std": -1.0}, "load_std"),
+        ({"sensor_std": 0.0}, "sensor_std"),
+        ({"sensor_std": -1e-6}, "sensor_std"),
+    ],
+)
 def test_kalman_bad_noise_raises(d, kw, name):
     with pytest.raises(ValueError, match=name):
         kalman_observer(d.reduced, **kw)

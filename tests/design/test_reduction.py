@@ -116,10 +116,12 @@ def test_invariance_under_diagonal_state_scaling(d):
     r2 = schur_balanced_truncation(A2, B2, C2, 6, E=E2)
     assert_allclose(r2.hsv[:10], r1.hsv[:10], rtol=1e-6)
     w = np.array([10.0, 178.6, 500.0, 1115.4, 3970.0, 1e4])
-    assert_allclose(frequency_response(r2.A, r2.B, r2.C, w),
-                    frequency_response(r1.A, r1.B, r1.C, w), rtol=1e-6)
-    assert_allclose(frequency_response(r2.A, r2.E, r2.C, w),
-                    frequency_response(r1.A, r1.E, r1.C, w), rtol=1e-6)
+    assert_allclose(
+        frequency_response(r2.A, r2.B, r2.C, w), frequency_response(r1.A, r1.B, r1.C, w), rtol=1e-6
+    )
+    assert_allclose(
+        frequency_response(r2.A, r2.E, r2.C, w), frequency_response(r1.A, r1.E, r1.C, w), rtol=1e-6
+    )
 
 
 def test_frequency_response_matches_direct_solve():

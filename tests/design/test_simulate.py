@@ -32,6 +32,7 @@ def sim(d):
 
     def run(fb, load=1, **kw):
         return simulate(A, B, E, Cy, obs, fb, thesis_load(load), **kw)
+
     return run
 
 
@@ -104,13 +105,11 @@ def test_lqr_saturated_vs_radau(d):
     z0[loop.ix_c] = 1.0  # load on during [0, 1e-3)
     t_end = 0.01
     t1 = np.linspace(0, 1e-3, 11)
-    s1 = solve_ivp(rhs, (0, 1e-3), z0, method="Radau", jac=jac, rtol=1e-9, atol=1e-14,
-                   t_eval=t1)
+    s1 = solve_ivp(rhs, (0, 1e-3), z0, method="Radau", jac=jac, rtol=1e-9, atol=1e-14, t_eval=t1)
     z = s1.y[:, -1].copy()
     z[loop.ix_c] = 0.0
     t2 = np.linspace(1e-3, t_end, 91)
-    s2 = solve_ivp(rhs, (1e-3, t_end), z, method="Radau", jac=jac, rtol=1e-9, atol=1e-14,
-                   t_eval=t2)
+    s2 = solve_ivp(rhs, (1e-3, t_end), z, method="Radau", jac=jac, rtol=1e-9, atol=1e-14, t_eval=t2)
     assert s1.success and s2.success
     y_ref = np.concatenate([s1.y[loop.ix_x].T @ loop.Cy, (s2.y[loop.ix_x].T @ loop.Cy)[1:]])
     res = loop.run(thesis_load(1), t_end)
@@ -149,8 +148,9 @@ def test_harmonic_load_loop_dimension(d):
     assert loop.N == 38 + 6 + 1 + 2 + 1
 
 
-@pytest.mark.parametrize("kw", [{"t_end": 0.0}, {"t_end": -1.0}, {"v_max": 0.0},
-                                {"v_max": -120.0}, {"dt": 0.0}])
+@pytest.mark.parametrize(
+    "kw", [{"t_end": 0.0}, {"t_end": -1.0}, {"v_max": 0.0}, {"v_max": -120.0}, {"dt": 0.0}]
+)
 def test_bad_args(d, sim, kw):
     args = {"t_end": 0.01, "v_max": 120.0} | kw
     with pytest.raises(ValueError):

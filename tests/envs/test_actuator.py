@@ -45,7 +45,7 @@ def test_a_delay_of_k_periods_shifts_the_response_exactly_k_steps(delay, compile
     # ... and so is the tip (same dynamics, summed in another order: to rounding)
     scale = np.abs(ref[:, 0]).max()
     np.testing.assert_allclose(got[delay:, 0], ref[:-delay, 0], rtol=1e-10, atol=1e-12 * scale)
-    assert np.abs(got[:delay + 1, 0]).max() == 0.0
+    assert np.abs(got[: delay + 1, 0]).max() == 0.0
     np.testing.assert_array_equal(got[:, 2], np.float32(u))  # the action, as requested
 
 
@@ -94,8 +94,9 @@ def test_the_slew_limited_voltage_ramps_at_the_rate_given(compiled):
 @pytest.mark.parametrize("compiled", PATHS)
 def test_options_compose_in_the_amplifier_order(compiled):
     # the command, delayed, moves the amplifier at the slew rate, which the lag follows
-    got = _run(np.full(12, 100.0), compiled, actuator_delay=2, slew_rate=5e4,
-               amplifier_bandwidth=500.0)[:, 1]
+    got = _run(
+        np.full(12, 100.0), compiled, actuator_delay=2, slew_rate=5e4, amplifier_bandwidth=500.0
+    )[:, 1]
     a = np.exp(-2 * np.pi * 500.0 * 1e-3)
     want, vp = [], 0.0
     for amp in [0.0, 0.0, 50.0] + [100.0] * 9:
@@ -105,8 +106,9 @@ def test_options_compose_in_the_amplifier_order(compiled):
 
 
 def test_the_reward_charges_the_patch_voltage_and_the_observer_sees_the_command():
-    env = ACLDBeamEnv(load_case=QUIET, sensor_noise=0.0, actuator_delay=1, lam=0.5,
-                      obs_mode="measurement")
+    env = ACLDBeamEnv(
+        load_case=QUIET, sensor_noise=0.0, actuator_delay=1, lam=0.5, obs_mode="measurement"
+    )
     env.reset(seed=0)
     obs, r, *_, info = env.step(np.array([60.0], np.float32))
     assert info["voltage"] == 0.0 and r == 0.0  # nothing on the patch yet
@@ -125,12 +127,17 @@ def test_options_are_off_by_default_and_v1_is_unchanged():
     assert env.batch.layout.z_size == 67 and env.batch.layout.out_voltage is None
 
 
-@pytest.mark.parametrize("kw, name", [
-    ({"actuator_delay": -1}, "actuator_delay"), ({"actuator_delay": 1.5}, "actuator_delay"),
-    ({"actuator_delay": 101}, "actuator_delay"), ({"amplifier_bandwidth": 0.0},
-                                                  "amplifier_bandwidth"),
-    ({"slew_rate": -5.0}, "slew_rate"), ({"slew_rate": float("inf")}, "slew_rate"),
-])
+@pytest.mark.parametrize(
+    "kw, name",
+    [
+        ({"actuator_delay": -1}, "actuator_delay"),
+        ({"actuator_delay": 1.5}, "actuator_delay"),
+        ({"actuator_delay": 101}, "actuator_delay"),
+        ({"amplifier_bandwidth": 0.0}, "amplifier_bandwidth"),
+        ({"slew_rate": -5.0}, "slew_rate"),
+        ({"slew_rate": float("inf")}, "slew_rate"),
+    ],
+)
 def test_bad_actuator_settings_name_themselves(kw, name):
     with pytest.raises(ValueError, match=name):
         ACLDBeamEnv(**kw)

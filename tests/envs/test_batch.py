@@ -26,8 +26,13 @@ N = 3
 STEPS = 130  # 50-step episodes: two autoresets
 
 _rng = np.random.default_rng(0)
-CUSTOM = TipLoad((Pulse(0.004, 1.3e-3, 0.7), Harmonic(0.05, 900.0, 0.0123, 0.02, 0.3),
-                  Samples(0.0021, 7e-4, tuple(_rng.normal(0.0, 0.1, 60).tolist()))))
+CUSTOM = TipLoad(
+    (
+        Pulse(0.004, 1.3e-3, 0.7),
+        Harmonic(0.05, 900.0, 0.0123, 0.02, 0.3),
+        Samples(0.0021, 7e-4, tuple(_rng.normal(0.0, 0.1, 60).tolist())),
+    )
+)
 
 #: Every option of the configuration, each on its own and a few together.
 OPTIONS = {
@@ -50,13 +55,18 @@ OPTIONS = {
     "delay": dict(load_case="random", actuator_delay=3),
     "lag": dict(load_case=2, amplifier_bandwidth=400.0),
     "slew": dict(load_case="random", slew_rate=3e4, obs_mode="measurement"),
-    "actuator": dict(load_case="random", actuator_delay=1, amplifier_bandwidth=800.0,
-                     slew_rate=6e4, observer="thesis"),
+    "actuator": dict(
+        load_case="random",
+        actuator_delay=1,
+        amplifier_bandwidth=800.0,
+        slew_rate=6e4,
+        observer="thesis",
+    ),
     "temperature": dict(load_case="random", temperature=24.0),
-    "temperature-range": dict(load_case="random", temperature_range=(17.0, 30.0),
-                              param_noise=0.03),
-    "thesis-actuator": dict(load_case=3, mesh="thesis", actuator_delay=2, slew_rate=2e4,
-                            temperature=22.0),
+    "temperature-range": dict(load_case="random", temperature_range=(17.0, 30.0), param_noise=0.03),
+    "thesis-actuator": dict(
+        load_case=3, mesh="thesis", actuator_delay=2, slew_rate=2e4, temperature=22.0
+    ),
 }
 
 
@@ -95,9 +105,13 @@ def _assert_same(a, b, what):
                 np.testing.assert_array_equal(ai[key], bi[key], err_msg=what)
                 continue
             scale = float(np.max(np.abs(bi[key]), initial=0.0))
-            np.testing.assert_allclose(np.asarray(ai[key], dtype=float),
-                                       np.asarray(bi[key], dtype=float), rtol=1e-9,
-                                       atol=1e-12 * scale + 1e-15, err_msg=f"{what} {key} {k}")
+            np.testing.assert_allclose(
+                np.asarray(ai[key], dtype=float),
+                np.asarray(bi[key], dtype=float),
+                rtol=1e-9,
+                atol=1e-12 * scale + 1e-15,
+                err_msg=f"{what} {key} {k}",
+            )
     return n_done
 
 

@@ -38,10 +38,11 @@ def test_passes_sb3_check_env():
 
 
 def test_make_without_import_registers_itself():
-    code = ("import gymnasium as gym; e = gym.make('acld_gym:ACLDBeam-v1'); "
-            "print(e.spec.max_episode_steps)")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         check=True)
+    code = (
+        "import gymnasium as gym; e = gym.make('acld_gym:ACLDBeam-v1'); "
+        "print(e.spec.max_episode_steps)"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "1000"
 
 
@@ -106,8 +107,9 @@ def test_passive_episode_matches_exact_simulation():
     env.reset(seed=0)
     ys = [env.step(np.zeros(1, np.float32))[4]["tip_deflection"] for _ in range(300)]
     d = nominal_design().design
-    ref = simulate(*d.plant, d.observer("thesis"), d.passive, thesis_load(2), t_end=0.3,
-                   v_max=None, dt=1e-3)
+    ref = simulate(
+        *d.plant, d.observer("thesis"), d.passive, thesis_load(2), t_end=0.3, v_max=None, dt=1e-3
+    )
     grid = np.isclose(ref.t / 1e-3, np.round(ref.t / 1e-3), atol=1e-6)
     np.testing.assert_allclose(ys, ref.y[grid][1:], atol=1e-9 * 1e-3 + 1e-12, rtol=1e-6)
 
@@ -142,13 +144,23 @@ def test_wrong_action_shape_raises():
         env.step(np.array([1.0, 2.0]))
 
 
-@pytest.mark.parametrize("kw, name", [
-    ({"load_case": 4}, "load_case"), ({"observer": "perfect"}, "observer"),
-    ({"obs_mode": "pixels"}, "obs_mode"), ({"dt": 0}, "dt"), ({"dt": float("nan")}, "dt"),
-    ({"y_ref": -1.0}, "y_ref"), ({"lam": -0.1}, "lam"), ({"param_noise": -0.1}, "param_noise"),
-    ({"sensor_noise": -1e-6}, "sensor_noise"), ({"episode_length": 0.0}, "episode_length"),
-    ({"render_mode": "ansi"}, "render_mode"), ({"deflection_limit": 0}, "deflection_limit"),
-])
+@pytest.mark.parametrize(
+    "kw, name",
+    [
+        ({"load_case": 4}, "load_case"),
+        ({"observer": "perfect"}, "observer"),
+        ({"obs_mode": "pixels"}, "obs_mode"),
+        ({"dt": 0}, "dt"),
+        ({"dt": float("nan")}, "dt"),
+        ({"y_ref": -1.0}, "y_ref"),
+        ({"lam": -0.1}, "lam"),
+        ({"param_noise": -0.1}, "param_noise"),
+        ({"sensor_noise": -1e-6}, "sensor_noise"),
+        ({"episode_length": 0.0}, "episode_length"),
+        ({"render_mode": "ansi"}, "render_mode"),
+        ({"deflection_limit": 0}, "deflection_limit"),
+    ],
+)
 def test_bad_kwargs_name_the_argument(kw, name):
     with pytest.raises(ValueError, match=name):
         ACLDBeamEnv(**kw)
@@ -168,9 +180,16 @@ def test_reset_options_select_load_case_and_reject_unknown_keys():
         env.reset(options={"load": env.load, "load_case": 1})
 
 
-@pytest.mark.parametrize("mesh, mode, n, order", [
-    ("converged", "estimate", 9, 8), ("converged", "measurement", 9, 8),
-    ("converged", "full", 36, 8), ("thesis", "estimate", 7, 6), ("thesis", "full", 38, 6)])
+@pytest.mark.parametrize(
+    "mesh, mode, n, order",
+    [
+        ("converged", "estimate", 9, 8),
+        ("converged", "measurement", 9, 8),
+        ("converged", "full", 36, 8),
+        ("thesis", "estimate", 7, 6),
+        ("thesis", "full", 38, 6),
+    ],
+)
 def test_observation_modes(mesh, mode, n, order):
     # Converged plant: 18 Ritz coordinates (36 states), 8-state design model (modes 1-4);
     # thesis mesh: 19 DOFs (38 states), 6-state design model (modes 1-3).
@@ -178,7 +197,7 @@ def test_observation_modes(mesh, mode, n, order):
     obs, info = env.reset(seed=0)
     assert obs.shape == (n,) and obs.dtype == np.float32
     for _ in range(5):
-        obs, *_ , info = env.step(np.zeros(1, np.float32))
+        obs, *_, info = env.step(np.zeros(1, np.float32))
     assert env.observation_space.contains(obs)
     assert {"tip_deflection", "voltage", "tip_load", "time", "xr_true"} <= set(info)
     assert info["xr_true"].shape == (order,)
@@ -197,12 +216,21 @@ def test_v0_is_the_thesis_configuration_in_the_canonical_basis():
     assert e.nom.design.reduced.order == 6 and e.param_noise == 0.0
     assert e.nom.plant.Ad.shape == (38, 38)
     # one configuration of the one class: its three settings are ordinary fields
-    assert e.config == preset("ACLDBeam-v0") == EnvConfig(
-        mesh="thesis", harmonic_modes=(179.0, 1115.0), model_std=0.0, param_noise_max=0.5,
-        env_id="ACLDBeam-v0")
+    assert (
+        e.config
+        == preset("ACLDBeam-v0")
+        == EnvConfig(
+            mesh="thesis",
+            harmonic_modes=(179.0, 1115.0),
+            model_std=0.0,
+            param_noise_max=0.5,
+            env_id="ACLDBeam-v0",
+        )
+    )
     assert e.observation_fingerprint["env_id"] == "ACLDBeam-v0"
-    assert ACLDBeamEnv(config=preset("ACLDBeam-v0")).observation_fingerprint["env_id"] == \
-        "ACLDBeam-v0"
+    assert (
+        ACLDBeamEnv(config=preset("ACLDBeam-v0")).observation_fingerprint["env_id"] == "ACLDBeam-v0"
+    )
     assert noisy.param_noise == 0.5
     with pytest.raises(ValueError, match="param_noise"):
         gym.make("ACLDBeam-v1", mesh="thesis", param_noise=0.5)
@@ -237,7 +265,7 @@ def test_reward_formula():
     env = ACLDBeamEnv(y_ref=2e-3, lam=0.5)
     env.reset(seed=0)
     _, r, _, _, info = env.step(np.array([60.0], np.float32))
-    expected = -(info["tip_deflection"] / 2e-3) ** 2 - 0.5 * (60.0 / 120.0) ** 2
+    expected = -((info["tip_deflection"] / 2e-3) ** 2) - 0.5 * (60.0 / 120.0) ** 2
     assert r == pytest.approx(expected, rel=1e-12)
 
 
@@ -278,9 +306,14 @@ def test_works_in_sb3_subprocvecenv():
     from stable_baselines3.common.env_util import make_vec_env
     from stable_baselines3.common.vec_env import SubprocVecEnv
 
-    venv = make_vec_env(ACLDBeamEnv, n_envs=2, seed=0, vec_env_cls=SubprocVecEnv,
-                        vec_env_kwargs={"start_method": "fork"},
-                        env_kwargs={"load_case": "random"})
+    venv = make_vec_env(
+        ACLDBeamEnv,
+        n_envs=2,
+        seed=0,
+        vec_env_cls=SubprocVecEnv,
+        vec_env_kwargs={"start_method": "fork"},
+        env_kwargs={"load_case": "random"},
+    )
     try:
         obs = venv.reset()
         assert obs.shape == (2, 9)

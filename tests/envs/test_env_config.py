@@ -19,14 +19,30 @@ from acld_gym.envs.vector_env import ACLDBeamVectorEnv
 from acld_gym.physics.loads import Pulse, TipLoad
 
 
-@pytest.mark.parametrize("field, value", [
-    ("load_case", 4), ("load_case", "1"), ("load_case", True), ("mesh", "coarse"),
-    ("dt", 0.0), ("dt", 1.0), ("episode_length", -1.0), ("observer", "perfect"),
-    ("obs_mode", "pixels"), ("sensor_noise", -1e-9), ("y_ref", 0.0), ("lam", float("nan")),
-    ("param_noise", 0.2), ("deflection_limit", 5.0), ("harmonic_modes", (1.0,)),
-    ("harmonic_modes", (100.0, -3.0)), ("model_std", -1.0), ("param_noise_max", 0.0),
-    ("env_id", ""),
-])
+@pytest.mark.parametrize(
+    "field, value",
+    [
+        ("load_case", 4),
+        ("load_case", "1"),
+        ("load_case", True),
+        ("mesh", "coarse"),
+        ("dt", 0.0),
+        ("dt", 1.0),
+        ("episode_length", -1.0),
+        ("observer", "perfect"),
+        ("obs_mode", "pixels"),
+        ("sensor_noise", -1e-9),
+        ("y_ref", 0.0),
+        ("lam", float("nan")),
+        ("param_noise", 0.2),
+        ("deflection_limit", 5.0),
+        ("harmonic_modes", (1.0,)),
+        ("harmonic_modes", (100.0, -3.0)),
+        ("model_std", -1.0),
+        ("param_noise_max", 0.0),
+        ("env_id", ""),
+    ],
+)
 def test_every_field_is_validated_by_name(field, value):
     with pytest.raises(ValueError, match=field):
         EnvConfig(**{field: value})
@@ -95,8 +111,13 @@ def test_v0_equals_v1_on_the_thesis_mesh_with_its_three_settings():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         v0 = gym.make("ACLDBeam-v0", load_case="random").unwrapped
-    same = ACLDBeamEnv(load_case="random", mesh="thesis", harmonic_modes=(179.0, 1115.0),
-                       model_std=0.0, param_noise_max=0.5)
+    same = ACLDBeamEnv(
+        load_case="random",
+        mesh="thesis",
+        harmonic_modes=(179.0, 1115.0),
+        model_std=0.0,
+        param_noise_max=0.5,
+    )
     acts = np.random.default_rng(3).uniform(-150, 150, (300, 1)).astype(np.float32)
     for env in (v0, same):
         env.reset(seed=9)

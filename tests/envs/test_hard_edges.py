@@ -30,10 +30,16 @@ def _steps_until_done(env, action) -> int:
 
 
 # --- 1. episode length follows episode_length and dt ------------------------------
-@pytest.mark.parametrize("kw, steps", [
-    ({}, 1000), ({"episode_length": 1.5}, 1500), ({"dt": 5e-4, "episode_length": 0.2}, 400),
-    ({"max_episode_steps": 300}, 300), ({"max_episode_steps": None}, 1000),
-])
+@pytest.mark.parametrize(
+    "kw, steps",
+    [
+        ({}, 1000),
+        ({"episode_length": 1.5}, 1500),
+        ({"dt": 5e-4, "episode_length": 0.2}, 400),
+        ({"max_episode_steps": 300}, 300),
+        ({"max_episode_steps": None}, 1000),
+    ],
+)
 def test_gym_make_follows_episode_length(kw, steps):
     env = gym.make("ACLDBeam-v1", **kw)
     assert _steps_until_done(env, np.zeros(1, np.float32)) == steps
@@ -56,12 +62,18 @@ def test_make_vec_and_sb3_follow_episode_length():
 
 
 # --- 3. no silent NaN, bounded randomization and reward ------------------------------
-@pytest.mark.parametrize("kw, name", [
-    ({"param_noise": 20}, "param_noise"), ({"param_noise": 0.2}, "param_noise"),
-    ({"mesh": "thesis", "param_noise": 0.1}, "param_noise"),
-    ({"y_ref": 1e-300}, "y_ref"), ({"sensor_noise": 1e300}, "sensor_noise"),
-    ({"lam": float("inf")}, "lam"), ({"deflection_limit": 10.0}, "deflection_limit"),
-])
+@pytest.mark.parametrize(
+    "kw, name",
+    [
+        ({"param_noise": 20}, "param_noise"),
+        ({"param_noise": 0.2}, "param_noise"),
+        ({"mesh": "thesis", "param_noise": 0.1}, "param_noise"),
+        ({"y_ref": 1e-300}, "y_ref"),
+        ({"sensor_noise": 1e300}, "sensor_noise"),
+        ({"lam": float("inf")}, "lam"),
+        ({"deflection_limit": 10.0}, "deflection_limit"),
+    ],
+)
 def test_out_of_range_arguments_name_themselves(kw, name):
     with pytest.raises(ValueError, match=name):
         ACLDBeamEnv(**kw)
@@ -87,10 +99,14 @@ def test_vector_env_terminates_on_non_finite_state():
 
 
 # --- 4. memory is bounded -----------------------------------------------------------
-@pytest.mark.parametrize("kw, name", [
-    ({"episode_length": 1e4}, "episode_length"), ({"dt": 1e-7}, "dt"),
-    ({"episode_length": 2 * MAX_EPISODE_STEPS * 1e-4, "dt": 1e-4}, "episode_length"),
-])
+@pytest.mark.parametrize(
+    "kw, name",
+    [
+        ({"episode_length": 1e4}, "episode_length"),
+        ({"dt": 1e-7}, "dt"),
+        ({"episode_length": 2 * MAX_EPISODE_STEPS * 1e-4, "dt": 1e-4}, "episode_length"),
+    ],
+)
 def test_episode_size_is_bounded(kw, name):
     with pytest.raises(ValueError, match=name):
         ACLDBeamEnv(**kw)
@@ -102,9 +118,17 @@ def test_vector_env_tables_are_bounded():
 
 
 # --- 6. actions -----------------------------------------------------------------
-@pytest.mark.parametrize("action", [np.zeros((2, 2)), np.zeros((1, 4)), np.zeros(3),
-                                    np.zeros((4, 1), complex), np.full((4, 1), True),
-                                    np.array(["1"] * 4)])
+@pytest.mark.parametrize(
+    "action",
+    [
+        np.zeros((2, 2)),
+        np.zeros((1, 4)),
+        np.zeros(3),
+        np.zeros((4, 1), complex),
+        np.full((4, 1), True),
+        np.array(["1"] * 4),
+    ],
+)
 def test_vector_env_takes_n_or_n_by_1_real_actions_only(action):
     venv = ACLDBeamVectorEnv(num_envs=4, load_case=1)
     venv.reset(seed=0)
@@ -141,8 +165,12 @@ def test_sb3_set_attr_validates_now():
 
 
 def test_any_real_scalar_type_is_accepted():
-    a = ACLDBeamEnv(dt=np.float32(1e-3), y_ref=np.float64(1e-3), lam=np.float16(0.01),
-                    episode_length=np.int64(1))
+    a = ACLDBeamEnv(
+        dt=np.float32(1e-3),
+        y_ref=np.float64(1e-3),
+        lam=np.float16(0.01),
+        episode_length=np.int64(1),
+    )
     assert a.dt == pytest.approx(1e-3) and a.max_steps == 1000
 
 
@@ -163,9 +191,14 @@ def test_vector_reset_seed_is_checked(seed):
         ACLDBeamVectorEnv(num_envs=3).reset(seed=seed)
 
 
-@pytest.mark.parametrize("kw, name", [({"shear_correction": 1e308}, "shear_correction"),
-                                      ({"beam_density": 1e-300}, "beam_density"),
-                                      ({"d31": -1.0}, "d31")])
+@pytest.mark.parametrize(
+    "kw, name",
+    [
+        ({"shear_correction": 1e308}, "shear_correction"),
+        ({"beam_density": 1e-300}, "beam_density"),
+        ({"d31": -1.0}, "d31"),
+    ],
+)
 def test_unphysical_parameters_are_rejected_by_name(kw, name):
     with pytest.raises(ValueError, match=name):
         build_model(**kw)

@@ -24,8 +24,9 @@ def _passive_episode(env, seed):
     while not done:
         obs, r, te, tr, info = env.step(np.zeros(1, np.float32))
         total += r
-        rewards.append((r, info["reward_deflection"] + info["reward_voltage"],
-                        info["reward_scale"], obs[-1]))
+        rewards.append(
+            (r, info["reward_deflection"] + info["reward_voltage"], info["reward_scale"], obs[-1])
+        )
         done = te or tr
     return total, c0, rewards, len(rewards)
 
@@ -43,11 +44,14 @@ def test_passive_return_is_minus_steps(case, compiled):
         assert log_c == np.float32(np.log(c))
 
 
-@pytest.mark.parametrize("changes", [
-    {"temperature": 35.0},                                # another plant: its own c
-    {"amplifier_bandwidth": 500.0, "actuator_delay": 2},  # not acting at zero voltage
-    {"mesh": "thesis", "episode_length": 0.3},
-])
+@pytest.mark.parametrize(
+    "changes",
+    [
+        {"temperature": 35.0},  # another plant: its own c
+        {"amplifier_bandwidth": 500.0, "actuator_delay": 2},  # not acting at zero voltage
+        {"mesh": "thesis", "episode_length": 0.3},
+    ],
+)
 def test_passive_return_with_plant_options(changes):
     env = ACLDBeamEnv(load_case="random", **SCALED, **changes)
     total, _, _, T = _passive_episode(env, seed=11)
@@ -65,8 +69,7 @@ def test_scale_depends_on_load_and_temperature():
 
 def test_vector_env_scales_each_sub_env_and_its_next_episode():
     n = 4
-    venv = gym.make_vec("ACLDBeam-v1", num_envs=n, load_case="random", episode_length=0.2,
-                        **SCALED)
+    venv = gym.make_vec("ACLDBeam-v1", num_envs=n, load_case="random", episode_length=0.2, **SCALED)
     obs, info = venv.reset(seed=7)
     assert obs.shape == (n, 10) and np.allclose(obs[:, -1], np.log(info["reward_scale"]))
     first = info["reward_scale"].copy()
@@ -80,8 +83,7 @@ def test_vector_env_scales_each_sub_env_and_its_next_episode():
     assert np.all(r == 0) and not np.allclose(info["reward_scale"], first)
     assert np.allclose(obs[:, -1], np.log(info["reward_scale"]))
     # the same draws as the single env: sub-env 0 of seed 7 is the single env of seed 7
-    _, c0, _, _ = _passive_episode(ACLDBeamEnv(load_case="random", episode_length=0.2,
-                                               **SCALED), 7)
+    _, c0, _, _ = _passive_episode(ACLDBeamEnv(load_case="random", episode_length=0.2, **SCALED), 7)
     assert c0 == pytest.approx(first[0], rel=1e-12)  # same load; batched round-off
 
 
@@ -99,16 +101,20 @@ def test_off_by_default_and_unchanged():
 
 
 def test_check_env_with_the_options():
-    check_env(ACLDBeamEnv(load_case="random", episode_length=0.05, **SCALED),
-              skip_render_check=True)
+    check_env(
+        ACLDBeamEnv(load_case="random", episode_length=0.05, **SCALED), skip_render_check=True
+    )
 
 
-@pytest.mark.parametrize("kwargs, match", [
-    ({"reward_scale": "episode"}, "reward_scale must be one of"),
-    ({"reward_scale": True}, "reward_scale must be one of"),
-    ({"observe_reward_scale": True}, "observe_reward_scale=True needs a reward_scale"),
-    ({"reward_scale": "passive", "observe_reward_scale": "yes"}, "observe_reward_scale must"),
-])
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"reward_scale": "episode"}, "reward_scale must be one of"),
+        ({"reward_scale": True}, "reward_scale must be one of"),
+        ({"observe_reward_scale": True}, "observe_reward_scale=True needs a reward_scale"),
+        ({"reward_scale": "passive", "observe_reward_scale": "yes"}, "observe_reward_scale must"),
+    ],
+)
 def test_bad_options_name_the_field(kwargs, match):
     with pytest.raises(ValueError, match=match):
         EnvConfig(**kwargs)
@@ -130,12 +136,15 @@ def _policy_episode(env, policy, seed):
     return total, info["reward_scale"], np.asarray(cost)
 
 
-@pytest.mark.parametrize("case, changes", [
-    (1, {}),
-    (3, {}),
-    ("random", {"actuator_delay": 1, "amplifier_bandwidth": 2000.0}),  # the env's own chain
-    ("random", {"temperature": 35.0, "observer": "thesis"}),
-])
+@pytest.mark.parametrize(
+    "case, changes",
+    [
+        (1, {}),
+        (3, {}),
+        ("random", {"actuator_delay": 1, "amplifier_bandwidth": 2000.0}),  # the env's own chain
+        ("random", {"temperature": 35.0, "observer": "thesis"}),
+    ],
+)
 def test_lqr_return_is_minus_steps_without_noise(case, changes):
     """Closed form: c is LQR's mean step cost on the load, so the thesis LQR (the baseline
     policy, run through the env) returns exactly -T on every load and plant option when the
@@ -147,8 +156,9 @@ def test_lqr_return_is_minus_steps_without_noise(case, changes):
     total, c, cost = _policy_episode(env, lqr, seed=5)
     assert total == pytest.approx(-env.max_steps, rel=1e-9)
     assert c == pytest.approx(cost.mean(), rel=1e-9)
-    assert np.abs(env.unwrapped.batch.scale_cost([env.unwrapped.batch.loads[0]])[0] - c) \
-        <= 1e-12 * c
+    assert (
+        np.abs(env.unwrapped.batch.scale_cost([env.unwrapped.batch.loads[0]])[0] - c) <= 1e-12 * c
+    )
 
 
 def test_lqr_scale_against_passive_and_with_sensor_noise():
@@ -170,19 +180,31 @@ def test_lqr_scale_against_passive_and_with_sensor_noise():
 def test_lqr_scale_vector_env_pickle_and_check_env():
     import pickle
 
-    venv = gym.make_vec("ACLDBeam-v1", num_envs=3, load_case="random", episode_length=0.1,
-                        reward_scale="lqr", observe_reward_scale=True)
+    venv = gym.make_vec(
+        "ACLDBeam-v1",
+        num_envs=3,
+        load_case="random",
+        episode_length=0.1,
+        reward_scale="lqr",
+        observe_reward_scale=True,
+    )
     obs, info = venv.reset(seed=2)
-    single = [ACLDBeamEnv(load_case="random", episode_length=0.1, reward_scale="lqr")
-              .reset(seed=2)[1]["reward_scale"]]
+    single = [
+        ACLDBeamEnv(load_case="random", episode_length=0.1, reward_scale="lqr").reset(seed=2)[1][
+            "reward_scale"
+        ]
+    ]
     assert np.allclose(obs[:, -1], np.log(info["reward_scale"]))
     assert info["reward_scale"][0] == pytest.approx(single[0], rel=1e-9)
-    env = ACLDBeamEnv(load_case="random", episode_length=0.05, reward_scale="lqr",
-                      observe_reward_scale=True)
+    env = ACLDBeamEnv(
+        load_case="random", episode_length=0.05, reward_scale="lqr", observe_reward_scale=True
+    )
     env.reset(seed=1)
     clone = pickle.loads(pickle.dumps(env))
     a = np.array([40.0], np.float32)
     assert np.array_equal(env.step(a)[0], clone.step(a)[0])
     assert clone.reset(seed=9)[1]["reward_scale"] == env.reset(seed=9)[1]["reward_scale"]
-    check_env(ACLDBeamEnv(load_case="random", episode_length=0.05, reward_scale="lqr"),
-              skip_render_check=True)
+    check_env(
+        ACLDBeamEnv(load_case="random", episode_length=0.05, reward_scale="lqr"),
+        skip_render_check=True,
+    )

@@ -61,8 +61,9 @@ def _assert_same(rows_c, rows_p):
                 continue
             assert type(ic[key]) is type(ip[key]), key
             scale = np.abs(ip[key]).max()
-            np.testing.assert_allclose(ic[key], ip[key], rtol=1e-9, atol=1e-12 * scale + 1e-15,
-                                       err_msg=key)
+            np.testing.assert_allclose(
+                ic[key], ip[key], rtol=1e-9, atol=1e-12 * scale + 1e-15, err_msg=key
+            )
 
 
 CASES = [
@@ -90,10 +91,20 @@ def test_compiled_and_numpy_steps_give_the_same_episode(kw):
 
 
 @needs_core
-@pytest.mark.parametrize("action", [
-    [35.0], (35.0,), np.array([35.0]), np.array([35]), np.array([35.0], np.float32)[::1],
-    np.array([35.0], ">f4"), np.array([35.0], np.float16), [np.int8(35)],
-], ids=["list", "tuple", "float64", "int", "view", "big-endian", "float16", "int8"])
+@pytest.mark.parametrize(
+    "action",
+    [
+        [35.0],
+        (35.0,),
+        np.array([35.0]),
+        np.array([35]),
+        np.array([35.0], np.float32)[::1],
+        np.array([35.0], ">f4"),
+        np.array([35.0], np.float16),
+        [np.int8(35)],
+    ],
+    ids=["list", "tuple", "float64", "int", "view", "big-endian", "float16", "int8"],
+)
 def test_every_action_type_steps_alike(action):
     # float32/float64 1-element arrays take the compiled path, the rest the numpy path
     ref = _env(True, load_case=2)
@@ -112,8 +123,10 @@ def test_paths_hand_over_state_mid_episode():
     # lists step in numpy, float32 arrays in C: alternating them equals all-C
     acts = np.random.default_rng(2).uniform(-150, 150, (300, 1)).astype(np.float32)
     mixed = [a if k % 3 else [float(a[0])] for k, a in enumerate(acts)]
-    _assert_same(_episode(_env(True, load_case="random", obs_mode="measurement"), 4, mixed),
-                 _episode(_env(True, load_case="random", obs_mode="measurement"), 4, acts))
+    _assert_same(
+        _episode(_env(True, load_case="random", obs_mode="measurement"), 4, mixed),
+        _episode(_env(True, load_case="random", obs_mode="measurement"), 4, acts),
+    )
 
 
 @pytest.mark.parametrize("compiled", [True, False])
@@ -153,36 +166,61 @@ def test_rendering_records_history():
     env.reset(seed=0)
     for v in (0.0, 50.0, -20.0):
         *_, info = env.step(np.array([v], np.float32))
-    assert len(env.history) == 3 and env.history[-1] == (info["time"], info["tip_deflection"],
-                                                         -20.0)
+    assert len(env.history) == 3 and env.history[-1] == (
+        info["time"],
+        info["tip_deflection"],
+        -20.0,
+    )
 
 
 def _core_args(env):
     b = env.batch
-    return dict(GT=b.GT, Z=b.Z, OUT=b.OUT, k=b.k, noise=b.noise, y_hist=b.y_hist,
-                comp=b.codes.comp, ncomp=b.codes.ncomp, pool=b.codes.pool, times=b.times,
-                **b.layout.core_kwargs(), obs_mode=0, n_obs=7, dt=1e-3, y_ref=1e-3, lam=0.01,
-                v_max=120.0, limit=0.02, y_scale=1e-3, slew_step=0.0, dgemm=None)
+    return dict(
+        GT=b.GT,
+        Z=b.Z,
+        OUT=b.OUT,
+        k=b.k,
+        noise=b.noise,
+        y_hist=b.y_hist,
+        comp=b.codes.comp,
+        ncomp=b.codes.ncomp,
+        pool=b.codes.pool,
+        times=b.times,
+        **b.layout.core_kwargs(),
+        obs_mode=0,
+        n_obs=7,
+        dt=1e-3,
+        y_ref=1e-3,
+        lam=0.01,
+        v_max=120.0,
+        limit=0.02,
+        y_scale=1e-3,
+        slew_step=0.0,
+        dgemm=None,
+    )
 
 
 @needs_core
-@pytest.mark.parametrize("change, match", [
-    (dict(GT=np.zeros((59, 67), np.float32)), "GT must be"),
-    (dict(Z=np.zeros((1, 66))), "GT must be"),
-    (dict(noise=np.zeros((2, 1001))), "inconsistent sizes"),
-    (dict(k=np.zeros(1, np.int32)), "k must be"),
-    (dict(obs_mode=3), "obs_mode"),
-    (dict(n_obs=8), "obs_mode"),
-    (dict(n_x=100), "inconsistent sizes"),
-    (dict(o_obs=55), "obs_mode"),
-    (dict(i_loads=10), "inconsistent sizes"),
-    (dict(o_xr=58), "inconsistent sizes"),
-    (dict(Z=np.zeros((1, 134))[:, ::2]), "Z must be"),
-    (dict(noise=np.zeros((1, 1001), ">f8")), "noise must be"),
-    (dict(comp=np.zeros((1, 8, 7))), "load arrays"),
-    (dict(ncomp=np.array([9])), "not encoded correctly"),
-    (dict(dgemm=3), "dgemm must be"),
-])
+@pytest.mark.parametrize(
+    "change, match",
+    [
+        (dict(GT=np.zeros((59, 67), np.float32)), "GT must be"),
+        (dict(Z=np.zeros((1, 66))), "GT must be"),
+        (dict(noise=np.zeros((2, 1001))), "inconsistent sizes"),
+        (dict(k=np.zeros(1, np.int32)), "k must be"),
+        (dict(obs_mode=3), "obs_mode"),
+        (dict(n_obs=8), "obs_mode"),
+        (dict(n_x=100), "inconsistent sizes"),
+        (dict(o_obs=55), "obs_mode"),
+        (dict(i_loads=10), "inconsistent sizes"),
+        (dict(o_xr=58), "inconsistent sizes"),
+        (dict(Z=np.zeros((1, 134))[:, ::2]), "Z must be"),
+        (dict(noise=np.zeros((1, 1001), ">f8")), "noise must be"),
+        (dict(comp=np.zeros((1, 8, 7))), "load arrays"),
+        (dict(ncomp=np.array([9])), "not encoded correctly"),
+        (dict(dgemm=3), "dgemm must be"),
+    ],
+)
 def test_core_constructor_rejects_inconsistent_arrays(change, match):
     from acld_gym.envs._stepcore import BatchCore
 
@@ -247,8 +285,13 @@ def test_compiled_info_keys_are_the_schema():
 
 def test_pure_python_switch_is_read_at_import():
     code = "import acld_gym.envs.beam_env as e; print(e.COMPILED_STEP)"
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         check=True, env={**os.environ, "ACLD_GYM_PURE_PYTHON": "1"})
+    out = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        check=True,
+        env={**os.environ, "ACLD_GYM_PURE_PYTHON": "1"},
+    )
     assert out.stdout.strip() == "False"
     assert batch_module.COMPILED_STEP is (batch_module.BatchCore is not None)
 
@@ -268,11 +311,35 @@ def test_non_finite_state_terminates_and_says_why(compiled):
 
 
 @pytest.mark.parametrize("compiled", [True, False] if COMPILED_STEP else [False])
-@pytest.mark.parametrize("action", [
-    "60", b"60", [True], np.array([True]), np.array([60 + 1j]), np.float32(60.0), 60.0,
-    np.array([[60.0]], np.float32), np.array([60.0, 1.0]), [None], np.array([np.nan]),
-], ids=["str", "bytes", "bool", "bool-array", "complex", "np-scalar", "float", "2d", "two",
-        "none", "nan"])
+@pytest.mark.parametrize(
+    "action",
+    [
+        "60",
+        b"60",
+        [True],
+        np.array([True]),
+        np.array([60 + 1j]),
+        np.float32(60.0),
+        60.0,
+        np.array([[60.0]], np.float32),
+        np.array([60.0, 1.0]),
+        [None],
+        np.array([np.nan]),
+    ],
+    ids=[
+        "str",
+        "bytes",
+        "bool",
+        "bool-array",
+        "complex",
+        "np-scalar",
+        "float",
+        "2d",
+        "two",
+        "none",
+        "nan",
+    ],
+)
 def test_bad_actions_are_rejected_and_leave_the_state_intact(compiled, action):
     # Issue 14: only real numbers of shape (1,) are an action.
     env = _env(compiled, load_case=2)
@@ -294,9 +361,14 @@ def test_layout_owns_every_slot():
         env = ACLDBeamEnv(mesh=mesh)
         lay = env.batch.layout
         assert isinstance(lay, StepLayout) and env.batch.GT.shape == (lay.z_size, lay.out_size)
-        z_slots = [lay.x, lay.xhat, slice(lay.y_meas, lay.y_meas + 1),
-                   slice(lay.voltage, lay.voltage + 1), lay.loads,
-                   slice(lay.noise, lay.noise + 1)]
+        z_slots = [
+            lay.x,
+            lay.xhat,
+            slice(lay.y_meas, lay.y_meas + 1),
+            slice(lay.voltage, lay.voltage + 1),
+            lay.loads,
+            slice(lay.noise, lay.noise + 1),
+        ]
         assert [s.start for s in z_slots[1:]] == [s.stop for s in z_slots[:-1]]
         assert z_slots[-1].stop == lay.z_size
         assert lay.out_estimate.stop == lay.out_size

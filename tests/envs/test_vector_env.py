@@ -26,15 +26,18 @@ def _vector_rollout(kw, seed, acts):
     return steps
 
 
-@pytest.mark.parametrize("kw", [
-    dict(load_case="random"),
-    dict(load_case="random", obs_mode="measurement", lam=0.1),
-    dict(load_case=1, observer="thesis"),
-    dict(load_case=2, obs_mode="full"),
-    dict(load_case=3, sensor_noise=0.0),
-    dict(load_case="random", param_noise=0.05, obs_mode="full"),
-    dict(load_case="random", mesh="thesis", param_noise=0.05),
-])
+@pytest.mark.parametrize(
+    "kw",
+    [
+        dict(load_case="random"),
+        dict(load_case="random", obs_mode="measurement", lam=0.1),
+        dict(load_case=1, observer="thesis"),
+        dict(load_case=2, obs_mode="full"),
+        dict(load_case=3, sensor_noise=0.0),
+        dict(load_case="random", param_noise=0.05, obs_mode="full"),
+        dict(load_case="random", mesh="thesis", param_noise=0.05),
+    ],
+)
 def test_equal_trajectories_with_single_env_across_autoresets(kw):
     kw = dict(kw, episode_length=SHORT)
     acts = np.random.default_rng(0).uniform(-150, 150, (120, N, 1)).astype(np.float32)
@@ -111,8 +114,14 @@ def test_bad_action_raises_and_leaves_state(bad):
 
 
 def test_same_validation_errors_as_single_env():
-    for kw in (dict(load_case=4), dict(dt=-1.0), dict(obs_mode="x"), dict(sensor_noise=-1.0),
-               dict(episode_length=1e-4), dict(render_mode="human")):
+    for kw in (
+        dict(load_case=4),
+        dict(dt=-1.0),
+        dict(obs_mode="x"),
+        dict(sensor_noise=-1.0),
+        dict(episode_length=1e-4),
+        dict(render_mode="human"),
+    ):
         with pytest.raises(ValueError):
             ACLDBeamVectorEnv(num_envs=2, **kw)
     with pytest.raises(ValueError):

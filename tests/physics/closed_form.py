@@ -60,27 +60,40 @@ import numpy as np
 import scipy.linalg as sla
 from scipy.optimize import brentq
 
-__all__ = ["cantilever_beta_l", "euler_bernoulli_cantilever", "timoshenko_wavenumbers",
-           "timoshenko_cantilever_determinant", "timoshenko_cantilever_frequencies",
-           "timoshenko_tip_deflection", "reduced_integration_tip_deflection", "ghm_modulus",
-           "Sandwich", "rku_flexural_rigidity", "mead_markus_flexural_rigidity",
-           "loss_factor", "rku_pole", "mead_markus_determinant", "mead_markus_pole",
-           "SUPPORTS"]
+__all__ = [
+    "cantilever_beta_l",
+    "euler_bernoulli_cantilever",
+    "timoshenko_wavenumbers",
+    "timoshenko_cantilever_determinant",
+    "timoshenko_cantilever_frequencies",
+    "timoshenko_tip_deflection",
+    "reduced_integration_tip_deflection",
+    "ghm_modulus",
+    "Sandwich",
+    "rku_flexural_rigidity",
+    "mead_markus_flexural_rigidity",
+    "loss_factor",
+    "rku_pole",
+    "mead_markus_determinant",
+    "mead_markus_pole",
+    "SUPPORTS",
+]
 
 
 # --- 1. Euler-Bernoulli cantilever ------------------------------------------------
+
 
 def cantilever_beta_l(n: int = 3) -> np.ndarray:
     """The first ``n`` roots of :math:`1 + \\cos x \\cosh x = 0` (clamped-free EB beam),
     1.87510407, 4.69409113, 7.85475744, ... (dimensionless)."""
     f = lambda x: 1.0 + np.cos(x) * np.cosh(x)  # noqa: E731
     # exactly one root in each [(j - 1) pi, j pi]: cos x changes sign once there
-    return np.array([brentq(f, (j - 1) * np.pi, j * np.pi, xtol=1e-15)
-                     for j in range(1, n + 1)])
+    return np.array([brentq(f, (j - 1) * np.pi, j * np.pi, xtol=1e-15) for j in range(1, n + 1)])
 
 
-def euler_bernoulli_cantilever(E: float, I: float, rho: float, A: float, L: float,
-                               n: int = 3) -> np.ndarray:
+def euler_bernoulli_cantilever(
+    E: float, I: float, rho: float, A: float, L: float, n: int = 3
+) -> np.ndarray:
     """Natural frequencies [rad/s] of a uniform EB cantilever,
     :math:`(\\beta_n L)^2 \\sqrt{EI/(\\rho A L^4)}`; E [Pa], I [m^4], rho [kg/m^3],
     A [m^2], L [m]."""
@@ -89,8 +102,10 @@ def euler_bernoulli_cantilever(E: float, I: float, rho: float, A: float, L: floa
 
 # --- 2. Timoshenko cantilever -------------------------------------------------------
 
-def timoshenko_wavenumbers(omega: float, E: float, G: float, k: float, rho: float,
-                           A: float, I: float) -> tuple[float, float]:
+
+def timoshenko_wavenumbers(
+    omega: float, E: float, G: float, k: float, rho: float, A: float, I: float
+) -> tuple[float, float]:
     r"""Wavenumbers :math:`(\alpha, \beta)` [1/m] of a Timoshenko beam at ``omega`` below
     the cut-off :math:`\sqrt{kGA/(\rho I)}`.
 
@@ -115,8 +130,9 @@ def timoshenko_wavenumbers(omega: float, E: float, G: float, k: float, rho: floa
     return float(np.sqrt(0.5 * (-b1 + disc))), float(np.sqrt(0.5 * (b1 + disc)))
 
 
-def timoshenko_cantilever_determinant(omega: float, E: float, G: float, k: float,
-                                      rho: float, A: float, I: float, L: float) -> float:
+def timoshenko_cantilever_determinant(
+    omega: float, E: float, G: float, k: float, rho: float, A: float, I: float, L: float
+) -> float:
     r"""Frequency function of the clamped-free Timoshenko beam (zero at a natural
     frequency ``omega`` [rad/s]).
 
@@ -163,8 +179,9 @@ def timoshenko_cantilever_determinant(omega: float, E: float, G: float, k: float
     return float((a11 * a22 - a12 * a21) / (r * np.cosh(a) ** 2 * al * be))
 
 
-def timoshenko_cantilever_frequencies(E: float, G: float, k: float, rho: float, A: float,
-                                      I: float, L: float, n: int = 3) -> np.ndarray:
+def timoshenko_cantilever_frequencies(
+    E: float, G: float, k: float, rho: float, A: float, I: float, L: float, n: int = 3
+) -> np.ndarray:
     """The first ``n`` natural frequencies [rad/s] of a uniform Timoshenko cantilever
     (roots of :func:`timoshenko_cantilever_determinant`, bracketed on a fine grid below
     the Euler-Bernoulli frequencies, which bound them from above)."""
@@ -174,8 +191,16 @@ def timoshenko_cantilever_frequencies(E: float, G: float, k: float, rho: float, 
     roots = []
     for i in range(len(grid) - 1):
         if np.sign(f[i]) != np.sign(f[i + 1]):
-            roots.append(brentq(timoshenko_cantilever_determinant, grid[i], grid[i + 1],
-                                args=(E, G, k, rho, A, I, L), xtol=1e-13, rtol=1e-15))
+            roots.append(
+                brentq(
+                    timoshenko_cantilever_determinant,
+                    grid[i],
+                    grid[i + 1],
+                    args=(E, G, k, rho, A, I, L),
+                    xtol=1e-13,
+                    rtol=1e-15,
+                )
+            )
         if len(roots) == n:
             break
     if len(roots) != n:
@@ -185,15 +210,18 @@ def timoshenko_cantilever_frequencies(E: float, G: float, k: float, rho: float, 
 
 # --- 3. Static tip deflection ------------------------------------------------------
 
-def timoshenko_tip_deflection(P: float, E: float, G: float, k: float, A: float, I: float,
-                              L: float) -> float:
+
+def timoshenko_tip_deflection(
+    P: float, E: float, G: float, k: float, A: float, I: float, L: float
+) -> float:
     """Tip deflection [m] of a Timoshenko cantilever under a tip load P [N]:
     :math:`P L^3/(3EI) + P L/(kGA)` (bending + shear; exact for Timoshenko theory)."""
     return P * L**3 / (3.0 * E * I) + P * L / (k * G * A)
 
 
-def reduced_integration_tip_deflection(P: float, E: float, G: float, k: float, A: float,
-                                       I: float, L: float, n_elements: int) -> float:
+def reduced_integration_tip_deflection(
+    P: float, E: float, G: float, k: float, A: float, I: float, L: float, n_elements: int
+) -> float:
     r"""Tip deflection [m] that the linear (two-node) Timoshenko element with one-point
     shear integration gives on ``n_elements`` equal elements:
     :math:`P L^3/(3EI)\,(1 - 1/(4N^2)) + P L/(kGA)`.
@@ -207,11 +235,11 @@ def reduced_integration_tip_deflection(P: float, E: float, G: float, k: float, A
     :math:`h^3 P/(12EI)` per element, i.e. :math:`PL^3/(12EIN^2)` in total. (Reddy's
     "interdependent interpolation" element would be nodally exact; this one is not.)
     """
-    return (P * L**3 / (3.0 * E * I) * (1.0 - 0.25 / n_elements**2)
-            + P * L / (k * G * A))
+    return P * L**3 / (3.0 * E * I) * (1.0 - 0.25 / n_elements**2) + P * L / (k * G * A)
 
 
 # --- 4. GHM modulus -----------------------------------------------------------------
+
 
 def ghm_modulus(s: complex, kappa: float, alpha: float, omega: float, zeta: float) -> complex:
     r"""GHM shear modulus [Pa] at the Laplace variable ``s`` [1/s] (one mini-oscillator):
@@ -219,11 +247,13 @@ def ghm_modulus(s: complex, kappa: float, alpha: float, omega: float, zeta: floa
     + \hat\omega^2)]` (Golla & Hughes 1985; thesis eq. (20)). ``G(1j*w)`` is the complex
     modulus :math:`G'(\omega) + jG''(\omega)` at the real frequency w."""
     s = complex(s)
-    return kappa * (1.0 + alpha * (s * s + 2.0 * zeta * omega * s)
-                    / (s * s + 2.0 * zeta * omega * s + omega**2))
+    return kappa * (
+        1.0 + alpha * (s * s + 2.0 * zeta * omega * s) / (s * s + 2.0 * zeta * omega * s + omega**2)
+    )
 
 
 # --- 5. Sandwich beam ---------------------------------------------------------------
+
 
 @dataclass(frozen=True)
 class Sandwich:
@@ -300,12 +330,19 @@ def rku_flexural_rigidity(p: Sandwich, G2: complex, k: float) -> complex:
     E1, E2, E3 = p.E1, p.E2, p.E3
     H21, H31 = 0.5 * (t1 + t2), 0.5 * t1 + t2 + 0.5 * t3
     g = G2 / (E3 * t3 * t2 * k**2)
-    D = ((E2 * t2 * (H21 - 0.5 * H31) + g * (E2 * t2 * H21 + E3 * t3 * H31))
-         / (E1 * t1 + 0.5 * E2 * t2 + g * (E1 * t1 + E2 * t2 + E3 * t3)))
-    ei = (E1 * t1**3 / 12 + E2 * t2**3 / 12 + E3 * t3**3 / 12
-          - E2 * t2**2 / 12 * (H31 - D) / (1 + g)
-          + E1 * t1 * D**2 + E2 * t2 * (H21 - D) ** 2 + E3 * t3 * (H31 - D) ** 2
-          - (0.5 * E2 * t2 * (H21 - D) + E3 * t3 * (H31 - D)) * (H31 - D) / (1 + g))
+    D = (E2 * t2 * (H21 - 0.5 * H31) + g * (E2 * t2 * H21 + E3 * t3 * H31)) / (
+        E1 * t1 + 0.5 * E2 * t2 + g * (E1 * t1 + E2 * t2 + E3 * t3)
+    )
+    ei = (
+        E1 * t1**3 / 12
+        + E2 * t2**3 / 12
+        + E3 * t3**3 / 12
+        - E2 * t2**2 / 12 * (H31 - D) / (1 + g)
+        + E1 * t1 * D**2
+        + E2 * t2 * (H21 - D) ** 2
+        + E3 * t3 * (H31 - D) ** 2
+        - (0.5 * E2 * t2 * (H21 - D) + E3 * t3 * (H31 - D)) * (H31 - D) / (1 + g)
+    )
     return p.b * ei
 
 
@@ -335,7 +372,7 @@ def loss_factor(lam: complex) -> float:
     describes; for light damping it equals :math:`2\zeta` of the pole
     (:math:`2\zeta\sqrt{1-\zeta^2}/(1 - 2\zeta^2)` exactly).
     """
-    z = -complex(lam) ** 2
+    z = -(complex(lam) ** 2)
     return z.imag / z.real
 
 
@@ -346,9 +383,15 @@ def _pole_from(mw2: complex) -> complex:
     return lam if lam.imag > 0 else -lam
 
 
-def rku_pole(p: Sandwich, k: float, G: Callable[[complex], complex], *,
-             evaluate_at: str = "pole", rigidity=rku_flexural_rigidity,
-             iterations: int = 100) -> complex:
+def rku_pole(
+    p: Sandwich,
+    k: float,
+    G: Callable[[complex], complex],
+    *,
+    evaluate_at: str = "pole",
+    rigidity=rku_flexural_rigidity,
+    iterations: int = 100,
+) -> complex:
     r"""Complex eigenvalue [1/s] of the sandwich mode of wavenumber ``k`` [1/m] from
     :math:`-m\lambda^2 = k^4 EI^*(k, G_2)`.
 
@@ -414,8 +457,9 @@ def _mead_markus_system(p: Sandwich, G2: complex, mw2: complex) -> np.ndarray:
 SUPPORTS = ("clamped-free", "pinned-pinned")
 
 
-def mead_markus_determinant(p: Sandwich, G2: complex, mw2: complex,
-                            supports: str = "clamped-free") -> complex:
+def mead_markus_determinant(
+    p: Sandwich, G2: complex, mw2: complex, supports: str = "clamped-free"
+) -> complex:
     r"""Frequency determinant of the Mead-Markus sandwich beam at
     :math:`\Omega = -\lambda^2` = ``mw2`` [1/s^2] (:math:`\omega^2` for real frequencies)
     with core modulus ``G2`` [Pa]. The solution is propagated exactly with the matrix
@@ -455,8 +499,13 @@ def mead_markus_determinant(p: Sandwich, G2: complex, mw2: complex,
     return complex(np.linalg.det(R @ T[:, unknown]))
 
 
-def _secant(f: Callable[[complex], complex], x0: complex, x1: complex,
-            tol: float = 1e-13, maxiter: int = 100) -> complex:
+def _secant(
+    f: Callable[[complex], complex],
+    x0: complex,
+    x1: complex,
+    tol: float = 1e-13,
+    maxiter: int = 100,
+) -> complex:
     f0, f1 = f(x0), f(x1)
     for _ in range(maxiter):
         if f1 == f0:
@@ -468,9 +517,15 @@ def _secant(f: Callable[[complex], complex], x0: complex, x1: complex,
     raise RuntimeError("secant iteration did not converge")
 
 
-def mead_markus_pole(p: Sandwich, G: Callable[[complex], complex], lam0: complex, *,
-                     supports: str = "clamped-free", evaluate_at: str = "pole",
-                     iterations: int = 100) -> complex:
+def mead_markus_pole(
+    p: Sandwich,
+    G: Callable[[complex], complex],
+    lam0: complex,
+    *,
+    supports: str = "clamped-free",
+    evaluate_at: str = "pole",
+    iterations: int = 100,
+) -> complex:
     r"""Complex eigenvalue [1/s] of the Mead-Markus sandwich beam (``supports`` as in
     :func:`mead_markus_determinant`) nearest the starting guess ``lam0`` (e.g.
     :func:`rku_pole`): a root of the determinant in :math:`\Omega = -\lambda^2`.
@@ -487,8 +542,9 @@ def mead_markus_pole(p: Sandwich, G: Callable[[complex], complex], lam0: complex
         s = lam if evaluate_at == "pole" else 1j * np.sqrt((-lam * lam).real)
         G2 = G(s)
         om = -lam * lam
-        om = _secant(lambda z, G2=G2: mead_markus_determinant(p, G2, z, supports),
-                     om, om * (1 + 1e-4))
+        om = _secant(
+            lambda z, G2=G2: mead_markus_determinant(p, G2, z, supports), om, om * (1 + 1e-4)
+        )
         new = _pole_from(om)
         if abs(new - lam) < 1e-13 * abs(lam):
             return new

@@ -35,8 +35,12 @@ def _matlab_element_indices() -> list[list[int]]:
             index = list(range(1, 7)) if iel == 1 else index[3:6] + [i + 3 for i in index[3:6]]
         elif iel <= nelL + nelC:
             if iel == nelL + 1:
-                index = (index[3:6] + [i + 3 for i in index[3:6]] + [i + 6 for i in index[3:6]]
-                         + [index[5] + 7])
+                index = (
+                    index[3:6]
+                    + [i + 3 for i in index[3:6]]
+                    + [i + 6 for i in index[3:6]]
+                    + [index[5] + 7]
+                )
             else:
                 index = index[4:8] + [i + 6 for i in index[4:10]]
         else:
@@ -137,8 +141,7 @@ def test_node_positions(mesh):
     assert_allclose(np.diff(x), [le for _, le, _ in d.elements], rtol=1e-12)
     # patch boundaries are nodes
     assert_allclose(x[mesh.n_before], P.patch_start, rtol=1e-12)
-    assert_allclose(x[mesh.n_before + mesh.n_patch], P.patch_start + P.patch_length,
-                    rtol=1e-12)
+    assert_allclose(x[mesh.n_before + mesh.n_patch], P.patch_start + P.patch_length, rtol=1e-12)
 
 
 def test_mesh_section_mismatch_rejected():
@@ -168,8 +171,10 @@ def test_global_matrices_symmetric_and_rigid_modes(mesh):
     ev = np.linalg.eigvalsh(K)
     assert np.sum(np.abs(ev) < 1e-12 * ev.max()) == 3
     # total transverse mass = beam + layers on the patch (Euler-Bernoulli lumped total)
-    total = (P.beam_density * P.beam_area * P.length
-             + (P.pzt_density * P.pzt_area + P.vem_density * P.vem_area) * P.patch_length)
+    total = (
+        P.beam_density * P.beam_area * P.length
+        + (P.pzt_density * P.pzt_area + P.vem_density * P.vem_area) * P.patch_length
+    )
     assert_allclose(R[:, 1] @ M @ R[:, 1], total, rtol=1e-12)
     assert_allclose(R[:, 0] @ M @ R[:, 0], total, rtol=1e-12)
     # piezo force: self-equilibrated (no net axial force / moment on the free structure)
@@ -182,7 +187,10 @@ def test_piezo_vector_assembled_only_at_patch_end_nodes():
     mesh = Mesh(2, 3, 4)
     d = number_dofs(P, mesh)
     _, _, _, Pc = assemble(P, d)
-    loaded = {n for n, nd in enumerate(d.node_dofs)
-              if np.any(np.abs(Pc[list(nd.values())]) > 1e-12 * np.abs(Pc).max())}
+    loaded = {
+        n
+        for n, nd in enumerate(d.node_dofs)
+        if np.any(np.abs(Pc[list(nd.values())]) > 1e-12 * np.abs(Pc).max())
+    }
     assert loaded == {mesh.n_before, mesh.n_before + mesh.n_patch}
     assert_array_equal(Pc[list(d.z_dofs)], 0.0)

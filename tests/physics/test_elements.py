@@ -25,11 +25,11 @@ from acld_gym.physics.params import BeamParameters
 
 P = BeamParameters()
 LENGTHS = [0.03, 0.06, 0.09, 0.0075]
-BEAM_W = [1, 4]          # w DOFs of the beam element
+BEAM_W = [1, 4]  # w DOFs of the beam element
 BEAM_U = [0, 3]
 ACLD_W = [1, 5]
 ACLD_U = [0, 4]
-ACLD_G = [3, 7]          # gamma DOFs
+ACLD_G = [3, 7]  # gamma DOFs
 Z = [8, 9]
 
 
@@ -57,6 +57,7 @@ def _rigid_modes(n_node_dofs: int, le: float, n_extra: int = 0) -> np.ndarray:
 
 
 # --- symmetry and definiteness ------------------------------------------------
+
 
 @pytest.mark.parametrize("le", LENGTHS)
 @pytest.mark.parametrize("make", [timoshenko_element, acld_element])
@@ -115,8 +116,9 @@ def test_shear_uses_reduced_integration():
 
 
 @pytest.mark.parametrize("le", LENGTHS)
-@pytest.mark.parametrize("make, terms", [(timoshenko_element, timoshenko_terms),
-                                         (acld_element, acld_terms)])
+@pytest.mark.parametrize(
+    "make, terms", [(timoshenko_element, timoshenko_terms), (acld_element, acld_terms)]
+)
 def test_element_is_the_sum_of_its_terms(make, terms, le):
     # The parameter-affine form the randomized plants rely on: coefficients x unit matrices
     # reproduce the element, and scaling a material parameter scales its terms only.
@@ -127,6 +129,7 @@ def test_element_is_the_sum_of_its_terms(make, terms, le):
 
 
 # --- mass totals ----------------------------------------------------------------
+
 
 @pytest.mark.parametrize("le", LENGTHS)
 def test_beam_element_total_mass(le):
@@ -142,8 +145,9 @@ def test_beam_element_total_mass(le):
 def test_acld_element_total_mass(le):
     # beam + VEM + PZT mass per unit length, times Le; axial rigid motion moves all layers
     M = acld_element(P, le).M
-    m = (P.beam_density * P.beam_area + P.vem_density * P.vem_area
-         + P.pzt_density * P.pzt_area) * le
+    m = (
+        P.beam_density * P.beam_area + P.vem_density * P.vem_area + P.pzt_density * P.pzt_area
+    ) * le
     one = np.ones(2)
     assert_allclose(one @ M[np.ix_(ACLD_W, ACLD_W)] @ one, m, rtol=1e-13)
     assert_allclose(one @ M[np.ix_(ACLD_U, ACLD_U)] @ one, m, rtol=1e-13)
@@ -151,40 +155,65 @@ def test_acld_element_total_mass(le):
 
 # --- piezo force vector -----------------------------------------------------------
 
+
 @pytest.mark.parametrize("le", LENGTHS)
 def test_acld_piezo_vector_eq32(le):
     # thesis eq. (32): Pc_e = Ec d31 b [-1 0 h -ts 1 0 -h ts] (independent of Le), z rows 0
     h, ts = P.pzt_offset, P.vem_thickness
-    expected = P.pzt_youngs_modulus * P.d31 * P.width * np.array(
-        [-1, 0, h, -ts, 1, 0, -h, ts, 0, 0])
+    expected = (
+        P.pzt_youngs_modulus * P.d31 * P.width * np.array([-1, 0, h, -ts, 1, 0, -h, ts, 0, 0])
+    )
     assert_allclose(acld_element(P, le).Pc, expected, rtol=1e-13, atol=0)
     assert_array_equal(timoshenko_element(P, le).Pc, np.zeros(6))
 
 
 # --- comparison with the printed MATLAB closed forms --------------------------------
 
+
 def _timoshenko_matlab(p: BeamParameters, Le: float):
     """TimoshenkoFEM2.m as printed in Appendix A."""
-    Eb, Gb, rhob, k = p.beam_youngs_modulus, p.beam_shear_modulus, p.beam_density, \
-        p.shear_correction
+    Eb, Gb, rhob, k = (
+        p.beam_youngs_modulus,
+        p.beam_shear_modulus,
+        p.beam_density,
+        p.shear_correction,
+    )
     Ab, Ib = p.width * p.beam_thickness, p.width * p.beam_thickness**3 / 12
     z = np.zeros(6)
     Kwbb = Eb * Ib / Le * np.array([z, z, [0, 0, 1, 0, 0, -1], z, z, [0, 0, -1, 0, 0, 1]])
-    Kwbs = Gb * Ab * k / 4 / Le * np.array([
-        [0, 0, 0, 0, 0, 0],
-        [0, 4, 2 * Le, 0, -4, 2 * Le],
-        [0, 2 * Le, Le**2, 0, -2 * Le, Le**2],
-        [0, 0, 0, 0, 0, 0],
-        [0, -4, -2 * Le, 0, 4, -2 * Le],
-        [0, 2 * Le, Le**2, 0, -2 * Le, Le**2]])
+    Kwbs = (
+        Gb
+        * Ab
+        * k
+        / 4
+        / Le
+        * np.array(
+            [
+                [0, 0, 0, 0, 0, 0],
+                [0, 4, 2 * Le, 0, -4, 2 * Le],
+                [0, 2 * Le, Le**2, 0, -2 * Le, Le**2],
+                [0, 0, 0, 0, 0, 0],
+                [0, -4, -2 * Le, 0, 4, -2 * Le],
+                [0, 2 * Le, Le**2, 0, -2 * Le, Le**2],
+            ]
+        )
+    )
     Kub = Eb * Ab / Le * np.array([[1, 0, 0, -1, 0, 0], z, z, [-1, 0, 0, 1, 0, 0], z, z])
-    Mwb = rhob * Le / 6 * np.array([
-        [0, 0, 0, 0, 0, 0],
-        [0, 2 * Ab, 0, 0, Ab, 0],
-        [0, 0, 2 * Ib, 0, 0, Ib],
-        [0, 0, 0, 0, 0, 0],
-        [0, Ab, 0, 0, 2 * Ab, 0],
-        [0, 0, Ib, 0, 0, 2 * Ib]])
+    Mwb = (
+        rhob
+        * Le
+        / 6
+        * np.array(
+            [
+                [0, 0, 0, 0, 0, 0],
+                [0, 2 * Ab, 0, 0, Ab, 0],
+                [0, 0, 2 * Ib, 0, 0, Ib],
+                [0, 0, 0, 0, 0, 0],
+                [0, Ab, 0, 0, 2 * Ab, 0],
+                [0, 0, Ib, 0, 0, 2 * Ib],
+            ]
+        )
+    )
     Mub = rhob * Ab * Le / 6 * np.array([[2, 0, 0, 1, 0, 0], z, z, [1, 0, 0, 2, 0, 0], z, z])
     Me = Mwb + Mub
     Ke = Kwbb + Kwbs + Kub
@@ -221,67 +250,153 @@ def _acld_matlab(p: BeamParameters, Le: float):
     # Beam layer: same closed forms as TimoshenkoFEM2 (Kwbb, Kwbs, Kub, Mwb, Mub)
     Mb, _, Kb = _timoshenko_matlab(dataclasses.replace(p, rayleigh_mass=0.0), Le)
     # PZT bending/shear/transverse mass: same forms with Ec, Gc, rhoc, Ac, Ic
-    pc = dataclasses.replace(p, beam_youngs_modulus=Ec, beam_shear_modulus=p.pzt_shear_modulus,
-                             beam_density=rhoc, beam_thickness=tc)
+    pc = dataclasses.replace(
+        p,
+        beam_youngs_modulus=Ec,
+        beam_shear_modulus=p.pzt_shear_modulus,
+        beam_density=rhoc,
+        beam_thickness=tc,
+    )
     Mc6, _, Kc6 = _timoshenko_matlab(pc, Le)
     # drop the PZT's own axial terms (Kub/Mub pattern); Kuc/Muc below replace them
     Kc6[np.ix_([0, 3], [0, 3])] = 0.0
     Mc6[np.ix_([0, 3], [0, 3])] = 0.0
     z8 = np.zeros(8)
-    Kuc = Ec * Ac / Le * np.array([
-        [1, 0, -h, ts, -1, 0, h, -ts],
-        z8,
-        [-h, 0, h**2, -h * ts, h, 0, -h**2, h * ts],
-        [ts, 0, -h * ts, ts**2, -ts, 0, h * ts, -ts**2],
-        [-1, 0, h, -ts, 1, 0, -h, ts],
-        z8,
-        [h, 0, -h**2, h * ts, -h, 0, h**2, -h * ts],
-        [-ts, 0, h * ts, -ts**2, ts, 0, -h * ts, ts**2]])
-    Muc = rhoc * Ac * Le * np.array([
-        [1 / 3, 0, -h / 3, ts / 3, 1 / 6, 0, -h / 6, ts / 6],
-        z8,
-        [-h / 3, 0, h**2 / 3, -h * ts / 3, -h / 6, 0, h**2 / 6, -h * ts / 6],
-        [ts / 3, 0, -h * ts / 3, ts**2 / 3, ts / 6, 0, -h * ts / 6, ts**2 / 6],
-        [1 / 6, 0, -h / 6, ts / 6, 1 / 3, 0, -h / 3, ts / 3],
-        z8,
-        [-h / 6, 0, h**2 / 6, -h * ts / 6, -h / 3, 0, h**2 / 3, -h * ts / 3],
-        [ts / 6, 0, -h * ts / 6, ts**2 / 6, ts / 3, 0, -h * ts / 3, ts**2 / 3]])
+    Kuc = (
+        Ec
+        * Ac
+        / Le
+        * np.array(
+            [
+                [1, 0, -h, ts, -1, 0, h, -ts],
+                z8,
+                [-h, 0, h**2, -h * ts, h, 0, -(h**2), h * ts],
+                [ts, 0, -h * ts, ts**2, -ts, 0, h * ts, -(ts**2)],
+                [-1, 0, h, -ts, 1, 0, -h, ts],
+                z8,
+                [h, 0, -(h**2), h * ts, -h, 0, h**2, -h * ts],
+                [-ts, 0, h * ts, -(ts**2), ts, 0, -h * ts, ts**2],
+            ]
+        )
+    )
+    Muc = (
+        rhoc
+        * Ac
+        * Le
+        * np.array(
+            [
+                [1 / 3, 0, -h / 3, ts / 3, 1 / 6, 0, -h / 6, ts / 6],
+                z8,
+                [-h / 3, 0, h**2 / 3, -h * ts / 3, -h / 6, 0, h**2 / 6, -h * ts / 6],
+                [ts / 3, 0, -h * ts / 3, ts**2 / 3, ts / 6, 0, -h * ts / 6, ts**2 / 6],
+                [1 / 6, 0, -h / 6, ts / 6, 1 / 3, 0, -h / 3, ts / 3],
+                z8,
+                [-h / 6, 0, h**2 / 6, -h * ts / 6, -h / 3, 0, h**2 / 3, -h * ts / 3],
+                [ts / 6, 0, -h * ts / 6, ts**2 / 6, ts / 3, 0, -h * ts / 3, ts**2 / 3],
+            ]
+        )
+    )
     # VEM
     c = (tb + ts) / 2
-    Kwsb = Es * Is / Le * np.array([z8, z8, [0, 0, 1, 0, 0, 0, -1, 0], z8, z8, z8,
-                                    [0, 0, -1, 0, 0, 0, 1, 0], z8])
-    Kus = Es * As / Le * np.array([
-        [1, 0, -c, ts / 2, -1, 0, c, -ts / 2],
-        z8,
-        [-c, 0, c**2, -c * ts / 2, c, 0, -c**2, c * ts / 2],
-        [ts / 2, 0, -c * ts / 2, ts**2 / 4, -ts / 2, 0, c * ts / 2, -ts**2 / 4],
-        [-1, 0, c, -ts / 2, 1, 0, -c, ts / 2],
-        z8,
-        [c, 0, -c**2, c * ts / 2, -c, 0, c**2, -c * ts / 2],
-        [-ts / 2, 0, c * ts / 2, -ts**2 / 4, ts / 2, 0, -c * ts / 2, ts**2 / 4]])
-    Ks = As * (kappa + alpha * kappa) * Le * np.array([
-        z8, z8, z8, [0, 0, 0, 1 / 3, 0, 0, 0, 1 / 6], z8, z8, z8,
-        [0, 0, 0, 1 / 6, 0, 0, 0, 1 / 3]])
-    Mws = rhos * Le * np.array([
-        z8,
-        [0, As / 3, 0, 0, 0, As / 6, 0, 0],
-        [0, 0, Is / 3, 0, 0, 0, Is / 6, 0],
-        z8, z8,
-        [0, As / 6, 0, 0, 0, As / 3, 0, 0],
-        [0, 0, Is / 6, 0, 0, 0, Is / 3, 0],
-        z8])
+    Kwsb = (
+        Es
+        * Is
+        / Le
+        * np.array([z8, z8, [0, 0, 1, 0, 0, 0, -1, 0], z8, z8, z8, [0, 0, -1, 0, 0, 0, 1, 0], z8])
+    )
+    Kus = (
+        Es
+        * As
+        / Le
+        * np.array(
+            [
+                [1, 0, -c, ts / 2, -1, 0, c, -ts / 2],
+                z8,
+                [-c, 0, c**2, -c * ts / 2, c, 0, -(c**2), c * ts / 2],
+                [ts / 2, 0, -c * ts / 2, ts**2 / 4, -ts / 2, 0, c * ts / 2, -(ts**2) / 4],
+                [-1, 0, c, -ts / 2, 1, 0, -c, ts / 2],
+                z8,
+                [c, 0, -(c**2), c * ts / 2, -c, 0, c**2, -c * ts / 2],
+                [-ts / 2, 0, c * ts / 2, -(ts**2) / 4, ts / 2, 0, -c * ts / 2, ts**2 / 4],
+            ]
+        )
+    )
+    Ks = (
+        As
+        * (kappa + alpha * kappa)
+        * Le
+        * np.array(
+            [
+                z8,
+                z8,
+                z8,
+                [0, 0, 0, 1 / 3, 0, 0, 0, 1 / 6],
+                z8,
+                z8,
+                z8,
+                [0, 0, 0, 1 / 6, 0, 0, 0, 1 / 3],
+            ]
+        )
+    )
+    Mws = (
+        rhos
+        * Le
+        * np.array(
+            [
+                z8,
+                [0, As / 3, 0, 0, 0, As / 6, 0, 0],
+                [0, 0, Is / 3, 0, 0, 0, Is / 6, 0],
+                z8,
+                z8,
+                [0, As / 6, 0, 0, 0, As / 3, 0, 0],
+                [0, 0, Is / 6, 0, 0, 0, Is / 3, 0],
+                z8,
+            ]
+        )
+    )
     tbs = tb + ts
-    Mus = rhos * As * Le * np.array([
-        [1 / 3, 0, -tbs / 6, ts / 6, 1 / 6, 0, -tbs / 12, ts / 12],
-        z8,
-        [-tbs / 6, 0, tbs**2 / 12, -tbs * ts / 12, -tbs / 12, 0, tbs**2 / 24, -tbs * ts / 24],
-        [ts / 6, 0, -tbs * ts / 12, ts**2 / 12, ts / 12, 0, -tbs * ts / 24, ts**2 / 24],
-        [1 / 6, 0, -tbs / 12, ts / 12, 1 / 3, 0, -tbs / 6, ts / 6],
-        z8,
-        [-tbs / 12, 0, tbs**2 / 24, -tbs * ts / 24, -tbs / 6, 0, tbs**2 / 12, -tbs * ts / 12],
-        [ts / 12, 0, -tbs * ts / 24, ts**2 / 24, ts / 6, 0, -tbs * ts / 12, ts**2 / 12]])
-    Kqz = As * alpha * kappa * Le * np.array([[0, 0], [0, 0], [0, 0], [1 / 3, 1 / 6],
-                                              [0, 0], [0, 0], [0, 0], [1 / 6, 1 / 3]])
+    Mus = (
+        rhos
+        * As
+        * Le
+        * np.array(
+            [
+                [1 / 3, 0, -tbs / 6, ts / 6, 1 / 6, 0, -tbs / 12, ts / 12],
+                z8,
+                [
+                    -tbs / 6,
+                    0,
+                    tbs**2 / 12,
+                    -tbs * ts / 12,
+                    -tbs / 12,
+                    0,
+                    tbs**2 / 24,
+                    -tbs * ts / 24,
+                ],
+                [ts / 6, 0, -tbs * ts / 12, ts**2 / 12, ts / 12, 0, -tbs * ts / 24, ts**2 / 24],
+                [1 / 6, 0, -tbs / 12, ts / 12, 1 / 3, 0, -tbs / 6, ts / 6],
+                z8,
+                [
+                    -tbs / 12,
+                    0,
+                    tbs**2 / 24,
+                    -tbs * ts / 24,
+                    -tbs / 6,
+                    0,
+                    tbs**2 / 12,
+                    -tbs * ts / 12,
+                ],
+                [ts / 12, 0, -tbs * ts / 24, ts**2 / 24, ts / 6, 0, -tbs * ts / 12, ts**2 / 12],
+            ]
+        )
+    )
+    Kqz = (
+        As
+        * alpha
+        * kappa
+        * Le
+        * np.array([[0, 0], [0, 0], [0, 0], [1 / 3, 1 / 6], [0, 0], [0, 0], [0, 0], [1 / 6, 1 / 3]])
+    )
     Kz = As * alpha * kappa * Le * np.array([[1 / 3, 1 / 6], [1 / 6, 1 / 3]])
     # printed Mz has [1/3 1/3; 1/6 1/3] (a typesetting slip); the eq. (28) form is
     # Kz / omega^2, symmetric
@@ -291,8 +406,12 @@ def _acld_matlab(p: BeamParameters, Le: float):
     Me = _embed8(Mb) + _embed8(Mc6) + Mws + Muc + Mus
     Ke = _embed8(Kb) + _embed8(Kc6) + Kuc + Kwsb + Kus + Ks
     M = np.block([[Me, np.zeros((8, 2))], [np.zeros((2, 8)), Mz]])
-    C = np.block([[p.rayleigh_mass * Me + p.rayleigh_stiffness * Ke, np.zeros((8, 2))],
-                  [np.zeros((2, 8)), Cz]])
+    C = np.block(
+        [
+            [p.rayleigh_mass * Me + p.rayleigh_stiffness * Ke, np.zeros((8, 2))],
+            [np.zeros((2, 8)), Cz],
+        ]
+    )
     K = np.block([[Ke, -Kqz], [-Kqz.T, Kz]])
     return M, C, K
 
@@ -308,6 +427,7 @@ def test_acld_element_matches_matlab(le, Es):
 
 
 # --- GHM ------------------------------------------------------------------------
+
 
 def _condensed(K: np.ndarray) -> np.ndarray:
     """Static condensation of the z DOFs: K_qq - K_qz K_zz^-1 K_zq."""
@@ -330,14 +450,16 @@ def test_ghm_static_limit_is_equilibrium_modulus(le):
     Kc2 = _condensed(acld_element(dataclasses.replace(P, ghm_kappa=k2), le).K)
     diff = Kc2 - Kc
     expected = np.zeros((8, 8))
-    expected[np.ix_(ACLD_G, ACLD_G)] = (k2 - P.ghm_kappa) * P.vem_area * le / 6 * np.array(
-        [[2, 1], [1, 2]])
+    expected[np.ix_(ACLD_G, ACLD_G)] = (
+        (k2 - P.ghm_kappa) * P.vem_area * le / 6 * np.array([[2, 1], [1, 2]])
+    )
     assert_allclose(diff, expected, rtol=1e-9, atol=1e-9 * np.abs(expected).max())
     # 3) the uncondensed (instantaneous) stiffness carries kappa (1 + alpha)
     Kq2 = acld_element(dataclasses.replace(P, ghm_kappa=k2), le).K[:8, :8]
     expected_hf = expected * (1 + P.ghm_alpha)
-    assert_allclose(Kq2 - base[:8, :8], expected_hf, rtol=1e-9,
-                    atol=1e-9 * np.abs(expected_hf).max())
+    assert_allclose(
+        Kq2 - base[:8, :8], expected_hf, rtol=1e-9, atol=1e-9 * np.abs(expected_hf).max()
+    )
 
 
 @pytest.mark.parametrize("le", [0.09, 0.03])
@@ -346,11 +468,13 @@ def test_damping_rayleigh_and_ghm_blocks(le):
     # Mz = Kz/omega^2 (eqs. 27-29), no mass/damping coupling between q and z
     e = acld_element(P, le)
     a, b = P.rayleigh_mass, P.rayleigh_stiffness
-    assert_allclose(e.C[:8, :8], a * e.M[:8, :8] + b * e.K[:8, :8], rtol=1e-13,
-                    atol=1e-16 * np.abs(e.C).max())
+    assert_allclose(
+        e.C[:8, :8], a * e.M[:8, :8] + b * e.K[:8, :8], rtol=1e-13, atol=1e-16 * np.abs(e.C).max()
+    )
     Kz = e.K[8:, 8:]
-    assert_allclose(Kz, P.vem_area * P.ghm_alpha * P.ghm_kappa * le / 6 * np.array(
-        [[2, 1], [1, 2]]), rtol=1e-13)
+    assert_allclose(
+        Kz, P.vem_area * P.ghm_alpha * P.ghm_kappa * le / 6 * np.array([[2, 1], [1, 2]]), rtol=1e-13
+    )
     assert_allclose(e.C[8:, 8:], 2 * P.ghm_zeta / P.ghm_omega * Kz, rtol=1e-13)
     assert_allclose(e.M[8:, 8:], Kz / P.ghm_omega**2, rtol=1e-13)
     for A in (e.M, e.C):
@@ -364,8 +488,12 @@ def test_damping_rayleigh_and_ghm_blocks(le):
 @pytest.mark.parametrize("le", LENGTHS)
 def test_beam_rayleigh_damping(le):
     e = timoshenko_element(P, le)
-    assert_allclose(e.C, P.rayleigh_mass * e.M + P.rayleigh_stiffness * e.K, rtol=1e-13,
-                    atol=1e-16 * np.abs(e.C).max())
+    assert_allclose(
+        e.C,
+        P.rayleigh_mass * e.M + P.rayleigh_stiffness * e.K,
+        rtol=1e-13,
+        atol=1e-16 * np.abs(e.C).max(),
+    )
     # and the coefficients actually act (not both zero)
     e0 = timoshenko_element(dataclasses.replace(P, rayleigh_mass=0.0, rayleigh_stiffness=0.0), le)
     assert_array_equal(e0.C, 0.0)

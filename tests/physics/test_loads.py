@@ -26,8 +26,9 @@ def test_case1_values():
 
 def test_case2_second_pulse():
     f = thesis_load(2)
-    assert_allclose(f(np.array([0.0, 0.0005, 0.001, 0.05, 0.1, 0.1005, 0.101, 0.2])),
-                    [1, 1, 0, 0, 1, 1, 0, 0])
+    assert_allclose(
+        f(np.array([0.0, 0.0005, 0.001, 0.05, 0.1, 0.1005, 0.101, 0.2])), [1, 1, 0, 0, 1, 1, 0, 0]
+    )
     assert_allclose(f.breakpoints(), [0.0, 0.001, 0.1, 0.101])
 
 
@@ -132,9 +133,15 @@ def _main_random_load(rng, duration, grid, modes):
         comps.append(Pulse(float(start), float(width), float(rng.uniform(-1.5, 1.5))))
     if rng.uniform() < 0.5:
         w0 = modes[0] if rng.uniform() < 0.7 else modes[1]
-        comps.append(Harmonic(float(rng.uniform(0.0, 0.08)), float(w0 * rng.uniform(0.95, 1.05)),
-                              float(rng.uniform(0.0, 0.5 * duration)),
-                              float(rng.uniform(0.05, 0.3)), float(rng.uniform(0, 2 * np.pi))))
+        comps.append(
+            Harmonic(
+                float(rng.uniform(0.0, 0.08)),
+                float(w0 * rng.uniform(0.95, 1.05)),
+                float(rng.uniform(0.0, 0.5 * duration)),
+                float(rng.uniform(0.05, 0.3)),
+                float(rng.uniform(0, 2 * np.pi)),
+            )
+        )
     if rng.uniform() < 0.5:
         step = max(np.round(2e-3 / grid), 1) * grid
         n = int(duration / step) + 1
@@ -150,8 +157,9 @@ def test_random_mix_has_the_same_draws_and_numbers(duration, grid):
 
     for seed in range(300):
         a, b = np.random.default_rng(seed), np.random.default_rng(seed)
-        assert random_load(a, duration, grid, (177.4, 976.2)) == \
-            _main_random_load(b, duration, grid, (177.4, 976.2))
+        assert random_load(a, duration, grid, (177.4, 976.2)) == _main_random_load(
+            b, duration, grid, (177.4, 976.2)
+        )
         assert a.bit_generator.state == b.bit_generator.state  # the draws that follow too
 
 
@@ -167,8 +175,9 @@ def test_samples_are_validated_compared_and_scaled():
     assert_allclose(f(np.array([0.0, 0.1, 0.35, 0.6, 1.1])), [0.0, 1.0, 2.0, 3.0, 0.0])
     half = TipLoad((s, Pulse(0.0, 0.2, 4.0), Harmonic(1.0, 3.0, 0.0, 1.0))).scaled(0.5)
     t = np.linspace(0, 1.2, 50)
-    assert_allclose(half(t), 0.5 * TipLoad((s, Pulse(0.0, 0.2, 4.0),
-                                            Harmonic(1.0, 3.0, 0.0, 1.0)))(t))
+    assert_allclose(
+        half(t), 0.5 * TipLoad((s, Pulse(0.0, 0.2, 4.0), Harmonic(1.0, 3.0, 0.0, 1.0)))(t)
+    )
     for bad in ((1.0,), (1.0, np.nan), ("a", "b"), (True, 1.0), ((1.0, 2.0), (3.0, 4.0))):
         with pytest.raises(ValueError, match="Samples.values"):
             Samples(0.0, 1.0, bad)
@@ -204,7 +213,7 @@ def test_sine_sweep_runs_through_its_frequencies(spacing):
     up = np.flatnonzero((x[:-1] <= 0) & (x[1:] > 0)) * 1e-5  # upward zero crossings [s]
     freq = 1.0 / np.diff(up)  # instantaneous frequency [Hz] at the crossings' midpoints
     tau = 0.5 * (up[1:] + up[:-1])
-    want = 20.0 + 180.0 * tau if spacing == "linear" else 20.0 * 10.0 ** tau
+    want = 20.0 + 180.0 * tau if spacing == "linear" else 20.0 * 10.0**tau
     assert_allclose(freq, want, rtol=0.02)
     with pytest.raises(ValueError, match="step"):
         sine_sweep(0.5, 20.0, 200.0, 1.0, step=1e-3)

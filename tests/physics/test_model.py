@@ -32,10 +32,12 @@ OMEGA_EB = BETA_L**2 * np.sqrt(EI / (RHO_A * P.length**4))  # ~172.3, 1079.6, 30
 # modes (~omega/sqrt(1+alpha) = 707 rad/s) stay in the spectrum and are filtered
 # out below by their mode shapes (no transverse kinetic energy).
 EPS = 1e-6
-BARE = {"pzt_youngs_modulus": P.pzt_youngs_modulus * EPS,
-        "pzt_shear_modulus": P.pzt_shear_modulus * EPS,
-        "pzt_density": P.pzt_density * EPS,
-        "vem_density": P.vem_density * EPS}
+BARE = {
+    "pzt_youngs_modulus": P.pzt_youngs_modulus * EPS,
+    "pzt_shear_modulus": P.pzt_shear_modulus * EPS,
+    "pzt_density": P.pzt_density * EPS,
+    "vem_density": P.vem_density * EPS,
+}
 
 
 @pytest.fixture(scope="module")
@@ -57,6 +59,7 @@ def _bending_frequencies(m, omega_max: float) -> np.ndarray:
 
 
 # --- matrices -----------------------------------------------------------------
+
 
 def test_shapes_and_tip_index(model):
     assert model.M.shape == model.C.shape == model.K.shape == (19, 19)  # thesis sec. 2.7
@@ -122,6 +125,7 @@ def test_overrides_reach_params_and_mesh():
 
 # --- state space --------------------------------------------------------------
 
+
 def test_state_space_shapes_and_structure(model):
     A, B, E, Cy = model.state_space()
     assert A.shape == (38, 38) and B.shape == (38, 1) and E.shape == (38, 1)
@@ -152,6 +156,7 @@ def test_dc_gain_equals_static_tip_deflection(model):
 
 # --- bare beam against beam theory ----------------------------------------------
 
+
 def test_bare_beam_matches_euler_bernoulli():
     # uniform 40-element mesh (7.5 mm elements everywhere)
     m = build_model(mesh=Mesh(4, 12, 24), **BARE)
@@ -176,8 +181,14 @@ def test_bare_beam_convergence_rate():
     # Rate from successive differences (no reference solution needed):
     # w(h) - w(h/2) ~ c h^r.
     factors = np.array([1, 2, 4, 8, 16])
-    w1 = np.array([_bending_frequencies(build_model(mesh=Mesh().refined(int(f)), **BARE),
-                                        1.5 * OMEGA_EB[0])[0] for f in factors])
+    w1 = np.array(
+        [
+            _bending_frequencies(
+                build_model(mesh=Mesh().refined(int(f)), **BARE), 1.5 * OMEGA_EB[0]
+            )[0]
+            for f in factors
+        ]
+    )
     diffs = w1[:-1] - w1[1:]
     assert np.all(diffs > 0)  # monotone convergence from above (stiffness-type error)
     rate = np.polyfit(np.log(1.0 / factors[:-1]), np.log(diffs), 1)[0]

@@ -18,19 +18,35 @@ from acld_gym.physics.params import BeamParameters, Mesh, parameter_table, split
 
 # --- defaults -----------------------------------------------------------------
 
+
 def test_defaults_equal_matlab_values():
     # thesis MATLAB (SystemMatrices03.m): tb=.003, ts=.00025, tc=.001, Gc=2.496e10, L=.3,
     # b=.015, PLL=0.1 (patch start 0.03 m), PLC=0.3 (patch length 0.09 m), ...
     p = BeamParameters()
     expected = {
-        "length": 0.3, "width": 0.015, "beam_thickness": 0.003,
-        "beam_youngs_modulus": 7.0e10, "beam_shear_modulus": 2.6e10, "beam_density": 2700.0,
-        "pzt_thickness": 1.0e-3, "pzt_youngs_modulus": 6.49e10, "pzt_shear_modulus": 2.496e10,
-        "pzt_density": 7600.0, "d31": -175e-12,
-        "vem_thickness": 0.25e-3, "vem_density": 1250.0, "vem_youngs_modulus": 0.0,
-        "ghm_kappa": 1.0e6, "ghm_alpha": 1.0, "ghm_omega": 1000.0, "ghm_zeta": 4.0,
-        "shear_correction": 5.0 / 6.0, "rayleigh_mass": 0.64, "rayleigh_stiffness": 1.2e-6,
-        "patch_start": 0.03, "patch_length": 0.09,
+        "length": 0.3,
+        "width": 0.015,
+        "beam_thickness": 0.003,
+        "beam_youngs_modulus": 7.0e10,
+        "beam_shear_modulus": 2.6e10,
+        "beam_density": 2700.0,
+        "pzt_thickness": 1.0e-3,
+        "pzt_youngs_modulus": 6.49e10,
+        "pzt_shear_modulus": 2.496e10,
+        "pzt_density": 7600.0,
+        "d31": -175e-12,
+        "vem_thickness": 0.25e-3,
+        "vem_density": 1250.0,
+        "vem_youngs_modulus": 0.0,
+        "ghm_kappa": 1.0e6,
+        "ghm_alpha": 1.0,
+        "ghm_omega": 1000.0,
+        "ghm_zeta": 4.0,
+        "shear_correction": 5.0 / 6.0,
+        "rayleigh_mass": 0.64,
+        "rayleigh_stiffness": 1.2e-6,
+        "patch_start": 0.03,
+        "patch_length": 0.09,
     }
     for name, value in expected.items():
         assert getattr(p, name) == pytest.approx(value, rel=1e-15, abs=0.0), name
@@ -59,6 +75,7 @@ def test_table1_preset_values():
 
 # --- derived quantities -------------------------------------------------------
 
+
 def _check_derived(p: BeamParameters) -> None:
     b, tb, ts, tc = p.width, p.beam_thickness, p.vem_thickness, p.pzt_thickness
     # rectangular sections: A = b t, I = b t^3 / 12; h = ts + (tb + tc)/2 (thesis MATLAB)
@@ -85,8 +102,9 @@ def test_derived_properties_default_numbers():
 
 def test_derived_properties_follow_replace():
     p = BeamParameters()
-    q = dataclasses.replace(p, width=0.02, beam_thickness=0.004, vem_thickness=0.5e-3,
-                            pzt_thickness=0.3e-3)
+    q = dataclasses.replace(
+        p, width=0.02, beam_thickness=0.004, vem_thickness=0.5e-3, pzt_thickness=0.3e-3
+    )
     _check_derived(q)
     assert q.beam_area != p.beam_area
     assert q.pzt_offset == pytest.approx(0.5e-3 + (0.004 + 0.3e-3) / 2)
@@ -104,17 +122,28 @@ def test_frozen():
 # --- validation ---------------------------------------------------------------
 
 BAD_PARAMS = [
-    ("length", 0.0), ("length", -0.3),
+    ("length", 0.0),
+    ("length", -0.3),
     ("width", 0.0),
-    ("beam_thickness", 0.0), ("beam_thickness", -1e-3),
-    ("pzt_thickness", 0.0), ("vem_thickness", -0.25e-3),
-    ("beam_youngs_modulus", 0.0), ("beam_youngs_modulus", -7e10),
-    ("pzt_youngs_modulus", -1.0), ("beam_shear_modulus", 0.0), ("pzt_shear_modulus", -1.0),
+    ("beam_thickness", 0.0),
+    ("beam_thickness", -1e-3),
+    ("pzt_thickness", 0.0),
+    ("vem_thickness", -0.25e-3),
+    ("beam_youngs_modulus", 0.0),
+    ("beam_youngs_modulus", -7e10),
+    ("pzt_youngs_modulus", -1.0),
+    ("beam_shear_modulus", 0.0),
+    ("pzt_shear_modulus", -1.0),
     ("vem_youngs_modulus", -1.0),
-    ("beam_density", 0.0), ("pzt_density", -7600.0), ("vem_density", 0.0),
-    ("ghm_kappa", 0.0), ("ghm_omega", -1.0), ("shear_correction", 0.0),
+    ("beam_density", 0.0),
+    ("pzt_density", -7600.0),
+    ("vem_density", 0.0),
+    ("ghm_kappa", 0.0),
+    ("ghm_omega", -1.0),
+    ("shear_correction", 0.0),
     ("rayleigh_mass", -0.1),
-    ("length", float("nan")), ("beam_youngs_modulus", float("nan")),
+    ("length", float("nan")),
+    ("beam_youngs_modulus", float("nan")),
     ("pzt_density", float("inf")),
     ("length", "0.3"),
 ]
@@ -126,9 +155,17 @@ def test_invalid_parameter_raises_naming_field(name, value):
         BeamParameters(**{name: value})
 
 
-@pytest.mark.parametrize("name,value", [("vem_youngs_modulus", 0.0), ("rayleigh_mass", 0.0),
-                                        ("rayleigh_stiffness", 0.0), ("patch_start", 0.0),
-                                        ("d31", 175e-12), ("d31", -175e-12)])
+@pytest.mark.parametrize(
+    "name,value",
+    [
+        ("vem_youngs_modulus", 0.0),
+        ("rayleigh_mass", 0.0),
+        ("rayleigh_stiffness", 0.0),
+        ("patch_start", 0.0),
+        ("d31", 175e-12),
+        ("d31", -175e-12),
+    ],
+)
 def test_allowed_boundary_values(name, value):
     # zero Es is the MATLAB value; zero damping and a patch at the clamp are legitimate
     assert getattr(BeamParameters(**{name: value}), name) == value
@@ -144,15 +181,24 @@ def test_patch_must_fit():
     assert p.patch_start + p.patch_length == pytest.approx(p.length)
 
 
-@pytest.mark.parametrize("name,value", [("n_patch", 0), ("n_patch", -1), ("n_before", -1),
-                                        ("n_after", -2)])
+@pytest.mark.parametrize(
+    "name,value", [("n_patch", 0), ("n_patch", -1), ("n_before", -1), ("n_after", -2)]
+)
 def test_mesh_bad_counts(name, value):
     with pytest.raises(ValueError, match=name):
         Mesh(**{name: value})
 
 
-@pytest.mark.parametrize("name,value", [("n_patch", 1.5), ("n_after", 3.0), ("n_before", "1"),
-                                        ("n_patch", True), ("n_after", float("nan"))])
+@pytest.mark.parametrize(
+    "name,value",
+    [
+        ("n_patch", 1.5),
+        ("n_after", 3.0),
+        ("n_before", "1"),
+        ("n_patch", True),
+        ("n_after", float("nan")),
+    ],
+)
 def test_mesh_non_integer_counts(name, value):
     with pytest.raises(ValueError, match=name):
         Mesh(**{name: value})

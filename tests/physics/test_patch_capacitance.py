@@ -17,8 +17,9 @@ from acld_gym.physics.params import BeamParameters, table1
 def test_default_patch_is_22_7_nF():
     # 1900 * 8.854e-12 F/m * (0.09 m * 0.015 m) / 0.001 m, by hand: 22.71 nF
     assert patch_capacitance() == pytest.approx(22.71e-9, rel=1e-3)
-    assert patch_capacitance() == pytest.approx(EPSILON_0 * PZT_PERMITTIVITY * 0.09 * 0.015
-                                                / 0.001, rel=1e-12)
+    assert patch_capacitance() == pytest.approx(
+        EPSILON_0 * PZT_PERMITTIVITY * 0.09 * 0.015 / 0.001, rel=1e-12
+    )
     assert EPSILON_0 == pytest.approx(8.8541878128e-12)
     assert PZT_PERMITTIVITY == 1900.0  # APC 850's K^T
 
@@ -43,12 +44,15 @@ def test_reference_slew_rate_is_the_current_limit_on_the_patch():
     assert slew_rate(0.095, 2 * c) == pytest.approx(REFERENCE_SLEW_RATE / 2)
 
 
-@pytest.mark.parametrize("kwargs, word", [
-    ({"relative_permittivity": 0.0}, "relative_permittivity"),
-    ({"relative_permittivity": float("nan")}, "relative_permittivity"),
-    ({"params": "steel"}, "params"),
-    ({"params": BeamParameters(patch_length=0.0, patch_start=0.0)}, "bare beam"),
-])
+@pytest.mark.parametrize(
+    "kwargs, word",
+    [
+        ({"relative_permittivity": 0.0}, "relative_permittivity"),
+        ({"relative_permittivity": float("nan")}, "relative_permittivity"),
+        ({"params": "steel"}, "params"),
+        ({"params": BeamParameters(patch_length=0.0, patch_start=0.0)}, "bare beam"),
+    ],
+)
 def test_bad_input_is_named(kwargs, word):
     with pytest.raises(ValueError, match=word):
         patch_capacitance(**kwargs)

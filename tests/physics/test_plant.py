@@ -88,10 +88,10 @@ def test_shipped_plant_is_current_and_equals_a_fresh_build():
     assert fresh.n_states == shipped.n_states == 36
     w = response_grid(_modes_in_band(shipped), BAND, points=100)
     for i in (1, 2):  # voltage and load
-        a = frequency_response(*(m for j, m in enumerate(shipped.state_space()) if j in (0, i, 3)),
-                               w)
-        b = frequency_response(*(m for j, m in enumerate(fresh.state_space()) if j in (0, i, 3)),
-                               w)
+        a = frequency_response(
+            *(m for j, m in enumerate(shipped.state_space()) if j in (0, i, 3)), w
+        )
+        b = frequency_response(*(m for j, m in enumerate(fresh.state_space()) if j in (0, i, 3)), w)
         assert np.max(np.abs(a - b)) / np.max(np.abs(b)) < 1e-5
 
 
@@ -117,7 +117,8 @@ def test_cache_key_follows_every_parameter(tmp_path, monkeypatch):
     again = plant_cache.cached(params, 1e-3, 128, build)
     assert calls == [1] and got is p and again.n_states == p.n_states
     assert [f.name for f in tmp_path.iterdir()] == [
-        f"plant-converged-{plant_cache.key(params, 1e-3, 128)}.npz"]
+        f"plant-converged-{plant_cache.key(params, 1e-3, 128)}.npz"
+    ]
     # A damaged file is ignored (rebuilt), never half-read.
     (tmp_path / f"plant-converged-{plant_cache.key(params, 1e-3, 128)}.npz").write_bytes(b"x")
     plant_cache.cached(params, 1e-3, 128, build)

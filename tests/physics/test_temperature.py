@@ -29,8 +29,10 @@ GRID = np.linspace(*TEMPERATURE_RANGE, 31)
 def test_shift_is_wlf_about_the_glass_transition():
     assert log_shift(T_REF) == 0.0 and shift_factor(T_REF) == 1.0
     for T in (17.0, 25.0, 33.0):
+
         def wlf(t):
             return -WLF_C1 * (t - T_GLASS) / (WLF_C2 + t - T_GLASS)
+
         assert log_shift(T) == pytest.approx(wlf(T) - wlf(T_REF), rel=1e-12)
     assert np.all(np.diff([log_shift(T) for T in GRID]) < 0)  # hotter: faster relaxation
     # at T_g the thesis material's loss peak sits at 1 Hz (the convention that fixes T_g)
@@ -42,8 +44,11 @@ def test_superposition_shifts_the_modulus_along_frequency():
     w = np.logspace(0, 4, 9)
     for T in (17.0, 27.0):
         # G(j w, T) = G_ref(j a_T w): the same curve at the reduced frequency
-        np.testing.assert_allclose(ghm_modulus(shifted_parameters(p, T), w),
-                                   ghm_modulus(p, shift_factor(T) * w), rtol=1e-12)
+        np.testing.assert_allclose(
+            ghm_modulus(shifted_parameters(p, T), w),
+            ghm_modulus(p, shift_factor(T) * w),
+            rtol=1e-12,
+        )
     assert shifted_parameters(p, T_REF) is p
 
 
@@ -103,11 +108,17 @@ def test_temperature_is_model_mismatch_the_design_stays_nominal():
     assert ranged.nom is v1.nom
 
 
-@pytest.mark.parametrize("kw", [{"temperature": 5.0}, {"temperature": 45.0},
-                                {"temperature": 16.0},  # below the glass transition
-                                {"temperature_range": (30.0, 20.0)},
-                                {"temperature_range": (17.0,)},
-                                {"temperature_range": (17.0, 50.0)}])
+@pytest.mark.parametrize(
+    "kw",
+    [
+        {"temperature": 5.0},
+        {"temperature": 45.0},
+        {"temperature": 16.0},  # below the glass transition
+        {"temperature_range": (30.0, 20.0)},
+        {"temperature_range": (17.0,)},
+        {"temperature_range": (17.0, 50.0)},
+    ],
+)
 def test_temperatures_outside_the_model_are_refused(kw):
     with pytest.raises(ValueError, match="temperature"):
         ACLDBeamEnv(**kw)

@@ -68,6 +68,7 @@ def bare_beam(n: int, **overrides):
 
 # --- the patch-free beam can be built ---------------------------------------------
 
+
 def test_bare_beam_has_no_acld_element():
     m = bare_beam(10)
     assert [kind for kind, _, _ in m.dofs.elements] == ["beam"] * 10
@@ -81,18 +82,21 @@ def test_bare_beam_has_no_acld_element():
     assert bare_beam(3).n_states == 18
 
 
-@pytest.mark.parametrize("overrides,field", [
-    # a zero-length patch must not carry ACLD elements ...
-    ({"patch_start": 0.0, "patch_length": 0.0, "n_before": 0, "n_patch": 1}, "n_patch"),
-    # ... and a real patch needs at least one
-    ({"patch_start": 0.0, "n_before": 0, "n_patch": 0}, "n_patch"),
-    ({"n_patch": 0}, "n_patch"),  # the thesis's patch with n_patch = 0
-    # n_patch = 0 is for the bare beam, whose elements are all counted in n_after
-    ({"patch_start": 0.0, "patch_length": 0.0, "n_before": 1, "n_patch": 0}, "n_patch"),
-    # a bare beam has no patch position
-    ({"patch_start": 0.03, "patch_length": 0.0, "n_before": 0, "n_patch": 0}, "patch_start"),
-    ({"patch_length": -0.01}, "patch_length"),
-])
+@pytest.mark.parametrize(
+    "overrides,field",
+    [
+        # a zero-length patch must not carry ACLD elements ...
+        ({"patch_start": 0.0, "patch_length": 0.0, "n_before": 0, "n_patch": 1}, "n_patch"),
+        # ... and a real patch needs at least one
+        ({"patch_start": 0.0, "n_before": 0, "n_patch": 0}, "n_patch"),
+        ({"n_patch": 0}, "n_patch"),  # the thesis's patch with n_patch = 0
+        # n_patch = 0 is for the bare beam, whose elements are all counted in n_after
+        ({"patch_start": 0.0, "patch_length": 0.0, "n_before": 1, "n_patch": 0}, "n_patch"),
+        # a bare beam has no patch position
+        ({"patch_start": 0.03, "patch_length": 0.0, "n_before": 0, "n_patch": 0}, "patch_start"),
+        ({"patch_length": -0.01}, "patch_length"),
+    ],
+)
 def test_zero_patch_validation(overrides, field):
     with pytest.raises(ValueError, match=rf"\b{field}\b"):
         build_model(**overrides)
@@ -108,6 +112,7 @@ def test_mesh_zero_patch_only_without_elements_before():
 
 # --- the closed forms themselves ------------------------------------------------------
 
+
 def test_reference_beam_closed_forms():
     # tabulated clamped-free roots (Thomson, App. D.3; Rayleigh): 1.8751, 4.6941, 7.8548
     assert_allclose(cantilever_beta_l(3), [1.87510407, 4.69409113, 7.85475744], atol=1e-8)
@@ -117,8 +122,11 @@ def test_reference_beam_closed_forms():
     # ... which scales with (t/L)^2 (rotary inertia and shear ~ (beta r)^2) and vanishes
     # in the slender limit: the frequency equation reduces to 1 + cos(bL) cosh(bL) = 0
     for scale in (10.0, 100.0):
-        rel_s = (timoshenko_cantilever_frequencies(E, G, KS, RHO, A, I, scale * L)
-                 / euler_bernoulli_cantilever(E, I, RHO, A, scale * L) - 1.0)
+        rel_s = (
+            timoshenko_cantilever_frequencies(E, G, KS, RHO, A, I, scale * L)
+            / euler_bernoulli_cantilever(E, I, RHO, A, scale * L)
+            - 1.0
+        )
         assert_allclose(rel_s, rel / scale**2, rtol=5e-3)  # to O((t/L)^2), measured 2e-3
 
 
@@ -158,8 +166,7 @@ def test_sparse_and_dense_bare_frequencies_agree(bare_frequencies):
     # modes of 6 mm elements are ~1e8 x omega_1^2, so eps x 1e8 ~ 2e-8 on omega_1^2);
     # measured 7e-9, 2e-10, 8e-11 with this machine's kernels, 5.6e-8 on mode 1 with
     # OpenBLAS's Sandybridge kernels
-    assert_allclose(bare_beam(50).undamped_frequencies()[:3], bare_frequencies[50],
-                    rtol=2e-7)
+    assert_allclose(bare_beam(50).undamped_frequencies()[:3], bare_frequencies[50], rtol=2e-7)
 
 
 def test_bare_beam_frequencies_match_timoshenko(bare_frequencies):
@@ -192,6 +199,7 @@ def test_bare_beam_frequency_convergence_rate(bare_frequencies):
 
 # --- 1. bare beam: statics -----------------------------------------------------------
 
+
 @pytest.mark.parametrize("shear_modulus", [G, G * 1e-4])  # the second makes shear ~ bending
 @pytest.mark.parametrize("n", [1, 2, 3, 10, 40])
 def test_bare_beam_static_tip_deflection(n, shear_modulus):
@@ -212,10 +220,19 @@ def test_bare_beam_static_tip_deflection(n, shear_modulus):
 
 # --- 2. fully covered sandwich beam ---------------------------------------------------
 
-SANDWICH = Sandwich(b=P.width, L=L, E1=P.beam_youngs_modulus, t1=P.beam_thickness,
-                    rho1=P.beam_density, t2=P.vem_thickness, rho2=P.vem_density,
-                    E3=P.pzt_youngs_modulus, t3=P.pzt_thickness, rho3=P.pzt_density,
-                    E2=P.vem_youngs_modulus)
+SANDWICH = Sandwich(
+    b=P.width,
+    L=L,
+    E1=P.beam_youngs_modulus,
+    t1=P.beam_thickness,
+    rho1=P.beam_density,
+    t2=P.vem_thickness,
+    rho2=P.vem_density,
+    E3=P.pzt_youngs_modulus,
+    t3=P.pzt_thickness,
+    rho3=P.pzt_density,
+    E2=P.vem_youngs_modulus,
+)
 
 
 def ghm(s: complex) -> complex:
@@ -236,8 +253,9 @@ def reference_poles():
     for at in ("pole", "real"):
         rku = [rku_pole(SANDWICH, k, ghm, evaluate_at=at) for k in K_CANTILEVER]
         out["rku", at] = np.array(rku)
-        out["mm", at] = np.array([mead_markus_pole(SANDWICH, ghm, lam, evaluate_at=at)
-                                  for lam in rku])
+        out["mm", at] = np.array(
+            [mead_markus_pole(SANDWICH, ghm, lam, evaluate_at=at) for lam in rku]
+        )
     return out
 
 
@@ -269,14 +287,16 @@ def test_reference_sandwich_closed_forms_agree_with_each_other():
         for k in K_CANTILEVER:
             # RKU with a shear-only core (E2 = 0) is Mead-Markus' D_t (1 + Y g/(g + k^2))
             assert rku_flexural_rigidity(SANDWICH, G2, k) == pytest.approx(
-                mead_markus_flexural_rigidity(SANDWICH, G2, k), rel=1e-12)
+                mead_markus_flexural_rigidity(SANDWICH, G2, k), rel=1e-12
+            )
     # the transfer-matrix solution reproduces RKU exactly where RKU is exact (pinned
     # ends, sinusoidal modes k = n pi / L)
     for n in (1, 2, 3):
         k = n * np.pi / L
         lam = rku_pole(SANDWICH, k, ghm)
-        assert mead_markus_pole(SANDWICH, ghm, 1.05 * lam, supports="pinned-pinned") \
-            == pytest.approx(lam, rel=1e-10)
+        assert mead_markus_pole(
+            SANDWICH, ghm, 1.05 * lam, supports="pinned-pinned"
+        ) == pytest.approx(lam, rel=1e-10)
     # and with a vanishing core modulus the cantilever is two uncoupled EB faces,
     # omega_n = (beta_n L)^2 sqrt((E1 I1 + E3 I3)/(m L^4))
     eb = cantilever_beta_l(3) ** 2 * np.sqrt(SANDWICH.D_faces / (SANDWICH.mass * L**4))
@@ -363,8 +383,10 @@ def test_rku_equivalent_wavelength_is_crude_for_this_cantilever(fe_poles, refere
     is not used as the acceptance reference; the FE agrees with the exact sandwich
     solution (40 elements) more than 10x better than RKU does."""
     rku, mm, fe = reference_poles["rku", "pole"], reference_poles["mm", "pole"], fe_poles[40]
-    eta = {name: np.array([loss_factor(lam) for lam in poles])
-           for name, poles in (("rku", rku), ("mm", mm), ("fe", fe))}
+    eta = {
+        name: np.array([loss_factor(lam) for lam in poles])
+        for name, poles in (("rku", rku), ("mm", mm), ("fe", fe))
+    }
     rku_err = eta["rku"] / eta["mm"] - 1.0  # measured -0.293, +0.417, +0.090
     fe_err = eta["fe"] / eta["mm"] - 1.0
     assert np.all(np.abs(rku_err) > 0.05), rku_err

@@ -30,8 +30,10 @@ def reproduce_out(tmp_path_factory):
     p = base / "sub" / "rows.json"  # parent directory created by the CLI
     plots = base / "figs"
     # A short window keeps this to a few seconds; the full run is tested in test_reproduce.
-    assert main(["reproduce", "--json", str(p), "--plots", str(plots), "--quiet",
-                 "--t-end", "0.1"]) == 0
+    assert (
+        main(["reproduce", "--json", str(p), "--plots", str(plots), "--quiet", "--t-end", "0.1"])
+        == 0
+    )
     return json.loads(p.read_text()), plots
 
 
@@ -64,7 +66,8 @@ def test_reproduce_json(reproduce_out):
     for r in rows:
         assert set(r) == KEYS
     assert {(r["case"], r["controller"], r["saturation"]) for r in rows} == {
-        (c, k, s) for c in (1, 2, 3) for k in ("passive", "lqr", "smc") for s in (True, False)}
+        (c, k, s) for c in (1, 2, 3) for k in ("passive", "lqr", "smc") for s in (True, False)
+    }
     for r in rows:
         if r["saturation"] and r["controller"] != "passive":
             assert abs(r["max_voltage_V"] - 120.0) <= 1e-9
@@ -73,24 +76,31 @@ def test_reproduce_json(reproduce_out):
 def test_reproduce_plots(reproduce_out):
     _, plots = reproduce_out
     files = {p.name for p in plots.glob("*.png")}
-    expected = {f"case{c}_{k}_{s}.png" for c in (1, 2, 3) for k in ("passive", "lqr", "smc")
-                for s in ("sat", "nosat")}
+    expected = {
+        f"case{c}_{k}_{s}.png"
+        for c in (1, 2, 3)
+        for k in ("passive", "lqr", "smc")
+        for s in ("sat", "nosat")
+    }
     expected |= {"hankel_singular_values.png", "frequency_response.png"}
     assert files == expected  # 20 distinct figures
     for name in files:
         assert (plots / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
-@pytest.mark.parametrize("argv,word", [
-    (["reproduce", "--t-end", "-1"], "--t-end"),
-    (["reproduce", "--t-end", "abc"], "--t-end"),
-    (["reproduce", "--t-end", "nan"], "--t-end"),
-    (["reproduce", "--observer", "luenberger"], "--observer"),
-    (["model", "--preset", "nope"], "--preset"),
-    (["reproduce", "--preset", "nope"], "--preset"),
-    (["frobnicate"], "frobnicate"),
-    ([], "command"),
-])
+@pytest.mark.parametrize(
+    "argv,word",
+    [
+        (["reproduce", "--t-end", "-1"], "--t-end"),
+        (["reproduce", "--t-end", "abc"], "--t-end"),
+        (["reproduce", "--t-end", "nan"], "--t-end"),
+        (["reproduce", "--observer", "luenberger"], "--observer"),
+        (["model", "--preset", "nope"], "--preset"),
+        (["reproduce", "--preset", "nope"], "--preset"),
+        (["frobnicate"], "frobnicate"),
+        ([], "command"),
+    ],
+)
 def test_bad_arguments(argv, word, capsys):
     with pytest.raises(SystemExit) as exc:
         main(argv)

@@ -57,8 +57,9 @@ def test_passive_case1_peak(rows):
     r = _row(rows, 1, "passive", False)
     assert r.peak_mm == pytest.approx(PASSIVE_CASE1_PEAK_MM, rel=0.02)
     assert r.max_voltage_V == 0.0
-    assert _row(rows, 1, "passive", True) == Table2Row(1, "passive", True, r.peak_mm,
-                                                       r.settling_s, 0.0)
+    assert _row(rows, 1, "passive", True) == Table2Row(
+        1, "passive", True, r.peak_mm, r.settling_s, 0.0
+    )
 
 
 def test_first_damped_frequency(d):
@@ -101,8 +102,7 @@ def test_smc_unsaturated_voltage_regression(rows, case, v):
 
 def test_smc_voltage_peak_time(d):
     A, B, E, Cy = d.plant
-    res = simulate(A, B, E, Cy, d.observer("thesis"), d.smc, thesis_load(1), t_end=0.02,
-                   v_max=None)
+    res = simulate(A, B, E, Cy, d.observer("thesis"), d.smc, thesis_load(1), t_end=0.02, v_max=None)
     i = int(np.argmax(np.abs(res.voltage)))
     assert res.t[i] == pytest.approx(6.7e-3, abs=0.5e-3)
     assert abs(res.voltage[i]) == pytest.approx(3179.0, rel=0.02)

@@ -47,8 +47,11 @@ def test_every_agent_is_in_the_table_with_its_training_label(agents):
         assert {r["case"] for r in ROWS if r["policy"] == name} == {1, 2, 3, "random"}
         label = _row(1, name)["training"]
         assert label == agent.training
-        assert label == ("from scratch" if agent.metadata["teacher"] is None
-                         else f"DAgger from {agent.metadata['teacher'].upper()} + RL")
+        assert label == (
+            "from scratch"
+            if agent.metadata["teacher"] is None
+            else f"DAgger from {agent.metadata['teacher'].upper()} + RL"
+        )
 
 
 @pytest.mark.parametrize("name", NAMES)
@@ -77,19 +80,21 @@ def test_the_pages_show_the_generated_tables():
     """Every row of ``train/agents/compare.md`` (written by ``python -m train.compare``) is
     on the training page, and the README's score table is its score table."""
     root = Path(__file__).resolve().parents[2]
-    rows = [line for line in (AGENTS_DIR / "compare.md").read_text().splitlines()
-            if line.startswith("| ")]
+    rows = [
+        line
+        for line in (AGENTS_DIR / "compare.md").read_text().splitlines()
+        if line.startswith("| ")
+    ]
     assert rows and [r for r in rows if r not in PAGE.splitlines()] == []
     readme = (root / "README.md").read_text().splitlines()
-    scores = rows[rows.index(next(r for r in rows if "score (IQM)" in r)):]
+    scores = rows[rows.index(next(r for r in rows if "score (IQM)" in r)) :]
     assert [r for r in scores if r not in readme] == []
 
 
 @pytest.mark.parametrize("name", NAMES)
 def test_heldout_random_set_reproduces_the_table(agents, name):
     env = ACLDBeamEnv(load_case="random")
-    rows = [metrics_row("random", name, rollout(agents[name], env, seed=s))
-            for s in HELDOUT_SEEDS]
+    rows = [metrics_row("random", name, rollout(agents[name], env, seed=s)) for s in HELDOUT_SEEDS]
     mean = mean_rows(rows, "random")[0]
     assert mean.ise == pytest.approx(_row("random", name)["ise"], rel=RTOL)
 
@@ -173,11 +178,17 @@ def _damage(agent_dir: Path, key: str, change) -> None:
 def test_every_array_is_checked_against_the_program(name, tmp_path):
     """Wrong shapes (one input too few, a second action, a matrix for a vector) and
     non-finite weights are refused at load, naming the file and the array."""
-    cases = [("W0", lambda w: w[:-1], "shape"), ("b0", lambda b: np.concatenate([b, b]), "shape"),
-             ("b0", lambda b: np.atleast_2d(b), "shape"),
-             ("W0", lambda w: np.where(np.arange(w.size).reshape(w.shape) == 0, np.nan, w),
-              "non-finite"),
-             ("b0", lambda b: b + np.inf, "non-finite")]
+    cases = [
+        ("W0", lambda w: w[:-1], "shape"),
+        ("b0", lambda b: np.concatenate([b, b]), "shape"),
+        ("b0", lambda b: np.atleast_2d(b), "shape"),
+        (
+            "W0",
+            lambda w: np.where(np.arange(w.size).reshape(w.shape) == 0, np.nan, w),
+            "non-finite",
+        ),
+        ("b0", lambda b: b + np.inf, "non-finite"),
+    ]
     for i, (key, change, what) in enumerate(cases):
         d = tmp_path / f"{name}-{i}"
         shutil.copytree(AGENTS_DIR / name, d)

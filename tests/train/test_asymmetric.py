@@ -17,10 +17,24 @@ def _model():
     from stable_baselines3 import PPO
     from stable_baselines3.common.env_util import make_vec_env
 
-    venv = make_vec_env("ACLDBeam-v1", n_envs=1, env_kwargs={
-        "reward_scale": "passive", "observe_reward_scale": True, "episode_length": 0.05})
-    return PPO(AsymmetricCriticPolicy, venv, n_steps=64, batch_size=64, seed=0, device="cpu",
-               policy_kwargs={"net_arch": {"pi": [], "vf": []}})
+    venv = make_vec_env(
+        "ACLDBeam-v1",
+        n_envs=1,
+        env_kwargs={
+            "reward_scale": "passive",
+            "observe_reward_scale": True,
+            "episode_length": 0.05,
+        },
+    )
+    return PPO(
+        AsymmetricCriticPolicy,
+        venv,
+        n_steps=64,
+        batch_size=64,
+        seed=0,
+        device="cpu",
+        policy_kwargs={"net_arch": {"pi": [], "vf": []}},
+    )
 
 
 def test_actor_ignores_log_scale_and_critic_is_scale_invariant():
@@ -54,8 +68,9 @@ def test_recipe_trains_and_exports_onto_the_plain_observation():
     assert data["env_kwargs"] == {"reward_scale": "passive", "observe_reward_scale": True}
     data.update(timesteps=2048, n_envs=4, whiten_steps=256, eval_points=1)
     data["model"] = {**data["model"], "n_steps": 128, "batch_size": 256, "n_epochs": 1}
-    policy, record = train_algo(TrainConfig.from_dict(data), 0, "ACLDBeam-v1",
-                                lambda steps, pol: None)
+    policy, record = train_algo(
+        TrainConfig.from_dict(data), 0, "ACLDBeam-v1", lambda steps, pol: None
+    )
     assert np.asarray(record["transform"]).shape == (9, 9)  # log c is not whitened
     assert policy.model.observation_space.shape == (10,)
     prog = policy_program(policy)
@@ -80,8 +95,11 @@ def _sac_config(**policy_kwargs):
     data = yaml.safe_load(open("train/benchmark/sac.yaml"))
     data.update(n_envs=2)
     model = data["model"]
-    data["model"] = {**model, "buffer_size": 1000, "policy_kwargs": {**model["policy_kwargs"],
-                                                                     **policy_kwargs}}
+    data["model"] = {
+        **model,
+        "buffer_size": 1000,
+        "policy_kwargs": {**model["policy_kwargs"], **policy_kwargs},
+    }
     return TrainConfig(**data)
 
 
@@ -96,8 +114,11 @@ def test_make_model_gives_the_sac_critic_the_configs_action_headroom():
     try:
         model = make_model(cfg, venv, 0)
         assert cfg.action_headroom == 3.0 and model.policy.action_headroom == 3.0
-        with pytest.raises(ValueError, match=r"model.policy_kwargs.action_headroom 2.0 "
-                                             r"differs from action_headroom 3.0"):
+        with pytest.raises(
+            ValueError,
+            match=r"model.policy_kwargs.action_headroom 2.0 "
+            r"differs from action_headroom 3.0",
+        ):
             make_model(_sac_config(action_headroom=2.0), venv, 0)
     finally:
         venv.close()

@@ -57,11 +57,14 @@ def test_averaging_off_or_not_started_leaves_the_model_alone():
         assert torch.equal(model.policy.weight, torch.full((1, 2), 2.0))
 
 
-@pytest.mark.parametrize("bad, match", [
-    ({"start": -1}, "average.start"),
-    ({"start": 0, "halflife": 0}, "average.halflife"),
-    ({"begin": 0}, "average: unknown key"),
-])
+@pytest.mark.parametrize(
+    "bad, match",
+    [
+        ({"start": -1}, "average.start"),
+        ({"start": 0, "halflife": 0}, "average.halflife"),
+        ({"begin": 0}, "average: unknown key"),
+    ],
+)
 def test_bad_average_configs_are_refused_by_name(bad, match):
     with pytest.raises(ValueError, match=match):
         _cfg(**bad)
@@ -82,16 +85,23 @@ def test_a_run_returns_the_average_of_its_iterates(monkeypatch):
 
     def spy(self, steps, model):
         if self.config is not None and steps >= self.config.start:
-            seen.append({k: v.detach().clone().double()
-                         for k, v in model.policy.state_dict().items()})
+            seen.append(
+                {k: v.detach().clone().double() for k, v in model.policy.state_dict().items()}
+            )
         update(self, steps, model)
 
     monkeypatch.setattr(sb3_train.Averaging, "update", spy)
     data = yaml.safe_load(open("train/benchmark/sac.yaml"))
-    data.update(timesteps=600, n_envs=4, eval_points=1, whiten_steps=128, select=None, restarts=1,
-                average={"start": 300})
-    data["model"] = {**data["model"], "learning_starts": 200, "buffer_size": 2000,
-                     "batch_size": 64}
+    data.update(
+        timesteps=600,
+        n_envs=4,
+        eval_points=1,
+        whiten_steps=128,
+        select=None,
+        restarts=1,
+        average={"start": 300},
+    )
+    data["model"] = {**data["model"], "learning_starts": 200, "buffer_size": 2000, "batch_size": 64}
     policy, record = sb3_train.train_sb3(TrainConfig.from_dict(data), 0, "ACLDBeam-v1")
     assert record["average"]["iterates"] == len(seen) > 10
     key = next(k for k in seen[0] if k.startswith("actor.mu") and k.endswith("weight"))

@@ -65,12 +65,30 @@ def test_benchmark_runs_end_to_end(tmp_path, capsys):
     from train.benchmark import main
 
     out = tmp_path / "bench"
-    argv = ["--config", *_tiny_configs(tmp_path), "--seeds", "0", "1", "--backend", "local",
-            "--random-episodes", "2", "--no-bound", "--out", str(out)]
+    argv = [
+        "--config",
+        *_tiny_configs(tmp_path),
+        "--seeds",
+        "0",
+        "1",
+        "--backend",
+        "local",
+        "--random-episodes",
+        "2",
+        "--no-bound",
+        "--out",
+        str(out),
+    ]
     assert main(argv) == 0
     capsys.readouterr()
-    for f in ("results.md", "results.json", "learning_curves.png",
-              "references-ACLDBeam-v1.json", "trials/tiny_vrs-s0.json", "trials/tiny_ppo-s1.json"):
+    for f in (
+        "results.md",
+        "results.json",
+        "learning_curves.png",
+        "references-ACLDBeam-v1.json",
+        "trials/tiny_vrs-s0.json",
+        "trials/tiny_ppo-s1.json",
+    ):
         assert (out / f).is_file(), f
     assert not list(out.rglob("*.tmp"))  # atomic writes leave no temp files
     summary = json.loads((out / "results.json").read_text())
@@ -88,12 +106,18 @@ def test_benchmark_runs_end_to_end(tmp_path, capsys):
     assert "0 runs (4 reused)" in capsys.readouterr().out
 
 
-@pytest.mark.parametrize("name, changes, model", [
-    ("ars", {"timesteps": 2000, "n_envs": 1, "loads": {1: 1}},
-     {"n_delta": 1, "n_top": 1, "n_eval_episodes": 1}),
-    ("sac", {"timesteps": 300, "n_envs": 2}, {"learning_starts": 100, "buffer_size": 1000}),
-    ("tqc", {"timesteps": 300, "n_envs": 2}, {"learning_starts": 100, "buffer_size": 1000}),
-])
+@pytest.mark.parametrize(
+    "name, changes, model",
+    [
+        (
+            "ars",
+            {"timesteps": 2000, "n_envs": 1, "loads": {1: 1}},
+            {"n_delta": 1, "n_top": 1, "n_eval_episodes": 1},
+        ),
+        ("sac", {"timesteps": 300, "n_envs": 2}, {"learning_starts": 100, "buffer_size": 1000}),
+        ("tqc", {"timesteps": 300, "n_envs": 2}, {"learning_starts": 100, "buffer_size": 1000}),
+    ],
+)
 def test_sb3_algorithms_train_and_act_in_volts(name, changes, model):
     from train.bench.algos import train_algo
     from train.config import TrainConfig
@@ -102,8 +126,9 @@ def test_sb3_algorithms_train_and_act_in_volts(name, changes, model):
     data.update(changes, eval_points=1)
     data["model"] = {**data["model"], **model}
     seen = []
-    policy, record = train_algo(TrainConfig.from_dict(data), 0, "ACLDBeam-v1",
-                                lambda steps, pol: seen.append(steps))
+    policy, record = train_algo(
+        TrainConfig.from_dict(data), 0, "ACLDBeam-v1", lambda steps, pol: seen.append(steps)
+    )
     assert seen[0] == 0 and record["steps"] >= changes["timesteps"]
     n_obs = gym.make("ACLDBeam-v1").observation_space.shape[0]
     v, _ = policy.predict(np.zeros(n_obs, np.float32) + 0.1)
@@ -122,12 +147,15 @@ def test_ppo_with_whitening_quadratic_critic_and_episode_scale():
     from train.config import TrainConfig
 
     data = yaml.safe_load(open("train/benchmark/ppo.yaml"))
-    data.update(timesteps=4000, n_envs=2, whiten_steps=1000, episode_scale=True,
-                eval_points=1)
+    data.update(timesteps=4000, n_envs=2, whiten_steps=1000, episode_scale=True, eval_points=1)
     data["model"] = {**data["model"], "n_steps": 500, "batch_size": 500, "n_epochs": 1}
     seen = []
-    policy, record = train_algo(TrainConfig.from_dict(data), 0, "ACLDBeam-v1",
-                                lambda steps, pol: seen.append((steps, pol.transform)))
+    policy, record = train_algo(
+        TrainConfig.from_dict(data),
+        0,
+        "ACLDBeam-v1",
+        lambda steps, pol: seen.append((steps, pol.transform)),
+    )
     assert seen[0] == (0, None) and record["whiten_steps"] == 1000
     assert record["steps"] >= 4000 and np.asarray(record["transform"]).shape == (9, 9)
     assert any(t is not None for _, t in seen[1:])  # whitened while training
@@ -136,8 +164,9 @@ def test_ppo_with_whitening_quadratic_critic_and_episode_scale():
     v, _ = policy.predict(z)
     prog = policy_program(policy)
     assert v.shape == (4, 1) and np.all(np.abs(v) <= 120.0)
-    assert np.allclose(120 * np.clip(prog(z.astype(np.float64)), -1, 1).reshape(-1, 1), v,
-                       atol=1e-3)
+    assert np.allclose(
+        120 * np.clip(prog(z.astype(np.float64)), -1, 1).reshape(-1, 1), v, atol=1e-3
+    )
 
 
 def test_fold_whitening_and_quadratic_features():
@@ -154,8 +183,10 @@ def test_fold_whitening_and_quadratic_features():
     env = gym.make("Pendulum-v1")
     T = np.random.default_rng(0).normal(size=(3, 3))
     z = np.random.default_rng(1).normal(size=(5, 3)).astype(np.float32)
-    for model in (PPO("MlpPolicy", env, policy_kwargs={"net_arch": {"pi": [], "vf": [8]}}),
-                  SAC("MlpPolicy", env, policy_kwargs={"net_arch": [8]})):
+    for model in (
+        PPO("MlpPolicy", env, policy_kwargs={"net_arch": {"pi": [], "vf": [8]}}),
+        SAC("MlpPolicy", env, policy_kwargs={"net_arch": [8]}),
+    ):
         before, _ = SB3Policy(model, None, None, transform=T).predict(z)
         fold_whitening(model, T)
         after, _ = SB3Policy(model, None, None).predict(z)
@@ -170,11 +201,19 @@ def test_episode_scaled_advantages():
     for t in range(6):
         scale = np.array([1.0, 1000.0]) if t < 3 else np.array([1.0, 0.001])
         starts = np.array([t == 0, t in (0, 3)])
-        buf.add(np.zeros((2, 2)), np.zeros((2, 2)), -scale * (t + 1), starts,
-                torch_zeros(2), torch_zeros(2))
+        buf.add(
+            np.zeros((2, 2)),
+            np.zeros((2, 2)),
+            -scale * (t + 1),
+            starts,
+            torch_zeros(2),
+            torch_zeros(2),
+        )
     buf.compute_returns_and_advantage(torch_zeros(2), np.zeros(2, dtype=bool))
-    rms = [np.sqrt(np.mean(buf.advantages[a:b, e] ** 2)) for e, a, b in
-           [(0, 0, 6), (1, 0, 3), (1, 3, 6)]]
+    rms = [
+        np.sqrt(np.mean(buf.advantages[a:b, e] ** 2))
+        for e, a, b in [(0, 0, 6), (1, 0, 3), (1, 3, 6)]
+    ]
     assert np.allclose(rms, 1.0)
     assert buf.returns[0, 1] == pytest.approx(-6000.0)  # the critic's targets unscaled
 
@@ -216,20 +255,47 @@ def test_benchmark_through_ray_tune(tmp_path):
     from train.benchmark import main
 
     out = tmp_path / "bench"
-    assert main(["--config", _tiny_configs(tmp_path)[0], "--seeds", "0", "1", "--backend", "ray",
-                 "--num-cpus", "2", "--random-episodes", "2", "--no-bound",
-                 "--out", str(out)]) == 0
+    assert (
+        main(
+            [
+                "--config",
+                _tiny_configs(tmp_path)[0],
+                "--seeds",
+                "0",
+                "1",
+                "--backend",
+                "ray",
+                "--num-cpus",
+                "2",
+                "--random-episodes",
+                "2",
+                "--no-bound",
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
     summary = json.loads((out / "results.json").read_text())
     assert summary["backend"] == "ray" and summary["algorithms"]["tiny_vrs"]["seeds"] == [0, 1]
     assert (out / "trials" / "tiny_vrs-s1.json").is_file()
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("algo, bound", [
-    ("vrs", 0.90),  # measured (train/benchmark/results-v1.json): seed 0 0.844, 5 seeds 0.83-0.85
-    ("ppo", 0.95),  # measured (results-v1.json): seed 0 0.862; 5 seeds 0.862-0.911
-    ("sac", 0.95),  # measured (results-v1.json, 2 runs a seed): seed 0 0.856; 5 seeds 0.839-0.879
-])
+@pytest.mark.parametrize(
+    "algo, bound",
+    [
+        (
+            "vrs",
+            0.90,
+        ),  # measured (train/benchmark/results-v1.json): seed 0 0.844, 5 seeds 0.83-0.85
+        ("ppo", 0.95),  # measured (results-v1.json): seed 0 0.862; 5 seeds 0.862-0.911
+        (
+            "sac",
+            0.95,
+        ),  # measured (results-v1.json, 2 runs a seed): seed 0 0.856; 5 seeds 0.839-0.879
+    ],
+)
 def test_recipe_seed_on_case1(algo, bound):
     """One seed of a teacher-free recipe (train/benchmark/<algo>.yaml, full budget) against
     LQR on case 1."""

@@ -63,11 +63,29 @@ def test_benchmark_saves_shippable_agents(tmp_path, capsys):
         (tmp_path / f"{name}.yaml").write_text(yaml.safe_dump(data))
         configs.append(str(tmp_path / f"{name}.yaml"))
     out = tmp_path / "bench"
-    assert main(["--config", *configs, "--seeds", "0", "--backend", "local",
-                 "--random-episodes", "1", "--no-bound", "--out", str(out)]) == 0
+    assert (
+        main(
+            [
+                "--config",
+                *configs,
+                "--seeds",
+                "0",
+                "--backend",
+                "local",
+                "--random-episodes",
+                "1",
+                "--no-bound",
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
     capsys.readouterr()
-    trials = {n: json.loads((out / "trials" / f"{n}-s0.json").read_text())
-              for n in ("tiny_vrs", "tiny_ppo")}
+    trials = {
+        n: json.loads((out / "trials" / f"{n}-s0.json").read_text())
+        for n in ("tiny_vrs", "tiny_ppo")
+    }
     for name, rec in trials.items():
         d = agent_dir(out, name, 0)
         agent = TrainedAgent.load(d)  # fingerprint checked against ACLDBeam-v1 today

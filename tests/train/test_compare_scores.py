@@ -53,8 +53,19 @@ def test_effort_columns_in_the_shipped_table():
 
 def test_the_markdown_has_the_effort_and_the_score(tmp_path, capsys):
     md, js = tmp_path / "c.md", tmp_path / "c.json"
-    argv = ["--only", "vrs", "--random-episodes", "1", "--score-episodes", "2", "--quiet",
-            "--markdown", str(md), "--json", str(js)]
+    argv = [
+        "--only",
+        "vrs",
+        "--random-episodes",
+        "1",
+        "--score-episodes",
+        "2",
+        "--quiet",
+        "--markdown",
+        str(md),
+        "--json",
+        str(js),
+    ]
     assert main(argv) == 0
     text = md.read_text()
     assert "| V rms [V] | Q [mvar] | TV after settling [kV/s] |" in text

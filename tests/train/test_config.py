@@ -45,29 +45,39 @@ def test_overrides_revalidate():
 BASE = dict(algo="ppo", timesteps=10, n_envs=2, model={"policy": "MlpPolicy"})
 
 
-@pytest.mark.parametrize("change, word", [
-    ({"algo": "dqn"}, "algo"), ({"n_envs": 0}, "n_envs"), ({"loads": {4: 1}}, "1, 2, 3"),
-    ({"loads": {1: 0}}, "loads"), ({"loads": {1: True}}, "loads"),
-    ({"env_kwargs": {"param_noise": -0.1}}, "param_noise"),
-    ({"env_kwargs": {"load_case": 1}}, "loads"),
-    ({"env_kwargs": {"reward_scael": "passive"}}, "reward_scael"),
-    ({"residual": "mpc"}, "residual"), ({"shaping": 0}, "shaping"),
-    ({"action_headroom": 0.5}, "action_headroom"), ({"action_headroom": "2"}, "action_headroom"),
-    ({"model": {}}, "policy"), ({"model": {"policy": "MlpPolicy", "learning_rat": 1}},
-                                "learning_rat"),
-    ({"model": {"policy": "MlpPolicy", "n_steps": "64"}}, "n_steps"),
-    ({"model": {"policy": "MlpPolicy", "max_grad_norm": "1.0e6"}}, "max_grad_norm"),
-    ({"normalize": {"norm_obbs": True}}, "norm_obbs"),
-    ({"features": "fourier"}, "features"), ({"episode_scale": 1}, "episode_scale"),
-    ({"whiten_steps": 100, "features": "direction"}, "whiten_steps"),
-    ({"distill": {"itertions": 3}}, "itertions"),
-    ({"distill": {"teacher": "mpc"}, "residual": "lqr"}, "residual"),
-    ({"select": 5}, "select"), ({"select": {"episodes": 4}}, "select.*missing.*every"),
-    ({"select": {"episodes": 4, "every": 10, "strat": 1}}, "select.*strat"),
-    ({"select": {"episodes": 0, "every": 10}}, "select.episodes"),
-    ({"select": {"episodes": 4, "every": 10, "start": -1}}, "select.start"),
-    ({"select": {"episodes": 4, "every": 10}, "normalize": {"norm_obs": True}}, "norm_obs"),
-])
+@pytest.mark.parametrize(
+    "change, word",
+    [
+        ({"algo": "dqn"}, "algo"),
+        ({"n_envs": 0}, "n_envs"),
+        ({"loads": {4: 1}}, "1, 2, 3"),
+        ({"loads": {1: 0}}, "loads"),
+        ({"loads": {1: True}}, "loads"),
+        ({"env_kwargs": {"param_noise": -0.1}}, "param_noise"),
+        ({"env_kwargs": {"load_case": 1}}, "loads"),
+        ({"env_kwargs": {"reward_scael": "passive"}}, "reward_scael"),
+        ({"residual": "mpc"}, "residual"),
+        ({"shaping": 0}, "shaping"),
+        ({"action_headroom": 0.5}, "action_headroom"),
+        ({"action_headroom": "2"}, "action_headroom"),
+        ({"model": {}}, "policy"),
+        ({"model": {"policy": "MlpPolicy", "learning_rat": 1}}, "learning_rat"),
+        ({"model": {"policy": "MlpPolicy", "n_steps": "64"}}, "n_steps"),
+        ({"model": {"policy": "MlpPolicy", "max_grad_norm": "1.0e6"}}, "max_grad_norm"),
+        ({"normalize": {"norm_obbs": True}}, "norm_obbs"),
+        ({"features": "fourier"}, "features"),
+        ({"episode_scale": 1}, "episode_scale"),
+        ({"whiten_steps": 100, "features": "direction"}, "whiten_steps"),
+        ({"distill": {"itertions": 3}}, "itertions"),
+        ({"distill": {"teacher": "mpc"}, "residual": "lqr"}, "residual"),
+        ({"select": 5}, "select"),
+        ({"select": {"episodes": 4}}, "select.*missing.*every"),
+        ({"select": {"episodes": 4, "every": 10, "strat": 1}}, "select.*strat"),
+        ({"select": {"episodes": 0, "every": 10}}, "select.episodes"),
+        ({"select": {"episodes": 4, "every": 10, "start": -1}}, "select.start"),
+        ({"select": {"episodes": 4, "every": 10}, "normalize": {"norm_obs": True}}, "norm_obs"),
+    ],
+)
 def test_bad_values_name_the_field(change, word):
     with pytest.raises(ValueError, match=word):
         TrainConfig(**{**BASE, **change})
@@ -119,23 +129,26 @@ def test_base_applies_the_recipe_under_a_files_own_settings(tmp_path):
     assert old == {**ppo, "model": {**ppo["model"], "ent_coef": 0.01}}
     _, ablation = read_config("ablation_ppo_lambda_095")  # chained: on 0.6.0's recipe
     assert ablation == {**old, "model": {**old["model"], "gae_lambda": 0.95}}
-    (tmp_path / "a.yaml").write_text("base: ppo\ntimesteps: 10\n"
-                                     "model: {policy_kwargs: {log_std_init: -2.0}}\n")
+    (tmp_path / "a.yaml").write_text(
+        "base: ppo\ntimesteps: 10\nmodel: {policy_kwargs: {log_std_init: -2.0}}\n"
+    )
     _, data = read_config(tmp_path / "a.yaml")
     assert data["timesteps"] == 10 and "base" not in data
-    assert data["model"]["policy_kwargs"] == {**ppo["model"]["policy_kwargs"],
-                                              "log_std_init": -2.0}
+    assert data["model"]["policy_kwargs"] == {**ppo["model"]["policy_kwargs"], "log_std_init": -2.0}
     assert data["model"]["n_steps"] == ppo["model"]["n_steps"]
     (tmp_path / "b.yaml").write_text(f"base: {tmp_path / 'a.yaml'}\nn_envs: 8\n")
     _, chained = read_config(tmp_path / "b.yaml")
     assert chained == {**data, "n_envs": 8}
 
 
-@pytest.mark.parametrize("text, match", [
-    ("base: 3\n", r"base: expected a config name or path, got 3"),
-    ("base: no_such_recipe\n", r"no_such_recipe.*does not exist"),
-    ("base: ppo\ntimesteps: -5\n", r"c.yaml: timesteps must be an integer"),
-])
+@pytest.mark.parametrize(
+    "text, match",
+    [
+        ("base: 3\n", r"base: expected a config name or path, got 3"),
+        ("base: no_such_recipe\n", r"no_such_recipe.*does not exist"),
+        ("base: ppo\ntimesteps: -5\n", r"c.yaml: timesteps must be an integer"),
+    ],
+)
 def test_base_errors_name_the_file_and_the_problem(tmp_path, text, match):
     (tmp_path / "c.yaml").write_text(text)
     with pytest.raises((ValueError, FileNotFoundError), match=match):

@@ -59,9 +59,13 @@ def test_fit_sign_recovers_a_separating_direction():
 def test_distill_config_validation():
     assert DistillConfig(iterations=4, beta=1.0, beta_decay=0.5).betas() == [1.0, 0.5, 0.25, 0.0]
     assert DistillConfig(iterations=1).betas() == [1.0]
-    for kw, word in [({"teacher": "pid"}, "teacher"), ({"iterations": 0}, "iterations"),
-                     ({"beta": 1.5}, "beta"), ({"beta_decay": -0.1}, "beta_decay"),
-                     ({"max_iter": 2.5}, "max_iter")]:
+    for kw, word in [
+        ({"teacher": "pid"}, "teacher"),
+        ({"iterations": 0}, "iterations"),
+        ({"beta": 1.5}, "beta"),
+        ({"beta_decay": -0.1}, "beta_decay"),
+        ({"max_iter": 2.5}, "max_iter"),
+    ]:
         with pytest.raises(ValueError, match=word):
             DistillConfig(**kw)
     base = dict(algo="ppo", timesteps=10, n_envs=2, model={"policy": "MlpPolicy"})
@@ -94,10 +98,15 @@ def test_dagger_imitates_the_mpc(distilled):
     # as a policy in volts it comes close to its teacher on thesis case 1 after only two
     # iterations (v1: MPC 0.95 x LQR; the shipped agents use six)
     venv.training = False
-    agent = TrainedAgent(policy_program(SB3Policy(model, None, cfg.features)),
-                         {"residual": cfg.residual}, "distilled")
-    ise = {name: metrics_row(1, name, rollout(p, ACLDBeamEnv(load_case=1), seed=0)).ise
-           for name, p in [("mpc", MPCPolicy()), ("distilled", agent)]}
+    agent = TrainedAgent(
+        policy_program(SB3Policy(model, None, cfg.features)),
+        {"residual": cfg.residual},
+        "distilled",
+    )
+    ise = {
+        name: metrics_row(1, name, rollout(p, ACLDBeamEnv(load_case=1), seed=0)).ise
+        for name, p in [("mpc", MPCPolicy()), ("distilled", agent)]
+    }
     assert ise["distilled"] < 1.15 * ise["mpc"]
 
 

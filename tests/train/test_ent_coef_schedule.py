@@ -12,8 +12,13 @@ from train.config import TrainConfig
 def _tiny_ppo(ent_coef) -> TrainConfig:
     data = yaml.safe_load(open("train/benchmark/ppo.yaml"))
     data.update(timesteps=1536, n_envs=4, eval_points=1, whiten_steps=256)
-    data["model"] = {**data["model"], "n_steps": 128, "batch_size": 256, "n_epochs": 1,
-                     "ent_coef": ent_coef}
+    data["model"] = {
+        **data["model"],
+        "n_steps": 128,
+        "batch_size": 256,
+        "n_epochs": 1,
+        "ent_coef": ent_coef,
+    }
     return TrainConfig(**data)
 
 

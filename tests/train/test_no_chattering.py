@@ -28,5 +28,5 @@ def test_shipped_agent_does_not_sit_at_the_limit(name, lqr_fraction):
     agent = TrainedAgent.load(AGENTS_DIR / name)
     frac = _settled_limit_fraction(agent)
     assert frac <= lqr_fraction + 0.01, (
-        f"{name}: at +/-120 V {frac:.0%} of the settled window of case 1 (LQR: "
-        f"{lqr_fraction:.0%})")
+        f"{name}: at +/-120 V {frac:.0%} of the settled window of case 1 (LQR: {lqr_fraction:.0%})"
+    )

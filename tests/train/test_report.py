@@ -67,8 +67,12 @@ def test_the_figure_marks_each_reported_result_at_its_budget():
     try:
         assert len(fig.axes) == 8  # the whole runs, and the zoom on the end of training
         for ax, case in zip(fig.axes, ("1", "2", "3", "random") * 2, strict=True):
-            marks = {(x, y) for line in ax.get_lines() if line.get_marker() == "D"
-                     for x, y in zip(line.get_xdata(), line.get_ydata(), strict=True)}
+            marks = {
+                (x, y)
+                for line in ax.get_lines()
+                if line.get_marker() == "D"
+                for x, y in zip(line.get_xdata(), line.get_ydata(), strict=True)
+            }
             for a in summary["algorithms"].values():
                 assert (a["budget"], a["ise_rel_lqr"][case]["iqm"]) in marks
         for ax, case in zip(fig.axes[4:], ("1", "2", "3", "random"), strict=True):

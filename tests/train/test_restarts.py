@@ -13,8 +13,11 @@ from train.config import TrainConfig
 
 
 def _cfg(restarts=2, select=True, timesteps=100):
-    return tiny_sac(timesteps, restarts=restarts,
-                    select={"episodes": 2, "every": 50, "start": 0} if select else None)
+    return tiny_sac(
+        timesteps,
+        restarts=restarts,
+        select={"episodes": 2, "every": 50, "start": 0} if select else None,
+    )
 
 
 def test_restart_seeds_start_with_the_trial_seed_and_are_shared_by_no_other_trial():
@@ -24,16 +27,19 @@ def test_restart_seeds_start_with_the_trial_seed_and_are_shared_by_no_other_tria
     every = [x for s in lists.values() for x in s]
     assert len(set(every)) == len(every)  # seed + k would give seed 0's run 2 to seed 1
     assert all(isinstance(x, int) and 0 <= x < 2**32 for x in every)
-    assert restart_seeds(7, 3) == restart_seeds(7, 3) and restart_seeds(7, 2) == \
-        restart_seeds(7, 3)[:2]
+    assert (
+        restart_seeds(7, 3) == restart_seeds(7, 3)
+        and restart_seeds(7, 2) == restart_seeds(7, 3)[:2]
+    )
 
 
 def test_budget_counts_every_run():
     assert _cfg(restarts=3, timesteps=100).budget == 300 and _cfg(restarts=1).budget == 100
 
 
-@pytest.mark.parametrize("restarts, word", [(0, "restarts"), (True, "restarts"),
-                                            (2.0, "restarts"), (65, "restarts")])
+@pytest.mark.parametrize(
+    "restarts, word", [(0, "restarts"), (True, "restarts"), (2.0, "restarts"), (65, "restarts")]
+)
 def test_bad_restarts_are_named(restarts, word):
     with pytest.raises(ValueError, match=word):
         _cfg(restarts=restarts)
@@ -55,8 +61,10 @@ def test_the_run_with_the_lowest_validation_cost_is_returned(monkeypatch):
         calls.append(seed)
         timed(0, f"policy-{seed}")
         timed(cfg_.timesteps, f"policy-{seed}")
-        return f"policy-{seed}", {"steps": cfg_.timesteps,
-                                  "select": {"steps": 50, "cost": costs[seed]}}
+        return f"policy-{seed}", {
+            "steps": cfg_.timesteps,
+            "select": {"steps": 50, "cost": costs[seed]},
+        }
 
     monkeypatch.setattr(algos, "train_sb3", fake_train)
     seen = []
@@ -71,21 +79,28 @@ def test_the_run_with_the_lowest_validation_cost_is_returned(monkeypatch):
     runs = record["restarts"]["runs"]
     assert record["restarts"]["chosen"] == 1
     assert [{k: r[k] for k in ("seed", "steps", "cost")} for r in runs] == [
-        {"seed": s, "steps": 50, "cost": costs[s]} for s in seeds]
+        {"seed": s, "steps": 50, "cost": costs[s]} for s in seeds
+    ]
     # every run is evaluated from its own step 0; each run's curve is its own policies'
     assert [s for s, _ in seen] == [0, 100] * 3
     for r in runs:
         assert [(p["steps"], p["policy"]) for p in r["curve"]] == [
-            (0, f"policy-{r['seed']}"), (100, f"policy-{r['seed']}")]
+            (0, f"policy-{r['seed']}"),
+            (100, f"policy-{r['seed']}"),
+        ]
     # the trial's curve is the returned run's: it ends at that run's policy, not the last run's
     assert record["curve"] == runs[1]["curve"] and record["curve"][-1]["n"] == 4
 
 
 def test_a_run_whose_curve_stops_short_gets_a_last_point(monkeypatch):
-    monkeypatch.setattr(algos, "train_sb3", lambda cfg, seed, env_id, timed: (
-        timed(0, "p0"), ("p", {"steps": cfg.timesteps}))[1])
-    policy, record = train_algo(_cfg(restarts=1, select=False), 3, "ACLDBeam-v1",
-                                lambda s, p: {"policy": p})
+    monkeypatch.setattr(
+        algos,
+        "train_sb3",
+        lambda cfg, seed, env_id, timed: (timed(0, "p0"), ("p", {"steps": cfg.timesteps}))[1],
+    )
+    policy, record = train_algo(
+        _cfg(restarts=1, select=False), 3, "ACLDBeam-v1", lambda s, p: {"policy": p}
+    )
     assert record["curve"] == [{"steps": 0, "policy": "p0"}, {"steps": 100, "policy": "p"}]
     _, record = train_algo(_cfg(restarts=1, select=False), 3, "ACLDBeam-v1")
     assert record["curve"] == []  # no callback, no curve
@@ -93,8 +108,14 @@ def test_a_run_whose_curve_stops_short_gets_a_last_point(monkeypatch):
 
 def test_one_run_is_the_plain_recipe(monkeypatch):
     seen = []
-    monkeypatch.setattr(algos, "train_sb3", lambda cfg, seed, env_id, timed: (
-        seen.append(seed) or "p", {"steps": cfg.timesteps, "select": {"steps": 0, "cost": 1}}))
+    monkeypatch.setattr(
+        algos,
+        "train_sb3",
+        lambda cfg, seed, env_id, timed: (
+            seen.append(seed) or "p",
+            {"steps": cfg.timesteps, "select": {"steps": 0, "cost": 1}},
+        ),
+    )
     policy, record = train_algo(_cfg(restarts=1), 11, "ACLDBeam-v1")
     assert seen == [11] and policy == "p" and "restarts" not in record
 
@@ -103,10 +124,15 @@ def test_two_tiny_sac_runs_return_the_better_one():
     """Real runs: the returned policy scores its run's chosen validation cost again, and
     that cost is the lower of the two runs'."""
     data = yaml.safe_load(open("train/benchmark/sac.yaml"))
-    data.update(timesteps=600, n_envs=4, eval_points=1, whiten_steps=128, restarts=2,
-                select={"episodes": 2, "every": 200, "start": 0})
-    data["model"] = {**data["model"], "learning_starts": 200, "buffer_size": 2000,
-                     "batch_size": 64}
+    data.update(
+        timesteps=600,
+        n_envs=4,
+        eval_points=1,
+        whiten_steps=128,
+        restarts=2,
+        select={"episodes": 2, "every": 200, "start": 0},
+    )
+    data["model"] = {**data["model"], "learning_starts": 200, "buffer_size": 2000, "batch_size": 64}
     policy, record = train_algo(TrainConfig.from_dict(data), 0, "ACLDBeam-v1")
     runs = record["restarts"]["runs"]
     assert [r["seed"] for r in runs] == restart_seeds(0, 2) and record["steps"] >= 1200

@@ -33,8 +33,9 @@ def test_validation_cost_is_one_for_the_passive_beam(design_env):
     """The reward per load divides by the passive beam's cost on the same load, so the
     passive beam scores 1 on every set of loads (up to round-off); LQR damps, below 1."""
     seeds = evaluate.validation_seeds(8)
-    assert evaluate.validation_cost(PassivePolicy.for_env(design_env), seeds=seeds) == \
-        pytest.approx(1.0, rel=1e-12)
+    assert evaluate.validation_cost(
+        PassivePolicy.for_env(design_env), seeds=seeds
+    ) == pytest.approx(1.0, rel=1e-12)
     lqr = evaluate.validation_cost(LQRPolicy.for_env(design_env), seeds=seeds)
     assert 0.2 < lqr < 0.9
 
@@ -78,8 +79,7 @@ def _tiny_recipe(**changes) -> TrainConfig:
     ``changes``."""
     data = yaml.safe_load(open("train/benchmark/sac.yaml"))
     data.update(timesteps=800, n_envs=4, eval_points=1, whiten_steps=128, **changes)
-    data["model"] = {**data["model"], "learning_starts": 200, "buffer_size": 2000,
-                     "batch_size": 64}
+    data["model"] = {**data["model"], "learning_starts": 200, "buffer_size": 2000, "batch_size": 64}
     return TrainConfig.from_dict(data)
 
 
@@ -111,5 +111,6 @@ def test_the_final_check_sees_the_final_policy():
     chosen, record = train_sb3(cfg, 0, "ACLDBeam-v1")
     assert [h["steps"] for h in record["select"]["history"]] == [800]
     seeds = evaluate.validation_seeds(2)
-    assert evaluate.validation_cost(chosen, "ACLDBeam-v1", seeds) == \
-        evaluate.validation_cost(plain, "ACLDBeam-v1", seeds)
+    assert evaluate.validation_cost(chosen, "ACLDBeam-v1", seeds) == evaluate.validation_cost(
+        plain, "ACLDBeam-v1", seeds
+    )

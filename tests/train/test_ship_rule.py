@@ -16,17 +16,21 @@ RESULTS = "train/benchmark/results-v1.json"
 
 def _results(tmp_path, per_seed):
     tmp_path.mkdir(parents=True, exist_ok=True)
-    (tmp_path / "results.json").write_text(json.dumps(
-        {"algorithms": {"x": {"per_seed": per_seed}}}))
+    (tmp_path / "results.json").write_text(
+        json.dumps({"algorithms": {"x": {"per_seed": per_seed}}})
+    )
     return tmp_path
 
 
 def test_the_lowest_mean_over_cases_1_to_3_wins_and_random_takes_no_part(tmp_path):
-    out = _results(tmp_path, [
-        {"seed": 0, "1": 0.80, "2": 0.95, "3": 1.00, "random": 0.90},  # mean 0.9167
-        {"seed": 7, "1": 0.85, "2": 0.85, "3": 0.99, "random": 1.50},  # mean 0.8967: best
-        {"seed": 3, "1": 0.90, "2": 0.90, "3": 0.99, "random": 0.50},
-    ])
+    out = _results(
+        tmp_path,
+        [
+            {"seed": 0, "1": 0.80, "2": 0.95, "3": 1.00, "random": 0.90},  # mean 0.9167
+            {"seed": 7, "1": 0.85, "2": 0.85, "3": 0.99, "random": 1.50},  # mean 0.8967: best
+            {"seed": 3, "1": 0.90, "2": 0.90, "3": 0.99, "random": 0.50},
+        ],
+    )
     assert best_seed(out, "x") == 7
 
 
@@ -56,13 +60,19 @@ def test_bad_inputs_are_named(tmp_path):
 
 
 def test_cli_ships_the_best_seed(tmp_path, capsys):
-    out = _results(tmp_path / "bench", [
-        {"seed": 0, "1": 0.9, "2": 0.9, "3": 1.0, "random": 1.0},
-        {"seed": 1, "1": 0.8, "2": 0.9, "3": 1.0, "random": 1.0}])
+    out = _results(
+        tmp_path / "bench",
+        [
+            {"seed": 0, "1": 0.9, "2": 0.9, "3": 1.0, "random": 1.0},
+            {"seed": 1, "1": 0.8, "2": 0.9, "3": 1.0, "random": 1.0},
+        ],
+    )
     shutil.copytree(AGENTS_DIR / "vrs", out / "agents" / "x-s1")
     assert main([str(out), "mine", "--best", "x", "--agents", str(tmp_path / "agents")]) == 0
     assert "x: seed 1 is best on cases 1-3" in capsys.readouterr().out
-    assert (TrainedAgent.load(tmp_path / "agents" / "mine").actor.arrays["W0"]
-            == TrainedAgent.load(AGENTS_DIR / "vrs").actor.arrays["W0"]).all()
+    assert (
+        TrainedAgent.load(tmp_path / "agents" / "mine").actor.arrays["W0"]
+        == TrainedAgent.load(AGENTS_DIR / "vrs").actor.arrays["W0"]
+    ).all()
     with pytest.raises(SystemExit):  # no agent directory for the chosen seed
         main([str(out), "mine", "--best", "y", "--agents", str(tmp_path / "agents")])

@@ -22,9 +22,10 @@ def _params(model) -> np.ndarray:
 def test_smoke_training(name, steps):
     cfg = load_config(name).with_overrides(timesteps=steps, n_envs=2, eval_points=1)
     if cfg.algo == "sac":
-        cfg = cfg.with_overrides(model={**cfg.model, "learning_starts": 100,
-                                        "buffer_size": 2000, "batch_size": 64},
-                                 whiten_steps=100)
+        cfg = cfg.with_overrides(
+            model={**cfg.model, "learning_starts": 100, "buffer_size": 2000, "batch_size": 64},
+            whiten_steps=100,
+        )
     else:  # a mini-batch that divides the 2-env rollout
         cfg = cfg.with_overrides(model={**cfg.model, "n_steps": 256, "batch_size": 256})
         if cfg.whiten_steps:

@@ -21,8 +21,12 @@ def _tiny(tmp_path, algo):
         data["model"] = {**data["model"], "n_steps": 128, "batch_size": 256, "n_epochs": 1}
     else:
         data.update(timesteps=600, n_envs=4, eval_points=1, whiten_steps=128)
-        data["model"] = {**data["model"], "learning_starts": 200, "buffer_size": 2000,
-                         "batch_size": 64}
+        data["model"] = {
+            **data["model"],
+            "learning_starts": 200,
+            "buffer_size": 2000,
+            "batch_size": 64,
+        }
     path = tmp_path / f"tiny_{algo}.yaml"
     path.write_text(yaml.safe_dump(data))
     return path
@@ -33,13 +37,17 @@ def test_the_default_config_is_the_benchmark_recipe():
 
     for algo in ("ppo", "sac"):
         args = build_parser().parse_args([algo, "--seed", "7"])
-        assert configure(args) == read_config(algo) == (algo, yaml.safe_load(
-            open(f"train/benchmark/{algo}.yaml")))
+        assert (
+            configure(args)
+            == read_config(algo)
+            == (algo, yaml.safe_load(open(f"train/benchmark/{algo}.yaml")))
+        )
 
 
 def test_overrides_of_the_command_line():
-    args = build_parser().parse_args(["ppo", "--timesteps", "100", "--n-envs", "3",
-                                      "--load-case", "2", "--param-noise", "0.02"])
+    args = build_parser().parse_args(
+        ["ppo", "--timesteps", "100", "--n-envs", "3", "--load-case", "2", "--param-noise", "0.02"]
+    )
     name, data = configure(args)
     assert name == "ppo" and data["timesteps"] == 100 and data["n_envs"] == 3
     assert data["loads"] == {2: 1}
@@ -56,13 +64,32 @@ def test_train_cli_is_a_benchmark_trial(algo, tmp_path, capsys):
 
     cfg = _tiny(tmp_path, algo)
     a = tmp_path / "cli"
-    assert train_main([algo, "--config", str(cfg), "--seed", "3", "--random-episodes", "1",
-                       "--out", str(a)]) == 0
+    assert (
+        train_main(
+            [algo, "--config", str(cfg), "--seed", "3", "--random-episodes", "1", "--out", str(a)]
+        )
+        == 0
+    )
     out = capsys.readouterr().out
     assert "ISE / LQR" in out and "case random" in out
-    assert bench_main(["--config", str(cfg), "--seeds", "3", "--backend", "local",
-                       "--random-episodes", "1", "--no-bound", "--out",
-                       str(tmp_path / "bench")]) == 0
+    assert (
+        bench_main(
+            [
+                "--config",
+                str(cfg),
+                "--seeds",
+                "3",
+                "--backend",
+                "local",
+                "--random-episodes",
+                "1",
+                "--no-bound",
+                "--out",
+                str(tmp_path / "bench"),
+            ]
+        )
+        == 0
+    )
     b = tmp_path / "bench" / "agents" / f"tiny_{algo}-s3"
     pa, pb = np.load(a / "policy.npz"), np.load(b / "policy.npz")
     assert sorted(pa.files) == sorted(pb.files)

@@ -21,7 +21,22 @@ def test_tune_sweep_runs_locally(tmp_path, capsys):
     pytest.importorskip("ray", reason="Ray Tune is the optional extra .[sweep]")
     from train.sweep import main
 
-    assert main(["vrs", "--seeds", "0", "1", "--timesteps", "4000", "--num-cpus", "2",
-                 "--out", str(tmp_path)]) == 0
+    assert (
+        main(
+            [
+                "vrs",
+                "--seeds",
+                "0",
+                "1",
+                "--timesteps",
+                "4000",
+                "--num-cpus",
+                "2",
+                "--out",
+                str(tmp_path),
+            ]
+        )
+        == 0
+    )
     out = capsys.readouterr().out
     assert "best:" in out and "ise_rel_lqr" in out

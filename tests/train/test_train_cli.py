@@ -17,48 +17,58 @@ def _exit2(fn, argv, capsys, word):
     return err
 
 
-@pytest.mark.parametrize("argv, word", [
-    (["a2c"], "invalid choice"),
-    ([], "algo"),
-    (["ppo", "--timesteps", "-5"], "--timesteps"),
-    (["ppo", "--timesteps", "abc"], "--timesteps"),
-    (["sac", "--n-envs", "0"], "--n-envs"),
-    (["ppo", "--load-case", "4"], "--load-case"),
-    (["ppo", "--seed", "-1"], "--seed"),
-    (["ppo", "--param-noise", "-0.1"], "--param-noise"),
-    (["ppo", "--config", "/nonexistent/ppo.yaml"], "does not exist"),
-    (["sac", "--config", "ppo_dagger"], "not 'sac'"),
-    (["vrs", "--param-noise", "0.01"], "env_kwargs"),
-    (["ppo", "--random-episodes", "0"], "--random-episodes"),
-    (["ppo", "--env-id", "ACLDBeam-v9"], "--env-id"),
-    (["ppo", "--backend", "ray"], "--backend"),
-])
+@pytest.mark.parametrize(
+    "argv, word",
+    [
+        (["a2c"], "invalid choice"),
+        ([], "algo"),
+        (["ppo", "--timesteps", "-5"], "--timesteps"),
+        (["ppo", "--timesteps", "abc"], "--timesteps"),
+        (["sac", "--n-envs", "0"], "--n-envs"),
+        (["ppo", "--load-case", "4"], "--load-case"),
+        (["ppo", "--seed", "-1"], "--seed"),
+        (["ppo", "--param-noise", "-0.1"], "--param-noise"),
+        (["ppo", "--config", "/nonexistent/ppo.yaml"], "does not exist"),
+        (["sac", "--config", "ppo_dagger"], "not 'sac'"),
+        (["vrs", "--param-noise", "0.01"], "env_kwargs"),
+        (["ppo", "--random-episodes", "0"], "--random-episodes"),
+        (["ppo", "--env-id", "ACLDBeam-v9"], "--env-id"),
+        (["ppo", "--backend", "ray"], "--backend"),
+    ],
+)
 def test_train_cli_bad_input(argv, word, capsys):
     _exit2(train_main, argv, capsys, word)
 
 
 def test_train_cli_bad_config_values(tmp_path, capsys):
     bad = tmp_path / "ppo.yaml"
-    bad.write_text("algo: ppo\ntimesteps: 10\nn_envs: 2\nresidual: pid\n"
-                   "model: {policy: MlpPolicy}\n")
+    bad.write_text(
+        "algo: ppo\ntimesteps: 10\nn_envs: 2\nresidual: pid\nmodel: {policy: MlpPolicy}\n"
+    )
     _exit2(train_main, ["ppo", "--config", str(bad)], capsys, "residual")
 
 
-@pytest.mark.parametrize("argv, word", [
-    (["--only", "nope"], "does not exist"),
-    (["--random-episodes", "-1"], "--random-episodes"),
-    (["--param-noise", "-1"], "--param-noise"),
-])
+@pytest.mark.parametrize(
+    "argv, word",
+    [
+        (["--only", "nope"], "does not exist"),
+        (["--random-episodes", "-1"], "--random-episodes"),
+        (["--param-noise", "-1"], "--param-noise"),
+    ],
+)
 def test_compare_cli_bad_input(argv, word, capsys):
     _exit2(compare_main, argv, capsys, word)
 
 
-@pytest.mark.parametrize("argv, word", [
-    (["dqn"], "invalid choice"),
-    (["ppo", "--timesteps", "0"], "--timesteps"),
-    (["ppo", "--num-cpus", "0"], "--num-cpus"),
-    (["ppo", "--seeds", "-1"], "--seeds"),
-])
+@pytest.mark.parametrize(
+    "argv, word",
+    [
+        (["dqn"], "invalid choice"),
+        (["ppo", "--timesteps", "0"], "--timesteps"),
+        (["ppo", "--num-cpus", "0"], "--num-cpus"),
+        (["ppo", "--seeds", "-1"], "--seeds"),
+    ],
+)
 def test_sweep_cli_bad_input(argv, word, capsys):
     _exit2(sweep_main, argv, capsys, word)
 

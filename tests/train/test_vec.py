@@ -49,13 +49,15 @@ def test_voltage_map_headroom_is_the_wrappers_map():
     unit = UnitAction(ACLDBeamEnv(load_case=1), headroom=3.0)
     assert np.allclose(v, np.clip(unit.action(a[:, 0]), -120, 120))
     a1 = rng.uniform(-2, 2, (50, 1))
-    assert np.array_equal(VoltageMap(headroom=1.0)(a1, obs[:1].repeat(50, 0)),
-                          VoltageMap()(a1, obs[:1].repeat(50, 0)))
+    assert np.array_equal(
+        VoltageMap(headroom=1.0)(a1, obs[:1].repeat(50, 0)), VoltageMap()(a1, obs[:1].repeat(50, 0))
+    )
     lqr = LQRPolicy()
     u0 = lqr.voltage(lqr.reduced_state(obs))
     res = VoltageMap("lqr", headroom=2.0)
-    assert np.allclose(res(np.full((7, 1), 0.1), obs)[:, 0], np.clip(u0 + 48.0, -120, 120),
-                       atol=1e-3)
+    assert np.allclose(
+        res(np.full((7, 1), 0.1), obs)[:, 0], np.clip(u0 + 48.0, -120, 120), atol=1e-3
+    )
     with pytest.raises(ValueError, match="headroom must be a number"):
         VoltageMap(headroom=0.9)
 

@@ -9,8 +9,15 @@ import sys
 import pytest
 import yaml
 
-ZOO_ONLY = {"env_wrapper", "env_kwargs", "n_envs", "n_timesteps", "policy", "policy_kwargs",
-            "learning_rate"}
+ZOO_ONLY = {
+    "env_wrapper",
+    "env_kwargs",
+    "n_envs",
+    "n_timesteps",
+    "policy",
+    "policy_kwargs",
+    "learning_rate",
+}
 
 
 @pytest.mark.parametrize("algo", ["ppo", "sac"])
@@ -56,8 +63,14 @@ def test_zoo_learning_rate_callback_gives_the_model_its_schedule():
     hp = yaml.safe_load(open("train/zoo/sac.yml"))["ACLDBeam-v1"]
     (callback,) = [c for c in get_callback_list(hp) if isinstance(c, LinearLearningRate)]
     # as rl-zoo3 gives it, a constant (its start), from which the callback takes over
-    model = SAC("MlpPolicy", "Pendulum-v1", learning_rate=hp["learning_rate"],
-                learning_starts=0, batch_size=8, seed=0)
+    model = SAC(
+        "MlpPolicy",
+        "Pendulum-v1",
+        learning_rate=hp["learning_rate"],
+        learning_starts=0,
+        batch_size=8,
+        seed=0,
+    )
     assert model.actor.optimizer.param_groups[0]["lr"] == hp["learning_rate"]
     model.learn(400, callback=callback)
     start, end = callback.schedule(1.0), callback.schedule(0.0)
@@ -77,19 +90,60 @@ def test_zoo_learning_rate_callback_rejects_bad_rates(start, end):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("algo, extra", [
-    ("ppo", ["n_envs:4", "n_steps:64", "batch_size:256"]),
-    ("sac", ["n_envs:4", "learning_starts:200", "batch_size:64"]),
-])
+@pytest.mark.parametrize(
+    "algo, extra",
+    [
+        ("ppo", ["n_envs:4", "n_steps:64", "batch_size:256"]),
+        ("sac", ["n_envs:4", "learning_starts:200", "batch_size:64"]),
+    ],
+)
 def test_rl_zoo3_trains_and_replays(tmp_path, algo, extra):
     pytest.importorskip("rl_zoo3")
-    common = ["--algo", algo, "--env", "ACLDBeam-v1", "--gym-packages", "acld_gym",
-              "-f", str(tmp_path)]
-    subprocess.run([sys.executable, "-m", "rl_zoo3.train", *common, "--conf-file",
-                    f"train/zoo/{algo}.yml", "-n", "1024", "--seed", "0", "--eval-freq", "-1",
-                    "--hyperparams", *extra], check=True, capture_output=True)
+    common = [
+        "--algo",
+        algo,
+        "--env",
+        "ACLDBeam-v1",
+        "--gym-packages",
+        "acld_gym",
+        "-f",
+        str(tmp_path),
+    ]
+    subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "rl_zoo3.train",
+            *common,
+            "--conf-file",
+            f"train/zoo/{algo}.yml",
+            "-n",
+            "1024",
+            "--seed",
+            "0",
+            "--eval-freq",
+            "-1",
+            "--hyperparams",
+            *extra,
+        ],
+        check=True,
+        capture_output=True,
+    )
     assert (tmp_path / algo / "ACLDBeam-v1_1" / "ACLDBeam-v1.zip").is_file()
-    out = subprocess.run([sys.executable, "-m", "rl_zoo3.enjoy", *common, "--no-render",
-                          "-n", "1100", "--env-kwargs", "load_case:1"], check=True,
-                         capture_output=True, text=True)
+    out = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "rl_zoo3.enjoy",
+            *common,
+            "--no-render",
+            "-n",
+            "1100",
+            "--env-kwargs",
+            "load_case:1",
+        ],
+        check=True,
+        capture_output=True,
+        text=True,
+    )
     assert "Loading" in out.stdout + out.stderr

@@ -9,8 +9,14 @@ from train.config import TrainConfig
 def tiny_sac(timesteps: int = 10, **fields) -> TrainConfig:
     """A SAC ``TrainConfig`` of ``timesteps`` env steps on raw observations with
     ``fields`` (``select=``, ``average=``, ``restarts=``) set."""
-    return TrainConfig(algo="sac", timesteps=timesteps, model={"policy": "MlpPolicy"},
-                       features=None, normalize={}, **fields)
+    return TrainConfig(
+        algo="sac",
+        timesteps=timesteps,
+        model={"policy": "MlpPolicy"},
+        features=None,
+        normalize={},
+        **fields,
+    )
 
 
 class LinearModel:

@@ -41,24 +41,37 @@ def _limit_file_size():  # ulimit -f 1 (KB), with EFBIG instead of the killing s
 def test_file_size_limit_midway_keeps_the_previous_result(tmp_path):
     path = tmp_path / "model.json"
     path.write_text('{"previous": "result"}\n')
-    out = subprocess.run([sys.executable, "-m", "acld_gym.thesis.cli", "model", "--json",
-                          str(path)],
-                         capture_output=True, text=True, preexec_fn=_limit_file_size, cwd=ROOT)
+    out = subprocess.run(
+        [sys.executable, "-m", "acld_gym.thesis.cli", "model", "--json", str(path)],
+        capture_output=True,
+        text=True,
+        preexec_fn=_limit_file_size,
+        cwd=ROOT,
+    )
     assert out.returncode != 0  # the JSON (several KB) cannot be written
     assert json.loads(path.read_text()) == {"previous": "result"}
     assert sorted(p.name for p in tmp_path.iterdir()) == ["model.json"]
 
 
-@pytest.mark.parametrize("module, args", [
-    ("baselines.evaluate", ["--json"]), ("acld_gym.thesis.cli", ["reproduce", "--json"]),
-    ("train.compare", ["--json"]), ("acld_gym.thesis.cli", ["mesh", "--json"]),
-])
+@pytest.mark.parametrize(
+    "module, args",
+    [
+        ("baselines.evaluate", ["--json"]),
+        ("acld_gym.thesis.cli", ["reproduce", "--json"]),
+        ("train.compare", ["--json"]),
+        ("acld_gym.thesis.cli", ["mesh", "--json"]),
+    ],
+)
 def test_unwritable_output_fails_before_computing(module, args, tmp_path):
     blocker = tmp_path / "file"
     blocker.write_text("not a directory")
     t0 = time.perf_counter()
-    out = subprocess.run([sys.executable, "-m", module, *args, str(blocker / "out.json")],
-                         capture_output=True, text=True, cwd=ROOT)
+    out = subprocess.run(
+        [sys.executable, "-m", module, *args, str(blocker / "out.json")],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+    )
     assert out.returncode == 2 and "Traceback" not in out.stderr
     assert "--json" in out.stderr and "not a directory" in out.stderr
     assert time.perf_counter() - t0 < 30  # refused up front, not after the computing
@@ -73,8 +86,10 @@ def test_check_writable_names_the_problem(tmp_path):
 _HEAD = "algo: ppo\ntimesteps: 10\nn_envs: 2\n"
 CONFIGS = {
     "malformed YAML": ("n_envs: [1,\n", "YAML"),
-    "learning_rate: fast": (_HEAD + "model: {policy: MlpPolicy, learning_rate: fast}\n",
-                            "learning_rate"),
+    "learning_rate: fast": (
+        _HEAD + "model: {policy: MlpPolicy, learning_rate: fast}\n",
+        "learning_rate",
+    ),
     "misspelled key": (_HEAD + "model: {policy: MlpPolicy, n_stepz: 3}\n", "n_stepz"),
     "shaping .inf": (_HEAD + "shaping: .inf\nmodel: {policy: MlpPolicy}\n", "shaping"),
 }
@@ -86,27 +101,44 @@ def test_training_cli_bad_config_is_one_line_and_creates_nothing(case, tmp_path)
     cfg = tmp_path / "bad.yaml"
     cfg.write_text(text)
     out_dir = tmp_path / "run"
-    res = subprocess.run([sys.executable, "-m", "train", "ppo", "--config", str(cfg),
-                          "--out", str(out_dir)], capture_output=True, text=True, cwd=ROOT)
+    res = subprocess.run(
+        [sys.executable, "-m", "train", "ppo", "--config", str(cfg), "--out", str(out_dir)],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+    )
     assert res.returncode == 2 and "Traceback" not in res.stderr
     assert word in res.stderr.strip().splitlines()[-1]
     assert not out_dir.exists()
 
 
-@pytest.mark.parametrize("flags, word", [
-    (["--param-noise", "inf"], "--param-noise"), (["--seed", "99999999999999999999"], "--seed"),
-    (["--param-noise", "0.5"], "--param-noise"),
-])
+@pytest.mark.parametrize(
+    "flags, word",
+    [
+        (["--param-noise", "inf"], "--param-noise"),
+        (["--seed", "99999999999999999999"], "--seed"),
+        (["--param-noise", "0.5"], "--param-noise"),
+    ],
+)
 def test_training_cli_bad_flags(flags, word, tmp_path):
     out_dir = tmp_path / "run"
-    res = subprocess.run([sys.executable, "-m", "train", "ppo", *flags, "--out", str(out_dir)],
-                         capture_output=True, text=True, cwd=ROOT)
+    res = subprocess.run(
+        [sys.executable, "-m", "train", "ppo", *flags, "--out", str(out_dir)],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+    )
     assert res.returncode == 2 and "Traceback" not in res.stderr and word in res.stderr
     assert not out_dir.exists()
 
 
 def test_closed_pipe_is_quiet():
-    res = subprocess.run(f"{sys.executable} -m acld_gym.thesis.cli params | head -1", shell=True,
-                         capture_output=True, text=True, cwd=ROOT,
-                         env={**os.environ, "PYTHONUNBUFFERED": "1"})
+    res = subprocess.run(
+        f"{sys.executable} -m acld_gym.thesis.cli params | head -1",
+        shell=True,
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        env={**os.environ, "PYTHONUNBUFFERED": "1"},
+    )
     assert res.stdout.startswith("| field") and "Traceback" not in res.stderr

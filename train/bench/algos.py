@@ -20,8 +20,9 @@ def restart_seeds(seed: int, restarts: int) -> list[int]:
     plain recipe), then 32-bit seeds drawn from ``numpy.random.SeedSequence((seed, k))``,
     which no other trial's seed list shares by construction (``seed + k`` would make
     seed 0's second run seed 1's first)."""
-    derived = [int(np.random.SeedSequence((seed, k)).generate_state(1)[0])
-               for k in range(1, restarts)]
+    derived = [
+        int(np.random.SeedSequence((seed, k)).generate_state(1)[0]) for k in range(1, restarts)
+    ]
     return [int(seed), *derived]
 
 
@@ -74,8 +75,9 @@ def train_algo(
         total += record["steps"]
         if cfg.restarts > 1:
             sel = record["select"]
-            runs.append({"seed": run_seed, "steps": sel["steps"], "cost": sel["cost"],
-                         "curve": curve})
+            runs.append(
+                {"seed": run_seed, "steps": sel["steps"], "cost": sel["cost"], "curve": curve}
+            )
         if best is None or (runs and runs[-1]["cost"] < runs[best[0]]["cost"]):
             best = (k, policy, record)  # the first of equal costs is kept
         policy = record = None

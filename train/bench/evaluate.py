@@ -157,8 +157,7 @@ def validation_rollout(policy, env_id: str = DEFAULT_ENV_ID, seeds=None) -> tupl
     seeds = [int(s) for s in (validation_seeds(32) if seeds is None else seeds)]
     if not seeds:
         raise ValueError("seeds must hold at least one random-load seed, got none")
-    venv = gym.make_vec(env_id, num_envs=len(seeds), load_case="random",
-                        reward_scale="passive")
+    venv = gym.make_vec(env_id, num_envs=len(seeds), load_case="random", reward_scale="passive")
     obs, _ = venv.reset(seed=seeds)
     (ret,), (steps,) = _side_by_side(policy, [venv], [obs], lambda r, info: r)
     return float(np.mean(-ret / steps)), int(steps.sum())

@@ -12,23 +12,34 @@ from acld_gym.util.atomic import save_figure
 from .evaluate import CASES
 from .trials import REFERENCES
 
-__all__ = ["GOALS", "goals_of", "summarize", "markdown", "ratio_log_axis", "curves_figure",
-           "plot_curves"]
+__all__ = [
+    "GOALS",
+    "goals_of",
+    "summarize",
+    "markdown",
+    "ratio_log_axis",
+    "curves_figure",
+    "plot_curves",
+]
 
 
 #: The goals (issue 20), each a function of every seed's ISE / LQR ``rel`` (seeds x
 #: :data:`CASES`), their IQM ``stats``, the references (ISE / LQR) and the runs.
 GOALS = {
-    "every_seed_beats_lqr_and_smc": lambda rel, stats, refs, runs: bool(all(
-        (rel[:, j] < min(1.0, refs.get("smc", {}).get(c, np.inf))).all()
-        for j, c in ((0, "1"), (1, "2"), (3, "random")))),
-    "every_seed_case3_within_2pct": lambda rel, stats, refs, runs: bool(
-        (rel[:, 2] <= 1.02).all()),
+    "every_seed_beats_lqr_and_smc": lambda rel, stats, refs, runs: bool(
+        all(
+            (rel[:, j] < min(1.0, refs.get("smc", {}).get(c, np.inf))).all()
+            for j, c in ((0, "1"), (1, "2"), (3, "random"))
+        )
+    ),
+    "every_seed_case3_within_2pct": lambda rel, stats, refs, runs: bool((rel[:, 2] <= 1.02).all()),
     "iqm_cases_1_2_at_most_0.90": lambda rel, stats, refs, runs: all(
-        stats[c]["iqm"] <= 0.90 for c in ("1", "2")),
+        stats[c]["iqm"] <= 0.90 for c in ("1", "2")
+    ),
     "iqm_random_at_most_0.97": lambda rel, stats, refs, runs: stats["random"]["iqm"] <= 0.97,
-    "train_wall_within_15_min": lambda rel, stats, refs, runs: max(
-        r["train_seconds"] for r in runs) <= 900.0,
+    "train_wall_within_15_min": lambda rel, stats, refs, runs: (
+        max(r["train_seconds"] for r in runs) <= 900.0
+    ),
 }
 
 
@@ -205,14 +216,22 @@ def _draw_case(ax, summary: dict, key: str, zoom_from: float) -> list[float]:
         ax.fill_between(steps, lo, hi, color=line.get_color(), alpha=0.2, lw=0)
         # the reported result: the final policy, or the selected checkpoint (select:)
         rep = a["ise_rel_lqr"][key]
-        ax.plot([a["budget"]], [rep["iqm"]], marker="D", ms=6, mfc="none",
-                color=line.get_color(), ls="none")
+        ax.plot(
+            [a["budget"]],
+            [rep["iqm"]],
+            marker="D",
+            ms=6,
+            mfc="none",
+            color=line.get_color(),
+            ls="none",
+        )
         near += [*mid[steps >= zoom_from], rep["ci_low"], rep["ci_high"]]
     for ref, (color, ls) in _REF_STYLES.items():
         if ref in summary["references"]:
             level = summary["references"][ref][key]
-            ax.axhline(level, color=color, ls=ls, lw=1,
-                       label=ref.upper() if ref != "bound" else "bound")
+            ax.axhline(
+                level, color=color, ls=ls, lw=1, label=ref.upper() if ref != "bound" else "bound"
+            )
             if ref in ("lqr", "smc"):
                 near.append(level)
     return near
@@ -246,8 +265,7 @@ def curves_figure(summary: dict):
                 ax.set_xscale("symlog", linthresh=1e4)  # step 0 (the initial actor) included
                 ax.set_xlim(left=0)
                 ratio_log_axis(ax, subs=(2, 3, 5))
-                ax.set_title(f"load case {case}" if case != "random"
-                             else "held-out random loads")
+                ax.set_title(f"load case {case}" if case != "random" else "held-out random loads")
             else:
                 ax.set_xscale("log")
                 ax.set_xlim(zoom_from, 1.3 * max(a["budget"] for a in algos.values()))
@@ -266,8 +284,15 @@ def curves_figure(summary: dict):
                 ax.set_xlabel("env steps")
     grid[0][0].set_ylabel("ISE / ISE$_{LQR}$ (IQM over seeds, 95 % CI)")
     grid[1][0].set_ylabel("ISE / ISE$_{LQR}$, zoomed")
-    grid[0][0].plot([], [], marker="D", mfc="none", color="k", ls="none",
-                    label="reported (final or selected checkpoint)")
+    grid[0][0].plot(
+        [],
+        [],
+        marker="D",
+        mfc="none",
+        color="k",
+        ls="none",
+        label="reported (final or selected checkpoint)",
+    )
     grid[0][0].legend(fontsize=7)
     fig.suptitle(f"Teacher-free RL on {summary['env_id']}", fontsize=10)
     fig.tight_layout()
@@ -302,10 +327,20 @@ def main(argv: list[str] | None = None) -> int:
 
     p = argparse.ArgumentParser(prog="python -m train.bench.report", description=main.__doc__)
     p.add_argument("results", type=Path, help="a results.json of python -m train.benchmark")
-    p.add_argument("--write", type=Path, default=None, metavar="PAGE",
-                   help="replace the generated block of this Markdown page")
-    p.add_argument("--plot", type=Path, default=None, metavar="FIG",
-                   help="also write the learning curves to this image")
+    p.add_argument(
+        "--write",
+        type=Path,
+        default=None,
+        metavar="PAGE",
+        help="replace the generated block of this Markdown page",
+    )
+    p.add_argument(
+        "--plot",
+        type=Path,
+        default=None,
+        metavar="FIG",
+        help="also write the learning curves to this image",
+    )
     args = p.parse_args(argv)
     try:
         summary = json.loads(args.results.read_text())

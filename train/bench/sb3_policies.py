@@ -252,18 +252,37 @@ class ScaledQuadraticCritic(ContinuousCritic):
     there, and meanwhile the quadratic terms make up for it; a feature of 100 brings it
     within 700."""
 
-    def __init__(self, observation_space, action_space, net_arch, *args, n_critics: int = 2,
-                 activation_fn=nn.ReLU, action_headroom: float = 1.0,
-                 offset_scale: float | None = None, **kwargs):
-        super().__init__(observation_space, action_space, net_arch, *args, n_critics=n_critics,
-                         activation_fn=activation_fn, **kwargs)
+    def __init__(
+        self,
+        observation_space,
+        action_space,
+        net_arch,
+        *args,
+        n_critics: int = 2,
+        activation_fn=nn.ReLU,
+        action_headroom: float = 1.0,
+        offset_scale: float | None = None,
+        **kwargs,
+    ):
+        super().__init__(
+            observation_space,
+            action_space,
+            net_arch,
+            *args,
+            n_critics=n_critics,
+            activation_fn=activation_fn,
+            **kwargs,
+        )
         from stable_baselines3.common.torch_layers import create_mlp
 
         from acld_gym.wrappers import check_headroom
 
         self.action_headroom = check_headroom(action_headroom)
-        self.offset_scale = (None if offset_scale is None else
-                             check_real("offset_scale", offset_scale, 0.0, low_open=True))
+        self.offset_scale = (
+            None
+            if offset_scale is None
+            else check_real("offset_scale", offset_scale, 0.0, low_open=True)
+        )
         d = int(observation_space.shape[0]) - 1 + int(np.prod(action_space.shape))
         self.quadratic = QuadraticFeatures(spaces.Box(-np.inf, np.inf, (d,), np.float32))
         # and the constant feature offset_scale, if any
@@ -310,17 +329,24 @@ class AsymmetricSACPolicy(SACPolicy):
     #: applied action): :func:`train.bench.sb3_train.make_model` passes the config's.
     takes_action_headroom = True
 
-    def __init__(self, *args, action_headroom: float = 1.0, offset_scale: float | None = None,
-                 mean_clip: float | None = None, log_std_min: float | None = None, **kwargs):
+    def __init__(
+        self,
+        *args,
+        action_headroom: float = 1.0,
+        offset_scale: float | None = None,
+        mean_clip: float | None = None,
+        log_std_min: float | None = None,
+        **kwargs,
+    ):
         from acld_gym.wrappers import check_headroom
 
         self.action_headroom = check_headroom(action_headroom)
         if mean_clip is not None:
             check_real("mean_clip", mean_clip, 0.0, low_open=True)
-        if log_std_min is not None and not -20.0 <= check_real("log_std_min",
-                                                               log_std_min) < 2.0:
-            raise ValueError(f"log_std_min must be in [-20, 2) (SAC's log std range), got "
-                             f"{log_std_min!r}")
+        if log_std_min is not None and not -20.0 <= check_real("log_std_min", log_std_min) < 2.0:
+            raise ValueError(
+                f"log_std_min must be in [-20, 2) (SAC's log std range), got {log_std_min!r}"
+            )
         self.offset_scale = offset_scale
         self.mean_clip = mean_clip
         self.log_std_min = log_std_min
@@ -338,11 +364,16 @@ class AsymmetricSACPolicy(SACPolicy):
 
     def make_critic(self, features_extractor=None) -> ScaledQuadraticCritic:
         critic_kwargs = self._update_features_extractor(self.critic_kwargs, features_extractor)
-        return ScaledQuadraticCritic(**critic_kwargs, action_headroom=self.action_headroom,
-                                     offset_scale=self.offset_scale).to(self.device)
+        return ScaledQuadraticCritic(
+            **critic_kwargs, action_headroom=self.action_headroom, offset_scale=self.offset_scale
+        ).to(self.device)
 
     def _get_constructor_parameters(self) -> dict:
         data = super()._get_constructor_parameters()
-        data.update(action_headroom=self.action_headroom, offset_scale=self.offset_scale,
-                    mean_clip=self.mean_clip, log_std_min=self.log_std_min)
+        data.update(
+            action_headroom=self.action_headroom,
+            offset_scale=self.offset_scale,
+            mean_clip=self.mean_clip,
+            log_std_min=self.log_std_min,
+        )
         return data

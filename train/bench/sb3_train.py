@@ -59,9 +59,11 @@ def _resolve_policy_kwargs(kwargs: dict) -> dict:
         if isinstance(kwargs.get(key), dict):
             kwargs = {**kwargs, key: _schedule(key, kwargs[key])}
 
-    named = {"SplitCriticPolicy": SplitCriticPolicy,
-             "AsymmetricCriticPolicy": AsymmetricCriticPolicy,
-             "AsymmetricSACPolicy": AsymmetricSACPolicy}
+    named = {
+        "SplitCriticPolicy": SplitCriticPolicy,
+        "AsymmetricCriticPolicy": AsymmetricCriticPolicy,
+        "AsymmetricSACPolicy": AsymmetricSACPolicy,
+    }
     if kwargs.get("policy") in named:
         kwargs = {**kwargs, "policy": named[kwargs["policy"]]}
     pk = dict(kwargs.get("policy_kwargs") or {})
@@ -101,22 +103,25 @@ def make_model(cfg: TrainConfig, venv, seed: int, **kwargs):
     ent_sched = ent_coef_schedule(cfg)
     if ent_sched is not None:
         if cfg.algo != "ppo":
-            raise ValueError(f"model.ent_coef: a schedule {{linear: [start, end]}} is for "
-                             f"ppo only, got one for {cfg.algo}")
+            raise ValueError(
+                f"model.ent_coef: a schedule {{linear: [start, end]}} is for "
+                f"ppo only, got one for {cfg.algo}"
+            )
         model_kwargs["ent_coef"] = ent_sched(1.0)
     policy = model_kwargs.pop("policy")
     if getattr(policy, "takes_action_headroom", False):  # it needs the env's action map
         pk = dict(model_kwargs.get("policy_kwargs") or {})
         if pk.get("action_headroom", cfg.action_headroom) != cfg.action_headroom:
-            raise ValueError(f"model.policy_kwargs.action_headroom "
-                             f"{pk['action_headroom']!r} differs from action_headroom "
-                             f"{cfg.action_headroom!r}: give it once, as action_headroom")
+            raise ValueError(
+                f"model.policy_kwargs.action_headroom "
+                f"{pk['action_headroom']!r} differs from action_headroom "
+                f"{cfg.action_headroom!r}: give it once, as action_headroom"
+            )
         model_kwargs["policy_kwargs"] = {**pk, "action_headroom": cfg.action_headroom}
     if cfg.episode_scale:
         model_kwargs["rollout_buffer_class"] = EpisodeScaledRolloutBuffer
     model_kwargs.setdefault("verbose", 0)
-    return algo_class(cfg.algo)(policy, venv, seed=seed, device="cpu",
-                                **{**model_kwargs, **kwargs})
+    return algo_class(cfg.algo)(policy, venv, seed=seed, device="cpu", **{**model_kwargs, **kwargs})
 
 
 class Selection:
@@ -159,8 +164,13 @@ class Selection:
             self.check(steps, model, snapshot)
         cost, chosen, state = self.best
         model.policy.load_state_dict(state)
-        return {"episodes": self.config.episodes, "history": self.history,
-                "steps": chosen, "cost": cost, "validation_env_steps": self.env_steps}
+        return {
+            "episodes": self.config.episodes,
+            "history": self.history,
+            "steps": chosen,
+            "cost": cost,
+            "validation_env_steps": self.env_steps,
+        }
 
 
 class Averaging:
@@ -180,8 +190,11 @@ class Averaging:
     def update(self, steps: int, model) -> None:
         if self.config is None or steps < self.config.start:
             return
-        params = {k: v.detach().to(torch.float64, copy=True)
-                  for k, v in model.policy.state_dict().items() if v.is_floating_point()}
+        params = {
+            k: v.detach().to(torch.float64, copy=True)
+            for k, v in model.policy.state_dict().items()
+            if v.is_floating_point()
+        }
         self.count += 1
         if self.mean is None:
             self.mean = params
@@ -195,7 +208,8 @@ class Averaging:
     def _load(self, model) -> None:
         state = model.policy.state_dict()
         model.policy.load_state_dict(
-            {**state, **{k: v.to(state[k].dtype) for k, v in self.mean.items()}})
+            {**state, **{k: v.to(state[k].dtype) for k, v in self.mean.items()}}
+        )
 
     @contextmanager
     def applied(self, model):
@@ -214,8 +228,11 @@ class Averaging:
         if self.mean is None:
             return None
         self._load(model)
-        return {"start": self.config.start, "halflife": self.config.halflife,
-                "iterates": self.count}
+        return {
+            "start": self.config.start,
+            "halflife": self.config.halflife,
+            "iterates": self.count,
+        }
 
 
 def train_sb3(
@@ -242,8 +259,10 @@ def train_sb3(
         from ..distill import distill
 
         t0 = time.perf_counter()
-        distilled = {"history": distill(model, venv, cfg.distill_config, seed=seed),
-                     "seconds": round(time.perf_counter() - t0, 1)}
+        distilled = {
+            "history": distill(model, venv, cfg.distill_config, seed=seed),
+            "seconds": round(time.perf_counter() - t0, 1),
+        }
     schedule = eval_schedule(cfg.timesteps, cfg.eval_points)
     white = venv.venv  # under VecNormalize (whiten_steps: no direction features)
     transform = None

@@ -71,8 +71,8 @@ def run_trial(
         "env_id": env_id,
         "config": config,
         "random_episodes": int(random_episodes),
-        "command": command or f"python -m train.benchmark --config {name} --seeds {seed} "
-        f"--env-id {env_id}",
+        "command": command
+        or f"python -m train.benchmark --config {name} --seeds {seed} --env-id {env_id}",
         "budget": cfg.budget,
         "steps": int(record.get("steps", 0)),
         "train_seconds": float(record["train_seconds"]),
@@ -81,7 +81,8 @@ def run_trial(
         "final_ise": {str(c): v for c, v in final.items()},
         "curve": record["curve"],
         "record": {
-            k: v for k, v in record.items()
+            k: v
+            for k, v in record.items()
             if k not in ("train_seconds", "train_cpu_seconds", "curve")
         },
     }

@@ -38,8 +38,9 @@ class LinearLearningRate(BaseCallback):
 
     def __init__(self, start: float, end: float, verbose: int = 0):
         super().__init__(verbose)
-        self.schedule = LinearSchedule(check_real("start", start, 0.0, low_open=True),
-                                       check_real("end", end, 0.0))
+        self.schedule = LinearSchedule(
+            check_real("start", start, 0.0, low_open=True), check_real("end", end, 0.0)
+        )
 
     def _on_training_start(self) -> None:
         self.model.lr_schedule = self.schedule

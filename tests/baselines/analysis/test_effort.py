@@ -19,8 +19,7 @@ def test_triangle_wave_has_its_rms_and_total_variation():
     v = A * (1 - 4 * np.abs(((k + period / 4) / period) % 1 - 0.5))
     e = effort(v, np.zeros(n), DT, settle_s=0.5)
     # sampled at 20 steps per ramp: RMS^2 = (A^2 / 3)(1 + 2 / 20^2) (continuous: A^2 / 3)
-    assert e.rms_voltage_V == pytest.approx(A / math.sqrt(3) * math.sqrt(1 + 2 / 20**2),
-                                            rel=1e-9)
+    assert e.rms_voltage_V == pytest.approx(A / math.sqrt(3) * math.sqrt(1 + 2 / 20**2), rel=1e-9)
     assert e.total_variation_V_per_s == pytest.approx(4 * A / (period * DT), rel=1e-9)
     assert e.limit_fraction == 0.0 and e.settled_from_s == 0.5
 
@@ -47,7 +46,8 @@ def test_time_at_the_limit_and_residual_tip_in_the_settled_window():
     assert e.residual_tip_rms_m == pytest.approx(2e-6)
     assert e.settled_rms_voltage_V == pytest.approx(math.sqrt((3 * 120.0**2 + 9.0) / 4))
     assert effort(v, y, DT, 0.5).reactive_power_var == pytest.approx(
-        effort(v, y, DT, 0.5, capacitance=patch_capacitance()).reactive_power_var)
+        effort(v, y, DT, 0.5, capacitance=patch_capacitance()).reactive_power_var
+    )
 
 
 def test_the_limit_within_a_solver_tolerance():

@@ -52,14 +52,16 @@ def test_no_load_is_rest_and_loads_add_up(rig):
 def test_passive_run_is_the_convolution_and_equals_the_passive_policy(rig):
     f = np.zeros(400)
     f[[0, 50, 51]] = (0.3, -0.2, 0.5)
-    np.testing.assert_allclose(rig.passive(f).y, rig.run(PassivePolicy(), f).y,
-                               atol=1e-12 * np.abs(rig.passive(f).y).max())
+    np.testing.assert_allclose(
+        rig.passive(f).y, rig.run(PassivePolicy(), f).y, atol=1e-12 * np.abs(rig.passive(f).y).max()
+    )
 
 
 def test_causal_convolution_by_hand():
     g = np.array([9.0, 1.0, 2.0, 3.0])  # g[0] is never used
-    np.testing.assert_allclose(causal_convolution([1.0, 10.0, 0.0], g),
-                               [0.0, 1.0, 2.0 + 10.0, 3.0 + 20.0])
+    np.testing.assert_allclose(
+        causal_convolution([1.0, 10.0, 0.0], g), [0.0, 1.0, 2.0 + 10.0, 3.0 + 20.0]
+    )
 
 
 def test_refusals_are_named(rig):

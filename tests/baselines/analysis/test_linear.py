@@ -57,8 +57,9 @@ def test_differences_of_predict_give_the_declared_gain(cls):
     declared, _ = small_signal_law(pol, 9, 120.0)
     measured, why = small_signal_law(PredictOnly(pol), 9, 120.0)
     assert measured is not None, why
-    np.testing.assert_allclose(measured.gain, declared.gain, rtol=1e-5,
-                               atol=1e-6 * np.abs(declared.gain).max())
+    np.testing.assert_allclose(
+        measured.gain, declared.gain, rtol=1e-5, atol=1e-6 * np.abs(declared.gain).max()
+    )
     assert declared.gain[8] == 0 and declared.offset == 0  # the tip entry is not used
 
 
@@ -100,8 +101,9 @@ def test_loop_matches_the_robustness_study(loop):
     pol = LQRPolicy()
     law, _ = small_signal_law(pol, 9, 120.0)
     nom = pol.nom
-    ref = np.linalg.eigvals(closed_loop_matrix(nom.plant, nom.output, nom.kalman,
-                                               pol.small_signal_gain()))
+    ref = np.linalg.eigvals(
+        closed_loop_matrix(nom.plant, nom.output, nom.kalman, pol.small_signal_gain())
+    )
     got = np.linalg.eigvals(loop.closed_loop(law))
     np.testing.assert_allclose(np.sort_complex(got), np.sort_complex(ref), atol=1e-12)
 
@@ -113,8 +115,11 @@ def test_modes_and_margins_do_not_depend_on_the_plants_coordinates(loop, passive
     n = loop.plant.Ad.shape[0]
     T = np.linalg.qr(rng.normal(size=(n, n)))[0] * rng.choice([-1.0, 1.0], n)
     p = loop.plant
-    moved = replace(loop, plant=replace(p, Ad=T.T @ p.Ad @ T, Bd=T.T @ p.Bd, W0=T.T @ p.W0,
-                                        W1=T.T @ p.W1), output=loop.output @ T)
+    moved = replace(
+        loop,
+        plant=replace(p, Ad=T.T @ p.Ad @ T, Bd=T.T @ p.Bd, W0=T.T @ p.W0, W1=T.T @ p.W1),
+        output=loop.output @ T,
+    )
     for a, b in zip(loop.modes(law, edges, 2000), moved.modes(law, edges, 2000), strict=True):
         # rel 1e-9: an eigenvalue of the rotated loop moves by round-off times its condition
         # (1.4e-10 relative for mode 3 with OpenBLAS's Nehalem kernels, 2653.6897212 rad/s)
@@ -134,8 +139,11 @@ def test_the_gain_margin_is_where_the_loop_goes_unstable(loop, cls):
     at = LinearLaw(gain=k * law.gain, offset=0.0)
     below = LinearLaw(gain=0.97 * k * law.gain, offset=0.0)
     assert loop.spectral_radius(at) == pytest.approx(1.0, abs=2e-4)
-    assert loop.spectral_radius(below) < 1.0 < loop.spectral_radius(
-        LinearLaw(gain=1.03 * k * law.gain, offset=0.0))
+    assert (
+        loop.spectral_radius(below)
+        < 1.0
+        < loop.spectral_radius(LinearLaw(gain=1.03 * k * law.gain, offset=0.0))
+    )
 
 
 def test_the_phase_margin_is_read_at_a_gain_crossover(loop):
@@ -161,8 +169,15 @@ def _small_pulse_run(pol_cls=LQRPolicy, steps=1500, **options):
     from acld_gym.physics.loads import thesis_load
     from baselines.evaluate import rollout
 
-    env = ACLDBeamEnv(config=preset("ACLDBeam-v1", sensor_noise=0.0, episode_length=steps * 1e-3,
-                                    load_case=thesis_load(1).scaled(1e-3), **options))
+    env = ACLDBeamEnv(
+        config=preset(
+            "ACLDBeam-v1",
+            sensor_noise=0.0,
+            episode_length=steps * 1e-3,
+            load_case=thesis_load(1).scaled(1e-3),
+            **options,
+        )
+    )
     pol = pol_cls.for_env(env)
     ep = rollout(pol, env, seed=0)
     loop = ObserverLoop.from_env(env)
@@ -195,6 +210,7 @@ def test_the_lab_rigs_delay_makes_the_nominal_lqr_unstable():
     assert rho > 1.01 and not margins(loop, law)["closed_loop_stable"]
     linear = int(np.argmax(np.abs(ep.voltage) >= 120.0))  # the first saturated period
     assert 200 < linear < 600
-    np.testing.assert_allclose(ep.y[:linear], exact[:linear],
-                               atol=1e-6 * np.abs(exact[:linear]).max())
-    assert np.abs(ep.y[linear - 50:linear]).max() > 10 * np.abs(ep.y[:50]).max()  # it grows
+    np.testing.assert_allclose(
+        ep.y[:linear], exact[:linear], atol=1e-6 * np.abs(exact[:linear]).max()
+    )
+    assert np.abs(ep.y[linear - 50 : linear]).max() > 10 * np.abs(ep.y[:50]).max()  # it grows

@@ -35,9 +35,11 @@ def test_passive_modes_are_the_models(rig, passive):
             assert m.damping_ratio == pytest.approx(zi, rel=1e-3)  # in fact much closer
 
 
-@pytest.mark.parametrize("make", [LQRPolicy, SMCPolicy, MPCPolicy,
-                                  lambda: TrainedAgent.load(AGENTS_DIR / "vrs")],
-                         ids=["lqr", "smc", "mpc", "vrs"])
+@pytest.mark.parametrize(
+    "make",
+    [LQRPolicy, SMCPolicy, MPCPolicy, lambda: TrainedAgent.load(AGENTS_DIR / "vrs")],
+    ids=["lqr", "smc", "mpc", "vrs"],
+)
 def test_identified_closed_loop_modes_are_the_exact_eigenvalues(rig, passive, make):
     pol = make()
     _, edges = passive

@@ -37,9 +37,14 @@ def test_the_bounds_own_episodes_score_one_and_lqr_zero(refs5):
     assert np.all(score_of(refs5.bound_ise, refs5).scores == 1.0)
     s = score_policy(LQRPolicy(), n_episodes=5, refs=refs5)
     assert np.all(s.scores == 0.0) and s.iqm == s.ci_low == s.ci_high == 0.0
-    assert s.as_dict() == {"iqm": 0.0, "ci_low": 0.0, "ci_high": 0.0, "n_episodes": 5,
-                           "test_set": "ACLDBeam-v1/test-v1",
-                           "mean_ise": pytest.approx(np.mean(refs5.lqr_ise), rel=1e-12)}
+    assert s.as_dict() == {
+        "iqm": 0.0,
+        "ci_low": 0.0,
+        "ci_high": 0.0,
+        "n_episodes": 5,
+        "test_set": "ACLDBeam-v1/test-v1",
+        "mean_ise": pytest.approx(np.mean(refs5.lqr_ise), rel=1e-12),
+    }
 
 
 def test_replaying_the_bounds_voltages_open_loop_scores_one(refs5):
@@ -54,8 +59,10 @@ def test_replaying_the_bounds_voltages_open_loop_scores_one(refs5):
 
 
 def test_the_interval_shrinks_as_episodes_are_added():
-    widths = [(lambda s: s.ci_high - s.ci_low)(score_policy(SMCPolicy(), n_episodes=n))
-              for n in (10, 20, 40)]
+    widths = [
+        (lambda s: s.ci_high - s.ci_low)(score_policy(SMCPolicy(), n_episodes=n))
+        for n in (10, 20, 40)
+    ]
     assert widths[0] > widths[1] > widths[2] > 0
 
 
@@ -98,8 +105,9 @@ def test_a_cached_file_is_reused_after_one_spot_check(counted, tmp_path):
     assert _file(tmp_path) == cache_path(test, _file(tmp_path).stem.rsplit("-", 1)[1])
 
 
-@pytest.mark.parametrize("damage", ["not json", "bound above lqr", "stale first episode",
-                                    "other seeds"])
+@pytest.mark.parametrize(
+    "damage", ["not json", "bound above lqr", "stale first episode", "other seeds"]
+)
 def test_a_damaged_or_stale_file_is_recomputed(counted, tmp_path, damage, capsys):
     test = TEST.first(3)
     good = references(test)

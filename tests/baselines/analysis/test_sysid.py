@@ -89,8 +89,7 @@ def test_the_most_energetic_pole_of_each_band_is_its_mode():
     assert modes[1].frequency_rad_s == pytest.approx(abs(-5 + 1000j))
     # an empty band gives None; a heavily damped pair is no mode
     heavy = np.exp(np.array([-600 + 1000j]) * DT)
-    assert select_modes(heavy, np.ones(1), DT, band_edges([200.0, 1000.0], DT), 100) == [None,
-                                                                                          None]
+    assert select_modes(heavy, np.ones(1), DT, band_edges([200.0, 1000.0], DT), 100) == [None, None]
 
 
 def test_residues_do_not_depend_on_the_realization():

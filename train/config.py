@@ -26,6 +26,7 @@ __all__ = [
     "TrainConfig",
     "SelectConfig",
     "AverageConfig",
+    "StdAnnealConfig",
     "algo_class",
     "config_path",
     "read_config",
@@ -120,6 +121,43 @@ class AverageConfig:
             check_int("average.halflife", self.halflife, 1, 10**12)
 
 
+@dataclass(frozen=True)
+class StdAnnealConfig:
+    r"""An annealed exploration noise (``TrainConfig.anneal_std``; PPO only, whose policy has
+    a state-independent log std, SB3's ``log_std`` parameter, Gaussian or gSDE): from env
+    step ``start`` on, the log std is no longer trained; it is held at its value there,
+    :math:`\log\sigma_0`, and lowered before each rollout to
+    :math:`\log\sigma_0 + \log f`, with f falling linearly in env steps from 1 at
+    ``start`` to ``end`` at the budget's end (gSDE's noise is drawn anew at the new std),
+    as the random search's noise falls over its budget (``vrs``: ``anneal``).
+
+    Attributes
+    ----------
+    start : int
+        Env steps before the annealing (the log std is trained until then).
+    end : float
+        The std's factor at the budget's end, in (0, 1].
+    """
+
+    start: int
+    end: float
+
+    def __post_init__(self):
+        check_int("anneal_std.start", self.start, 0, 10**12)
+        if isinstance(self.end, bool) or not isinstance(self.end, (int, float)):
+            raise ValueError(f"anneal_std.end must be a number in (0, 1], got {self.end!r}")
+        if not 0.0 < float(self.end) <= 1.0:
+            raise ValueError(f"anneal_std.end must lie in (0, 1], got {self.end!r}")
+
+    def factor(self, steps: int, stop: int) -> float:
+        """f at env step ``steps`` of a run whose budget ends at ``stop`` (1 before
+        ``start``, ``end`` from ``stop`` on)."""
+        if steps <= self.start:
+            return 1.0
+        done = min((steps - self.start) / max(stop - self.start, 1), 1.0)
+        return 1.0 - (1.0 - float(self.end)) * done
+
+
 def _section(cls, data: dict, name: str):
     """The dataclass ``cls`` of a config's mapping ``name`` (``distill``, ``select``,
     ``average``);
@@ -147,6 +185,7 @@ _SECTIONS = {
     "distill": _distill_config_class,
     "select": lambda: SelectConfig,
     "average": lambda: AverageConfig,
+    "anneal_std": lambda: StdAnnealConfig,
 }
 
 
@@ -236,6 +275,10 @@ class TrainConfig:
     average : dict or None
         SB3 algorithms: weight averaging of the policy (:class:`AverageConfig`'s fields,
         e.g. ``{start: 1000000}``); None (default): the iterates as trained.
+    anneal_std : dict or None
+        PPO: the exploration noise annealed over the end of the budget
+        (:class:`StdAnnealConfig`'s fields, e.g. ``{start: 2500000, end: 0.2}``); None
+        (default): the log std trained throughout.
     restarts : int
         SB3 algorithms with ``select``: independent runs of ``timesteps`` each from fresh
         initialisations (the first with the trial's seed, the others with seeds derived
@@ -261,6 +304,7 @@ class TrainConfig:
     distill: dict | None = None
     select: dict | None = None
     average: dict | None = None
+    anneal_std: dict | None = None
     restarts: int = 1
 
     @property
@@ -370,6 +414,10 @@ class TrainConfig:
             raise ValueError(
                 "residual, shaping, distill, select and average are for the SB3 algorithms"
             )
+        if self.anneal_std is not None and self.algo != "ppo":
+            raise ValueError(
+                f"anneal_std is for ppo only (a state-independent log std), got algo {self.algo!r}"
+            )
         if self.restarts > 1 and self.select is None:
             raise ValueError(
                 f"restarts: {self.restarts} runs need select: (the choice between "
@@ -446,6 +494,11 @@ class TrainConfig:
     def average_config(self) -> AverageConfig | None:
         """The :class:`AverageConfig` of ``average`` (None if off)."""
         return self._section_config("average")
+
+    @property
+    def anneal_std_config(self) -> StdAnnealConfig | None:
+        """The :class:`StdAnnealConfig` of ``anneal_std`` (None if off)."""
+        return self._section_config("anneal_std")
 
     @property
     def teacher(self) -> str | None:

@@ -28,7 +28,15 @@ from .sb3_policies import (
     SplitCriticPolicy,
 )
 
-__all__ = ["Averaging", "LinearSchedule", "Selection", "fold_whitening", "make_model", "train_sb3"]
+__all__ = [
+    "Averaging",
+    "LinearSchedule",
+    "Selection",
+    "StdAnnealing",
+    "fold_whitening",
+    "make_model",
+    "train_sb3",
+]
 
 
 class LinearSchedule:
@@ -235,6 +243,45 @@ class Averaging:
         }
 
 
+class StdAnnealing:
+    """The annealed exploration noise of :class:`train.config.StdAnnealConfig`
+    (``cfg.anneal_std``; inert if None): :meth:`update`, before each rollout, freezes the
+    policy's ``log_std`` the first time the run is at or past ``start`` and sets it to the
+    frozen value plus log f (gSDE: the noise is drawn anew at that std); :meth:`record`
+    says what it did."""
+
+    def __init__(self, cfg: TrainConfig):
+        self.config = cfg.anneal_std_config
+        self.frozen: torch.Tensor | None = None
+        self.factor = 1.0
+        self.at: int | None = None
+
+    def update(self, steps: int, stop: int, model, n_envs: int) -> None:
+        if self.config is None or steps < self.config.start:
+            return
+        log_std = model.policy.log_std
+        if self.frozen is None:
+            self.frozen = log_std.detach().clone()
+            self.at = int(steps)
+            log_std.requires_grad_(False)  # Adam skips a parameter without a gradient
+        self.factor = self.config.factor(steps, stop)
+        with torch.no_grad():
+            log_std.copy_(self.frozen + float(np.log(self.factor)))
+        if getattr(model, "use_sde", False):
+            model.policy.reset_noise(n_envs)
+
+    def record(self) -> dict | None:
+        if self.config is None:
+            return None
+        return {
+            "start": self.config.start,
+            "end": self.config.end,
+            "frozen_at": self.at,
+            "last_factor": self.factor,
+            "frozen_log_std": None if self.frozen is None else self.frozen.flatten().tolist(),
+        }
+
+
 def train_sb3(
     cfg: TrainConfig,
     seed: int,
@@ -294,6 +341,7 @@ def train_sb3(
 
     select = Selection(cfg, env_id)
     average = Averaging(cfg)
+    anneal = StdAnnealing(cfg)
 
     class Curve(BaseCallback):
         def _on_step(self) -> bool:
@@ -311,6 +359,9 @@ def train_sb3(
         def _on_training_start(self) -> None:
             self._on_step()
 
+        def _on_rollout_start(self) -> None:  # after SB3 drew gSDE's noise for it
+            anneal.update(offset + int(self.num_timesteps), offset + budget, model, venv.num_envs)
+
         def _on_rollout_end(self) -> None:  # before the update of this rollout
             average.update(offset + int(self.num_timesteps), model)
             if ent_sched is not None:  # the last rollout may overshoot the budget
@@ -326,6 +377,7 @@ def train_sb3(
         "transform": None if transform is None else transform.tolist(),
         "distill": distilled,
         "average": averaged,
+        "anneal_std": anneal.record(),
         "select": select.finish(steps, model, snapshot),
     }
     if transform is not None:  # u = T' z into the actor's first layer: a plain SB3 actor on z

@@ -10,15 +10,9 @@ import torch
 import yaml
 from stable_baselines3 import PPO
 
+from tests.train.tiny_sb3 import tiny_ppo
 from train.bench.sb3_train import train_sb3
 from train.config import StdAnnealConfig, TrainConfig
-
-
-def _tiny_ppo(**fields) -> TrainConfig:
-    data = yaml.safe_load(open("train/benchmark/ppo.yaml"))
-    data.update(timesteps=1536, n_envs=4, eval_points=1, whiten_steps=256, **fields)
-    data["model"] = {**data["model"], "n_steps": 128, "batch_size": 256, "n_epochs": 1}
-    return TrainConfig(**data)
 
 
 def test_the_factor_falls_linearly_from_start_to_the_budget_end():
@@ -40,7 +34,7 @@ def test_the_factor_falls_linearly_from_start_to_the_budget_end():
 )
 def test_bad_configs_are_refused_by_name(bad, match):
     with pytest.raises(ValueError, match=match):
-        _tiny_ppo(anneal_std=bad)
+        tiny_ppo(anneal_std=bad)
 
 
 def test_it_is_for_ppo_only():
@@ -59,7 +53,7 @@ def test_updates_see_the_trained_then_the_annealed_log_std(monkeypatch):
 
     monkeypatch.setattr(PPO, "train", spy)
     # 256 whitening steps, then rollouts of 512 starting at 256, 768 and 1280 env steps
-    _, record = train_sb3(_tiny_ppo(anneal_std={"start": 700, "end": 0.5}), 0, "ACLDBeam-v1")
+    _, record = train_sb3(tiny_ppo(anneal_std={"start": 700, "end": 0.5}), 0, "ACLDBeam-v1")
     rec = record["anneal_std"]
     assert rec["frozen_at"] == 768
     frozen = torch.tensor(rec["frozen_log_std"]).reshape(seen[0].shape)
@@ -76,5 +70,5 @@ def test_off_it_leaves_the_log_std_trained(monkeypatch):
     monkeypatch.setattr(
         PPO, "train", lambda self: (seen.append(self.policy.log_std.requires_grad), train(self))
     )
-    _, record = train_sb3(_tiny_ppo(), 0, "ACLDBeam-v1")
+    _, record = train_sb3(tiny_ppo(), 0, "ACLDBeam-v1")
     assert record["anneal_std"] is None and seen == [True] * 3

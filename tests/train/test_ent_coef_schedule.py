@@ -5,21 +5,13 @@ import pytest
 import yaml
 from stable_baselines3 import PPO
 
+from tests.train.tiny_sb3 import tiny_ppo
 from train.bench.sb3_train import make_model, train_sb3
 from train.config import TrainConfig
 
 
 def _tiny_ppo(ent_coef) -> TrainConfig:
-    data = yaml.safe_load(open("train/benchmark/ppo.yaml"))
-    data.update(timesteps=1536, n_envs=4, eval_points=1, whiten_steps=256)
-    data["model"] = {
-        **data["model"],
-        "n_steps": 128,
-        "batch_size": 256,
-        "n_epochs": 1,
-        "ent_coef": ent_coef,
-    }
-    return TrainConfig(**data)
+    return tiny_ppo({"ent_coef": ent_coef})
 
 
 def test_each_update_uses_the_scheduled_coefficient(monkeypatch):

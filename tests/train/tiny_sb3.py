@@ -2,6 +2,7 @@
 SB3 model (``Averaging``, ``Selection`` and ``train_algo`` read only ``model.policy``)."""
 
 import torch
+import yaml
 
 from train.config import TrainConfig
 
@@ -17,6 +18,22 @@ def tiny_sac(timesteps: int = 10, **fields) -> TrainConfig:
         normalize={},
         **fields,
     )
+
+
+def tiny_ppo(model: dict | None = None, **fields) -> TrainConfig:
+    """The PPO recipe (train/benchmark/ppo.yaml) shrunk to 1536 env steps on 4 sub-envs: 256
+    of whitening, then rollouts of 512 starting at 256, 768 and 1280 env steps, one epoch
+    each; ``model`` keys and ``fields`` changed on top."""
+    data = yaml.safe_load(open("train/benchmark/ppo.yaml"))
+    data.update(timesteps=1536, n_envs=4, eval_points=1, whiten_steps=256, **fields)
+    data["model"] = {
+        **data["model"],
+        "n_steps": 128,
+        "batch_size": 256,
+        "n_epochs": 1,
+        **(model or {}),
+    }
+    return TrainConfig(**data)
 
 
 class LinearModel:

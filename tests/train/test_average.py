@@ -5,10 +5,9 @@ run whose returned actor is the average of its iterates."""
 import numpy as np
 import pytest
 import torch
-import yaml
 
 from tests.train.tiny_sb3 import LinearModel as _Model
-from tests.train.tiny_sb3 import tiny_sac
+from tests.train.tiny_sb3 import tiny_sac, tiny_sac_recipe
 from train.bench.sb3_train import Averaging
 from train.config import TrainConfig
 
@@ -91,18 +90,8 @@ def test_a_run_returns_the_average_of_its_iterates(monkeypatch):
         update(self, steps, model)
 
     monkeypatch.setattr(sb3_train.Averaging, "update", spy)
-    data = yaml.safe_load(open("train/benchmark/sac.yaml"))
-    data.update(
-        timesteps=600,
-        n_envs=4,
-        eval_points=1,
-        whiten_steps=128,
-        select=None,
-        restarts=1,
-        average={"start": 300},
-    )
-    data["model"] = {**data["model"], "learning_starts": 200, "buffer_size": 2000, "batch_size": 64}
-    policy, record = sb3_train.train_sb3(TrainConfig.from_dict(data), 0, "ACLDBeam-v1")
+    cfg = tiny_sac_recipe(600, select=None, restarts=1, average={"start": 300})
+    policy, record = sb3_train.train_sb3(cfg, 0, "ACLDBeam-v1")
     assert record["average"]["iterates"] == len(seen) > 10
     key = next(k for k in seen[0] if k.startswith("actor.mu") and k.endswith("weight"))
     mean = torch.stack([s[key] for s in seen]).mean(0)

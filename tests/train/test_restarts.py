@@ -4,12 +4,10 @@ has the lowest validation cost, with the budget of all runs and the learning cur
 run returned (each run's curve kept beside its cost)."""
 
 import pytest
-import yaml
 
-from tests.train.tiny_sb3 import tiny_sac
+from tests.train.tiny_sb3 import tiny_sac, tiny_sac_recipe
 from train.bench import algos, evaluate
 from train.bench.algos import restart_seeds, train_algo
-from train.config import TrainConfig
 
 
 def _cfg(restarts=2, select=True, timesteps=100):
@@ -123,17 +121,8 @@ def test_one_run_is_the_plain_recipe(monkeypatch):
 def test_two_tiny_sac_runs_return_the_better_one():
     """Real runs: the returned policy scores its run's chosen validation cost again, and
     that cost is the lower of the two runs'."""
-    data = yaml.safe_load(open("train/benchmark/sac.yaml"))
-    data.update(
-        timesteps=600,
-        n_envs=4,
-        eval_points=1,
-        whiten_steps=128,
-        restarts=2,
-        select={"episodes": 2, "every": 200, "start": 0},
-    )
-    data["model"] = {**data["model"], "learning_starts": 200, "buffer_size": 2000, "batch_size": 64}
-    policy, record = train_algo(TrainConfig.from_dict(data), 0, "ACLDBeam-v1")
+    cfg = tiny_sac_recipe(600, restarts=2, select={"episodes": 2, "every": 200, "start": 0})
+    policy, record = train_algo(cfg, 0, "ACLDBeam-v1")
     runs = record["restarts"]["runs"]
     assert [r["seed"] for r in runs] == restart_seeds(0, 2) and record["steps"] >= 1200
     assert record["select"]["cost"] == min(r["cost"] for r in runs)

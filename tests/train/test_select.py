@@ -5,11 +5,10 @@ a run returns the parameters of its best check, not its last."""
 import numpy as np
 import pytest
 import torch
-import yaml
 
 from baselines.policies import LQRPolicy, PassivePolicy
 from tests.train.tiny_sb3 import LinearModel as _Model
-from tests.train.tiny_sb3 import tiny_sac
+from tests.train.tiny_sb3 import tiny_sac, tiny_sac_recipe
 from train.bench import evaluate
 from train.bench.sb3_train import Selection
 from train.compare import HELDOUT_SEEDS
@@ -75,12 +74,8 @@ def test_selection_off_is_inert():
 
 
 def _tiny_recipe(**changes) -> TrainConfig:
-    """The SAC recipe (train/benchmark/sac.yaml) shrunk to 800 env steps on 4 sub-envs, with
-    ``changes``."""
-    data = yaml.safe_load(open("train/benchmark/sac.yaml"))
-    data.update(timesteps=800, n_envs=4, eval_points=1, whiten_steps=128, **changes)
-    data["model"] = {**data["model"], "learning_starts": 200, "buffer_size": 2000, "batch_size": 64}
-    return TrainConfig.from_dict(data)
+    """The SAC recipe shrunk to 800 env steps, with ``changes``."""
+    return tiny_sac_recipe(800, **changes)
 
 
 def test_a_run_returns_its_best_checkpoint(tmp_path):

@@ -9,7 +9,10 @@ and prints :math:`J_\\sigma` of the trained law and of the shipped random-search
 (``train/agents/vrs``) at fractions of that ``sigma``, on the same validation loads and the
 same noise draws for both (common random numbers; one gain draw per episode, where gSDE draws
 one per 64-step rollout). ``J`` is :func:`train.bench.evaluate.validation_cost`'s (the env's
-reward per load over the passive beam's). Not a test; takes about 2 min::
+reward per load over the passive beam's). Last it prints the cost of the trained law acting
+with its stochastic policy's expected action, ``E[clip(mu + eps)]`` at the trained ``sigma``
+(:class:`_MeanActionLaw`), the other deterministic version of a clipped-Gaussian policy than
+the clipped mean the agents act with. Not a test; takes about 2 min::
 
     python benchmarks/smoothed_objective.py --seed 0
 """
@@ -48,6 +51,35 @@ class _PerEpisodeLaw:
     def predict(self, obs, state=None, episode_start=None, deterministic=True):
         a = np.einsum("ni,ni->n", np.asarray(obs, float), self.W) + self.b
         return 120.0 * np.clip(a, -1.0, 1.0)[:, None], state
+
+
+class _MeanActionLaw:
+    r"""``predict`` of the deterministic law that acts with the stochastic policy's expected
+    action, :math:`120\,E[\mathrm{clip}(W'z + b + \epsilon' u, -1, 1)]` with
+    :math:`\epsilon \sim N(0, \mathrm{diag}\,\sigma^2)` on the whitened :math:`u = T'z`:
+    for :math:`X \sim N(\mu, s^2)`, :math:`\mu = W'z + b`, :math:`s^2 = \sum_i \sigma_i^2
+    u_i^2`, :math:`E[\mathrm{clip}(X)] = -\Phi(\alpha) + 1 - \Phi(\beta) + \mu(\Phi(\beta) -
+    \Phi(\alpha)) + s(\varphi(\alpha) - \varphi(\beta))`, :math:`\alpha = -(1 + \mu)/s`,
+    :math:`\beta = (1 - \mu)/s` -- the other deterministic version of a clipped Gaussian
+    policy than the clipped mean :math:`\mathrm{clip}(\mu)` the agents are evaluated with."""
+
+    def __init__(self, W: np.ndarray, b: float, sigma: np.ndarray, T: np.ndarray):
+        self.W, self.b, self.var, self.T = np.ravel(W), b, np.ravel(sigma) ** 2, T
+
+    def predict(self, obs, state=None, episode_start=None, deterministic=True):
+        from scipy.stats import norm
+
+        z = np.atleast_2d(np.asarray(obs, float))
+        mu = z @ self.W + self.b
+        s = np.sqrt(((z @ self.T) ** 2) @ self.var) + 1e-300
+        lo, hi = (-1.0 - mu) / s, (1.0 - mu) / s
+        mean = (
+            -norm.cdf(lo)
+            + norm.sf(hi)
+            + mu * (norm.cdf(hi) - norm.cdf(lo))
+            + s * (norm.pdf(lo) - norm.pdf(hi))
+        )
+        return 120.0 * mean[:, None], state
 
 
 def gain_noise_cost(W, b, dW, seeds, env_id: str = "ACLDBeam-v1") -> float:
@@ -105,6 +137,14 @@ def main(argv=None) -> int:
             draws = [zero] if scale == 0 else [scale * e @ T.T for e in eps]  # T eps per load
             row.append(np.mean([gain_noise_cost(W, b, dW, seeds) for dW in draws]))
         print(f"| {scale:g} x trained | " + " | ".join(f"{j:.4f}" for j in row) + " |")
+    from train.bench.evaluate import validation_cost
+
+    W, b = laws[f"ppo seed {args.seed}"]
+    mean_law = validation_cost(_MeanActionLaw(W, b, sigma, T), "ACLDBeam-v1", seeds)
+    print(
+        f"\nppo seed {args.seed} acting with its expected clipped action at the trained sigma "
+        f"(no noise): {mean_law:.5f}, against its clipped mean (the agent): row 0 above"
+    )
     return 0
 
 

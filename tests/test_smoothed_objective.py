@@ -50,3 +50,30 @@ def test_refuses_what_it_cannot_read():
     W, b = so.linear_law(TrainedAgent.load(AGENTS / "vrs").actor)
     with pytest.raises(ValueError, match=r"dW: expected shape \(2, 9\)"):
         so.gain_noise_cost(W, b, np.zeros((3, 9)), validation_seeds(2))
+
+
+def test_mean_action_law_is_the_expected_clipped_action():
+    """The closed form against Monte Carlo of clip(W'z + b + eps'T'z) (2e5 draws), on
+    observations where the clip is active on part of the distribution."""
+    rng = np.random.default_rng(0)
+    W, b = rng.normal(size=3), 0.2
+    T = rng.normal(size=(3, 3))
+    sigma = np.array([0.5, 0.2, 1.0])
+    z = rng.normal(size=(4, 3))
+    law = so._MeanActionLaw(W, b, sigma, T)
+    volts, _ = law.predict(z)
+    eps = rng.normal(size=(200_000, 3)) * sigma
+    for k in range(len(z)):
+        mc = np.clip(z[k] @ W + b + eps @ (T.T @ z[k]), -1.0, 1.0).mean()
+        assert volts[k, 0] / 120.0 == pytest.approx(mc, abs=5e-3)
+    assert np.ptp(volts) > 0 and np.all(np.abs(volts) < 120.0)  # not saturated: a mean
+
+
+def test_mean_action_law_without_noise_is_the_clipped_mean():
+    agent = TrainedAgent.load(AGENTS / "vrs")
+    W, b = so.linear_law(agent.actor)
+    seeds = validation_seeds(4)
+    tiny = so._MeanActionLaw(W, b, np.full(W.size, 1e-12), np.eye(W.size))
+    assert validation_cost(tiny, seeds=seeds) == pytest.approx(
+        validation_cost(agent, seeds=seeds), rel=1e-9
+    )

@@ -144,10 +144,7 @@ class StdAnnealConfig:
 
     def __post_init__(self):
         check_int("anneal_std.start", self.start, 0, 10**12)
-        if isinstance(self.end, bool) or not isinstance(self.end, (int, float)):
-            raise ValueError(f"anneal_std.end must be a number in (0, 1], got {self.end!r}")
-        if not 0.0 < float(self.end) <= 1.0:
-            raise ValueError(f"anneal_std.end must lie in (0, 1], got {self.end!r}")
+        check_real("anneal_std.end", self.end, 0.0, 1.0, low_open=True)
 
     def factor(self, steps: int, stop: int) -> float:
         """f at env step ``steps`` of a run whose budget ends at ``stop`` (1 before
@@ -160,7 +157,7 @@ class StdAnnealConfig:
 
 def _section(cls, data: dict, name: str):
     """The dataclass ``cls`` of a config's mapping ``name`` (``distill``, ``select``,
-    ``average``);
+    ``average``, ``anneal_std``);
     ``ValueError`` naming ``name`` and its unknown or missing keys."""
     known = {f.name for f in fields(cls)}
     required = {

@@ -26,9 +26,9 @@ def test_the_factor_falls_linearly_from_start_to_the_budget_end():
     "bad, match",
     [
         ({"start": -1, "end": 0.5}, "anneal_std.start"),
-        ({"start": 0, "end": 0.0}, r"anneal_std.end must lie in \(0, 1\]"),
-        ({"start": 0, "end": 1.5}, r"anneal_std.end must lie in \(0, 1\]"),
-        ({"start": 0, "end": "half"}, "anneal_std.end must be a number"),
+        ({"start": 0, "end": 0.0}, "anneal_std.end must be > 0"),
+        ({"start": 0, "end": 1.5}, "anneal_std.end must be <= 1"),
+        ({"start": 0, "end": "half"}, "anneal_std.end must be a finite real number"),
         ({"start": 0}, r"anneal_std: unknown key\(s\) \[\], missing \['end'\]"),
     ],
 )

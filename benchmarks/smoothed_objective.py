@@ -64,20 +64,21 @@ class _MeanActionLaw:
     policy than the clipped mean :math:`\mathrm{clip}(\mu)` the agents are evaluated with."""
 
     def __init__(self, W: np.ndarray, b: float, sigma: np.ndarray, T: np.ndarray):
+        from scipy.stats import norm  # once, not per step
+
         self.W, self.b, self.var, self.T = np.ravel(W), b, np.ravel(sigma) ** 2, T
+        self.norm = norm
 
     def predict(self, obs, state=None, episode_start=None, deterministic=True):
-        from scipy.stats import norm
-
         z = np.atleast_2d(np.asarray(obs, float))
         mu = z @ self.W + self.b
         s = np.sqrt(((z @ self.T) ** 2) @ self.var) + 1e-300
         lo, hi = (-1.0 - mu) / s, (1.0 - mu) / s
         mean = (
-            -norm.cdf(lo)
-            + norm.sf(hi)
-            + mu * (norm.cdf(hi) - norm.cdf(lo))
-            + s * (norm.pdf(lo) - norm.pdf(hi))
+            -self.norm.cdf(lo)
+            + self.norm.sf(hi)
+            + mu * (self.norm.cdf(hi) - self.norm.cdf(lo))
+            + s * (self.norm.pdf(lo) - self.norm.pdf(hi))
         )
         return 120.0 * mean[:, None], state
 
@@ -109,7 +110,7 @@ def main(argv=None) -> int:
     )
     args = p.parse_args(argv)
     from train.agent import TrainedAgent, export_sb3
-    from train.bench.evaluate import validation_seeds
+    from train.bench.evaluate import validation_cost, validation_seeds
     from train.bench.sb3_train import train_sb3
     from train.config import load_config
 
@@ -137,8 +138,6 @@ def main(argv=None) -> int:
             draws = [zero] if scale == 0 else [scale * e @ T.T for e in eps]  # T eps per load
             row.append(np.mean([gain_noise_cost(W, b, dW, seeds) for dW in draws]))
         print(f"| {scale:g} x trained | " + " | ".join(f"{j:.4f}" for j in row) + " |")
-    from train.bench.evaluate import validation_cost
-
     W, b = laws[f"ppo seed {args.seed}"]
     mean_law = validation_cost(_MeanActionLaw(W, b, sigma, T), "ACLDBeam-v1", seeds)
     print(

@@ -10,10 +10,6 @@ from train.bench.sb3_train import make_model, train_sb3
 from train.config import TrainConfig
 
 
-def _tiny_ppo(ent_coef) -> TrainConfig:
-    return tiny_ppo({"ent_coef": ent_coef})
-
-
 def test_each_update_uses_the_scheduled_coefficient(monkeypatch):
     used = []
     train = PPO.train
@@ -23,7 +19,7 @@ def test_each_update_uses_the_scheduled_coefficient(monkeypatch):
         return train(self)
 
     monkeypatch.setattr(PPO, "train", spy)
-    train_sb3(_tiny_ppo({"linear": [0.02, 0.0]}), 0, "ACLDBeam-v1")
+    train_sb3(tiny_ppo({"ent_coef": {"linear": [0.02, 0.0]}}), 0, "ACLDBeam-v1")
     # 1280 env steps after the whitening, 512 per rollout: updates at 512, 1024, 1536 steps
     assert used == pytest.approx([0.02 * (1 - 512 / 1280), 0.02 * (1 - 1024 / 1280), 0.0])
 
@@ -32,7 +28,7 @@ def test_a_constant_coefficient_is_left_alone(monkeypatch):
     used = []
     train = PPO.train
     monkeypatch.setattr(PPO, "train", lambda self: (used.append(self.ent_coef), train(self)))
-    train_sb3(_tiny_ppo(0.01), 0, "ACLDBeam-v1")
+    train_sb3(tiny_ppo({"ent_coef": 0.01}), 0, "ACLDBeam-v1")
     assert used == [0.01] * 3
 
 
@@ -45,4 +41,4 @@ def test_a_schedule_is_for_ppo_only():
 
 def test_a_malformed_schedule_names_the_key():
     with pytest.raises(ValueError, match="ent_coef"):
-        make_model(_tiny_ppo({"linear": [0.01]}), None, 0)
+        make_model(tiny_ppo({"ent_coef": {"linear": [0.01]}}), None, 0)

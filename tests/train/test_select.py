@@ -12,7 +12,6 @@ from tests.train.tiny_sb3 import tiny_sac, tiny_sac_recipe
 from train.bench import evaluate
 from train.bench.sb3_train import Selection
 from train.compare import HELDOUT_SEEDS
-from train.config import TrainConfig
 
 
 @pytest.fixture(scope="module")
@@ -73,17 +72,12 @@ def test_selection_off_is_inert():
     assert torch.equal(model.policy.weight, before)
 
 
-def _tiny_recipe(**changes) -> TrainConfig:
-    """The SAC recipe shrunk to 800 env steps, with ``changes``."""
-    return tiny_sac_recipe(800, **changes)
-
-
 def test_a_run_returns_its_best_checkpoint(tmp_path):
     """A tiny SAC run of the recipe with selection: the returned (whitening-folded) policy
     scores the chosen check's validation cost again."""
     from train.bench.sb3_train import train_sb3
 
-    cfg = _tiny_recipe(select={"episodes": 2, "every": 200, "start": 0})
+    cfg = tiny_sac_recipe(800, select={"episodes": 2, "every": 200, "start": 0})
     policy, record = train_sb3(cfg, 0, "ACLDBeam-v1")
     sel = record["select"]
     costs = [h["cost"] for h in sel["history"]]
@@ -101,8 +95,8 @@ def test_the_final_check_sees_the_final_policy():
     check there would see the policy one update short of the final one)."""
     from train.bench.sb3_train import train_sb3
 
-    plain, _ = train_sb3(_tiny_recipe(restarts=1, select=None), 0, "ACLDBeam-v1")
-    cfg = _tiny_recipe(restarts=1, select={"episodes": 1, "every": 800, "start": 800})
+    plain, _ = train_sb3(tiny_sac_recipe(800, restarts=1, select=None), 0, "ACLDBeam-v1")
+    cfg = tiny_sac_recipe(800, restarts=1, select={"episodes": 1, "every": 800, "start": 800})
     chosen, record = train_sb3(cfg, 0, "ACLDBeam-v1")
     assert [h["steps"] for h in record["select"]["history"]] == [800]
     seeds = evaluate.validation_seeds(2)

@@ -282,6 +282,15 @@ class TrainConfig:
         from it, :func:`train.bench.algos.restart_seeds`); the trial returns the run whose
         chosen check has the lowest validation cost (the same validation loads for all).
         The budget is ``restarts * timesteps`` (:attr:`budget`). Default 1: one run.
+    restart_above : float, "lqr" or None
+        With ``restarts`` > 1: a run is followed by the next only if its chosen check's
+        validation cost is above this (:func:`train.bench.evaluate.validation_cost`, the
+        passive beam's 1 on every load, so 1.0 retries a run that controls worse than no
+        control at all); ``"lqr"``: above LQR's cost on the same validation loads
+        (:func:`train.bench.evaluate.lqr_validation_cost`), so a run that does not beat
+        LQR there is retried. The first run at or below it is returned, and if none is,
+        the lowest. Seeds then train ``timesteps`` to :attr:`budget` env steps, by one
+        rule. None (default): every run, the lowest returned.
     """
 
     algo: str
@@ -303,10 +312,12 @@ class TrainConfig:
     average: dict | None = None
     anneal_std: dict | None = None
     restarts: int = 1
+    restart_above: float | str | None = None
 
     @property
     def budget(self) -> int:
-        """Env steps of training in all: ``restarts * timesteps``."""
+        """Env steps of training in all: ``restarts * timesteps`` (with
+        ``restart_above``, the most a seed may take)."""
         return self.restarts * self.timesteps
 
     def __post_init__(self):
@@ -315,6 +326,20 @@ class TrainConfig:
         for name in ("timesteps", "n_envs", "eval_points"):
             check_int(name, getattr(self, name), 1, 10**12)
         check_int("restarts", self.restarts, 1, 64)
+        if self.restart_above is not None:
+            if isinstance(self.restart_above, str):
+                if self.restart_above != "lqr":
+                    raise ValueError(
+                        "restart_above must be a positive number, 'lqr' or null, "
+                        f"got {self.restart_above!r}"
+                    )
+            else:
+                check_real("restart_above", self.restart_above, 0.0, None, low_open=True)
+            if self.restarts < 2:
+                raise ValueError(
+                    f"restart_above needs restarts >= 2 (runs to choose from), "
+                    f"got restarts {self.restarts}"
+                )
         if (
             not isinstance(self.loads, dict)
             or not self.loads

@@ -125,8 +125,10 @@ def test_parse_load_case_names_the_choices(value):
 def test_base_applies_the_recipe_under_a_files_own_settings(tmp_path):
     """``base:`` names a recipe; the file's settings go on top, nested mappings key by key."""
     _, ppo = read_config("ppo")
-    _, old = read_config("ablation_ppo_ent_01")  # acld-gym 0.6.0's recipe: ppo, one change
-    assert old == {**ppo, "model": {**ppo["model"], "ent_coef": 0.01}}
+    _, one_run = read_config("ablation_ppo_one_run")  # acld-gym 0.7.0's recipe: ppo, one run
+    assert one_run == {**ppo, "restarts": 1, "restart_above": None, "select": None}
+    _, old = read_config("ablation_ppo_ent_01")  # 0.6.0's: chained on 0.7.0's, one change
+    assert old == {**one_run, "model": {**one_run["model"], "ent_coef": 0.01}}
     _, ablation = read_config("ablation_ppo_lambda_095")  # chained: on 0.6.0's recipe
     assert ablation == {**old, "model": {**old["model"], "gae_lambda": 0.95}}
     (tmp_path / "a.yaml").write_text(

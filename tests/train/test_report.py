@@ -41,6 +41,23 @@ def test_a_restarted_recipe_shows_its_runs_and_the_returned_runs_curve():
     assert "(1 runs)" not in markdown(summary)
 
 
+def test_a_recipe_that_retries_failed_runs_shows_the_most_and_each_seeds_runs():
+    """PPO's recipe retries a run only if it failed (restart_above): the budget is the most
+    a seed may take, and each seed's row says how many runs it took."""
+    summary = json.loads(RESULTS.read_text())
+    ppo = summary["algorithms"]["ppo"]
+    assert ppo["restarts"] == 3 and ppo["restart_above"] == "lqr"
+    assert ppo["budget"] / 3 <= ppo["curve"][-1]["steps"] < ppo["budget"] / 2  # one run's
+    text = markdown(summary)
+    assert f"| ppo (ppo) | {ppo['budget']:,} (up to 3 runs) |" in text
+    for s in ppo["per_seed"]:
+        runs = f"{s['runs']} run" + ("s" if s["runs"] > 1 else "")
+        assert f"| ppo | {s['seed']} ({runs}) |" in text
+    assert "| sac | 0 |" in text  # every run of every seed: no count per seed
+    two = {**ppo, "per_seed": [{**ppo["per_seed"][0], "runs": 2}]}
+    assert "| ppo | 0 (2 runs) |" in markdown({**summary, "algorithms": {"ppo": two}})
+
+
 def test_write_replaces_only_the_block(tmp_path, capsys):
     page = tmp_path / "page.md"
     begin = BEGIN.format(src=RESULTS, dst=page)

@@ -1,21 +1,43 @@
 """Independent restarts of a run (``TrainConfig.restarts``): the first run is the recipe's
 own, the others have seeds of their own, and the trial returns the run whose selected check
 has the lowest validation cost, with the budget of all runs and the learning curve of the
-run returned (each run's curve kept beside its cost)."""
+run returned (each run's curve kept beside its cost). With ``restart_above``, a run is
+followed by another only if its cost is above that."""
 
+import gymnasium as gym
 import pytest
 
+import acld_gym  # noqa: F401  (registers the envs)
 from tests.train.tiny_sb3 import tiny_sac, tiny_sac_recipe
 from train.bench import algos, evaluate
 from train.bench.algos import restart_seeds, train_algo
 
 
-def _cfg(restarts=2, select=True, timesteps=100):
+def _cfg(restarts=2, select=True, timesteps=100, **fields):
     return tiny_sac(
         timesteps,
         restarts=restarts,
         select={"episodes": 2, "every": 50, "start": 0} if select else None,
+        **fields,
     )
+
+
+def _fake_runs(monkeypatch, costs):
+    """``train_sb3`` replaced by runs whose chosen check costs ``costs[seed]``; returns the
+    list the seeds of the runs trained are appended to."""
+    calls = []
+
+    def fake_train(cfg_, seed, env_id, timed):
+        calls.append(seed)
+        timed(0, f"policy-{seed}")
+        timed(cfg_.timesteps, f"policy-{seed}")
+        return f"policy-{seed}", {
+            "steps": cfg_.timesteps,
+            "select": {"steps": 50, "cost": costs[seed]},
+        }
+
+    monkeypatch.setattr(algos, "train_sb3", fake_train)
+    return calls
 
 
 def test_restart_seeds_start_with_the_trial_seed_and_are_shared_by_no_other_trial():
@@ -53,18 +75,7 @@ def test_the_run_with_the_lowest_validation_cost_is_returned(monkeypatch):
     cfg = _cfg(restarts=3)
     seeds = restart_seeds(5, 3)
     costs = dict(zip(seeds, (0.7, 0.5, 0.6), strict=True))  # the second run is the best
-    calls = []
-
-    def fake_train(cfg_, seed, env_id, timed):
-        calls.append(seed)
-        timed(0, f"policy-{seed}")
-        timed(cfg_.timesteps, f"policy-{seed}")
-        return f"policy-{seed}", {
-            "steps": cfg_.timesteps,
-            "select": {"steps": 50, "cost": costs[seed]},
-        }
-
-    monkeypatch.setattr(algos, "train_sb3", fake_train)
+    calls = _fake_runs(monkeypatch, costs)
     seen = []
 
     def on_eval(steps, policy):
@@ -88,6 +99,70 @@ def test_the_run_with_the_lowest_validation_cost_is_returned(monkeypatch):
         ]
     # the trial's curve is the returned run's: it ends at that run's policy, not the last run's
     assert record["curve"] == runs[1]["curve"] and record["curve"][-1]["n"] == 4
+
+
+@pytest.mark.parametrize(
+    "costs, trained, chosen",
+    [
+        ((0.52, 1.9, 0.51), 1, 0),  # a sound first run is the seed's: no restart
+        ((1.94, 0.51, 0.4), 2, 1),  # a failed run is followed by one, which stops the runs
+        ((1.0, 0.4, 0.3), 1, 0),  # at the threshold is not above it
+        ((1.9, 1.2, 1.5), 3, 1),  # none below: every run, the lowest returned
+    ],
+)
+def test_restart_above_retries_only_a_failed_run(monkeypatch, costs, trained, chosen):
+    seeds = restart_seeds(5, 3)
+    calls = _fake_runs(monkeypatch, dict(zip(seeds, costs, strict=True)))
+    policy, record = train_algo(_cfg(restarts=3, restart_above=1.0), 5, "ACLDBeam-v1")
+    assert calls == seeds[:trained] and policy == f"policy-{seeds[chosen]}"
+    assert record["steps"] == 100 * trained and record["restarts"]["chosen"] == chosen
+    assert [r["cost"] for r in record["restarts"]["runs"]] == list(costs[:trained])
+
+
+def test_restart_above_lqr_is_lqrs_cost_on_the_selections_validation_loads(monkeypatch):
+    seeds = restart_seeds(5, 3)
+    calls = _fake_runs(monkeypatch, dict(zip(seeds, (0.55, 0.52, 0.5), strict=True)))
+    asked = []
+
+    def fake_lqr(env_id, loads):
+        asked.append((env_id, loads))
+        return 0.535
+
+    monkeypatch.setattr(algos, "lqr_validation_cost", fake_lqr)
+    policy, record = train_algo(_cfg(restarts=3, restart_above="lqr"), 5, "ACLDBeam-v1")
+    # the first run does not beat LQR (0.55 > 0.535): retried; the second does
+    assert calls == seeds[:2] and policy == f"policy-{seeds[1]}"
+    assert asked == [("ACLDBeam-v1", evaluate.validation_seeds(2))]  # select's 2 episodes
+    assert record["restarts"]["threshold"] == 0.535
+
+
+def test_lqr_validation_cost_is_the_lqr_policys():
+    from baselines.policies import LQRPolicy
+
+    seeds = evaluate.validation_seeds(2)
+    lqr = LQRPolicy.for_env(gym.make("ACLDBeam-v1"))
+    cost = evaluate.lqr_validation_cost("ACLDBeam-v1", seeds)
+    assert cost == evaluate.validation_cost(lqr, "ACLDBeam-v1", seeds)
+    assert 0.3 < cost < 1.0  # LQR controls: below the passive beam's 1
+
+
+@pytest.mark.parametrize(
+    "fields, match",
+    [
+        ({"restart_above": "passive"}, "restart_above must be a positive number, 'lqr' or null"),
+        ({"restarts": 1, "restart_above": "lqr"}, "restart_above needs restarts >= 2"),
+        ({"restarts": 1, "restart_above": 1.0}, "restart_above needs restarts >= 2"),
+        ({"restart_above": 0.0}, "restart_above must be > 0"),
+        ({"restart_above": -1}, "restart_above must be > 0"),
+        ({"restart_above": "1"}, "restart_above must be a positive number, 'lqr' or null"),
+        ({"restart_above": True}, "restart_above must be a finite real number"),
+        ({"restart_above": float("nan")}, "restart_above must be a finite real number"),
+    ],
+)
+def test_bad_restart_above_is_named(fields, match):
+    with pytest.raises(ValueError, match=match):
+        _cfg(**{"restarts": 2, **fields})
+    assert _cfg(restarts=2, restart_above=1.0).budget == 200  # the most a seed may take
 
 
 def test_a_run_whose_curve_stops_short_gets_a_last_point(monkeypatch):

@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 
 from ..config import TrainConfig
-from .evaluate import CurveCallback
+from .evaluate import CurveCallback, lqr_validation_cost, validation_seeds
 from .sb3_train import train_sb3
 from .search import train_random_search
 
@@ -50,10 +50,13 @@ def train_algo(
 
     With ``cfg.restarts`` > 1 the runs follow one another (seeds :func:`restart_seeds`);
     the policy and record returned are those of the run whose selected check has the
-    lowest validation cost, with ``record["steps"]`` all runs' steps, ``record["curve"]``
-    the returned run's curve (its steps count from the start of that run: the curve is
-    the training of the policy returned; the budget spent is ``record["steps"]``) and
-    ``record["restarts"]`` each run's seed, chosen step, cost and curve."""
+    lowest validation cost (with ``cfg.restart_above``, the runs stop at the first whose
+    cost is at most that, which is then the lowest; ``"lqr"``: LQR's cost on the same
+    validation loads, ``record["restarts"]["threshold"]``), with ``record["steps"]`` all runs'
+    steps, ``record["curve"]`` the returned run's curve (its steps count from the start of
+    that run: the curve is the training of the policy returned; the budget spent is
+    ``record["steps"]``) and ``record["restarts"]`` each run's seed, chosen step, cost and
+    curve."""
     spent = [0.0, 0.0]
     curve: list = []  # the current run's
 
@@ -66,6 +69,10 @@ def train_algo(
 
     t0, c0 = time.perf_counter(), time.process_time()
     best, runs, total = None, [], 0  # only the best run so far is kept alive (model, buffer)
+    threshold = cfg.restart_above
+    if threshold == "lqr":  # the level to beat, on the selection's own validation loads
+        seeds = validation_seeds(cfg.select_config.episodes)
+        threshold = lqr_validation_cost(env_id, seeds)
     for k, run_seed in enumerate(restart_seeds(seed, cfg.restarts)):
         curve = []
         policy, record = _train_once(cfg, run_seed, env_id, timed)
@@ -81,10 +88,14 @@ def train_algo(
         if best is None or (runs and runs[-1]["cost"] < runs[best[0]]["cost"]):
             best = (k, policy, record)  # the first of equal costs is kept
         policy = record = None
+        if threshold is not None and runs[-1]["cost"] <= threshold:
+            break  # a good enough run: no more restarts
     chosen, policy, record = best
     if runs:
         record["steps"] = total
         record["restarts"] = {"chosen": chosen, "runs": runs}
+        if threshold is not None:
+            record["restarts"]["threshold"] = threshold
     record["train_seconds"] = time.perf_counter() - t0 - spent[0]
     record["train_cpu_seconds"] = time.process_time() - c0 - spent[1]
     return policy, record

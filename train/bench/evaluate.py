@@ -41,6 +41,7 @@ __all__ = [
     "validation_seeds",
     "validation_cost",
     "validation_rollout",
+    "lqr_validation_cost",
     "ise_rel_lqr",
     "lqr_ise",
     "reference_policies",
@@ -150,6 +151,15 @@ def validation_cost(policy, env_id: str = DEFAULT_ENV_ID, seeds=None) -> float:
     validation seeds (:func:`validation_seeds`). :func:`validation_rollout` also gives the
     env steps it took."""
     return validation_rollout(policy, env_id, seeds)[0]
+
+
+def lqr_validation_cost(env_id: str = DEFAULT_ENV_ID, seeds=None) -> float:
+    """:func:`validation_cost` of the LQR designed on ``env_id``
+    (:meth:`baselines.policies.LQRPolicy.for_env`) on the loads of ``seeds``: the level a
+    trained policy has to beat there."""
+    from baselines.policies import LQRPolicy
+
+    return validation_cost(LQRPolicy.for_env(_make_env(env_id, 1)), env_id, seeds)
 
 
 def validation_rollout(policy, env_id: str = DEFAULT_ENV_ID, seeds=None) -> tuple[float, int]:

@@ -79,7 +79,8 @@ def summarize(records: list[dict], refs: dict) -> dict:
         out["algorithms"][name] = {
             "algo": runs[0]["algo"],
             "budget": runs[0]["budget"],
-            "restarts": int(runs[0]["config"].get("restarts", 1)),  # runs per seed
+            "restarts": int(runs[0]["config"].get("restarts", 1)),  # runs per seed (at most)
+            "restart_above": runs[0]["config"].get("restart_above"),
             "seeds": [r["seed"] for r in runs],
             "ise_rel_lqr": stats,
             "goals": goals,
@@ -96,6 +97,7 @@ def summarize(records: list[dict], refs: dict) -> dict:
                     "seed": r["seed"],
                     "train_seconds": r["train_seconds"],
                     "train_cpu_seconds": r.get("train_cpu_seconds", np.nan),
+                    "runs": len(r.get("record", {}).get("restarts", {}).get("runs", [None])),
                     **{str(c): float(rel[i, j]) for j, c in enumerate(CASES)},
                 }
                 for i, r in enumerate(runs)
@@ -107,9 +109,12 @@ def summarize(records: list[dict], refs: dict) -> dict:
 
 def budget(a: dict) -> str:
     """An algorithm's budget per seed as the table prints it: ``4,000,000 (2 runs)`` when
-    each seed is several runs (``restarts:``)."""
+    each seed is several runs (``restarts:``), ``15,000,000 (up to 3 runs)`` when a run
+    is followed by another only if it failed (``restart_above:``)."""
     runs = a.get("restarts", 1)
-    return f"{a['budget']:,}" + (f" ({runs} runs)" if runs > 1 else "")
+    if runs == 1:
+        return f"{a['budget']:,}"
+    return f"{a['budget']:,} ({'up to ' if a.get('restart_above') else ''}{runs} runs)"
 
 
 def markdown(summary: dict) -> str:
@@ -162,8 +167,11 @@ def markdown(summary: dict) -> str:
     for name, a in summary["algorithms"].items():
         for s in a["per_seed"]:
             vals = " | ".join(f"{s[str(c)]:.3f}" for c in CASES)
+            seed = s["seed"]
+            if a.get("restart_above"):  # how many runs this seed took
+                seed = f"{seed} ({s['runs']} run{'s' if s['runs'] > 1 else ''})"
             lines.append(
-                f"| {name} | {s['seed']} | {vals} | {s['train_seconds']:.0f} / "
+                f"| {name} | {seed} | {vals} | {s['train_seconds']:.0f} / "
                 f"{s['train_cpu_seconds']:.0f} |"
             )
     return "\n".join(lines) + "\n"

@@ -1,0 +1,55 @@
+"""``benchmarks/zoo_eval.py``: an rl-zoo3 run's agent evaluated through the plain env, and with
+``--validation N`` its cost on the first N validation loads, by which a recipe's restarts
+choose between runs (train/zoo/ppo.yml)."""
+
+import importlib.util
+import json
+from pathlib import Path
+
+import gymnasium as gym
+import pytest
+
+import acld_gym  # noqa: F401  (registers the envs)
+from acld_gym.wrappers import UnitAction
+from train.bench.evaluate import lqr_validation_cost, validation_cost, validation_seeds
+from train.bench.sb3_policies import SB3Policy
+from train.voltage import VoltageMap
+
+_PATH = Path(__file__).resolve().parents[1] / "benchmarks" / "zoo_eval.py"
+_spec = importlib.util.spec_from_file_location("zoo_eval", _PATH)
+zoo_eval = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(zoo_eval)
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    """An rl-zoo3-like run directory: an untrained PPO saved as ``ACLDBeam-v1.zip``."""
+    from stable_baselines3 import PPO
+
+    path = tmp_path_factory.mktemp("run")
+    env = UnitAction(gym.make("ACLDBeam-v1"))
+    PPO("MlpPolicy", env, n_steps=8, batch_size=8, seed=0).save(path / "ACLDBeam-v1.zip")
+    return path
+
+
+def test_validation_is_the_validation_cost_of_the_saved_agent(run, capsys):
+    from stable_baselines3 import PPO
+
+    assert zoo_eval.main(["ppo", str(run), "--validation", "2"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert set(out["ise_rel_lqr"]) == {"1", "2", "3", "random"}
+    model = PPO.load(run / "ACLDBeam-v1.zip", device="cpu")
+    policy = SB3Policy(model, None, None, voltage_map=VoltageMap())
+    expected = validation_cost(policy, "ACLDBeam-v1", validation_seeds(2))
+    assert out["validation_cost"] == pytest.approx(expected, rel=1e-12)
+    lqr = lqr_validation_cost("ACLDBeam-v1", validation_seeds(2))
+    assert out["lqr_validation_cost"] == pytest.approx(lqr, rel=1e-12)
+    assert out["validation_cost"] > lqr  # an untrained agent does not beat LQR
+    assert zoo_eval.main(["ppo", str(run)]) == 0
+    assert "validation_cost" not in json.loads(capsys.readouterr().out)  # off by default
+
+
+def test_a_negative_validation_count_is_refused(run, capsys):
+    with pytest.raises(SystemExit):
+        zoo_eval.main(["ppo", str(run), "--validation", "-1"])
+    assert "--validation: expected a number of loads >= 0, got -1" in capsys.readouterr().err

@@ -2,7 +2,6 @@
 the README's and nothing else, the README's line builds a ``check_env``-clean env, and the
 saved actor is evaluated on the same observation slots it was trained on."""
 
-import importlib.util
 from pathlib import Path
 
 import gymnasium as gym
@@ -12,11 +11,9 @@ from gymnasium.utils.env_checker import check_env
 
 import acld_gym  # noqa: F401
 from acld_gym.wrappers import ObserveModes, UnitAction
+from tests.benchmark_scripts import load_script
 
-_PATH = Path(__file__).resolve().parents[1] / "benchmarks" / "single_file_ppo.py"
-_spec = importlib.util.spec_from_file_location("single_file_ppo", _PATH)
-sfp = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(sfp)
+sfp = load_script("single_file_ppo")
 
 # The shape of CleanRL's ppo_continuous_action.py where the script edits it.
 CLEANRL_LIKE = """import numpy as np

@@ -3,19 +3,16 @@
 episode whose gains are zeroed costs the passive beam's 1 on its load), and agents that are not
 one linear law, or perturbations of the wrong shape, are refused."""
 
-import importlib.util
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from tests.benchmark_scripts import load_script
 from train.agent import TrainedAgent
 from train.bench.evaluate import validation_cost, validation_seeds
 
-_PATH = Path(__file__).resolve().parents[1] / "benchmarks" / "smoothed_objective.py"
-_spec = importlib.util.spec_from_file_location("smoothed_objective", _PATH)
-so = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(so)
+so = load_script("smoothed_objective")
 
 AGENTS = Path(__file__).resolve().parents[1] / "train" / "agents"
 

@@ -2,23 +2,19 @@
 ``--validation N`` its cost on the first N validation loads, by which a recipe's restarts
 choose between runs (train/zoo/ppo.yml)."""
 
-import importlib.util
 import json
-from pathlib import Path
 
 import gymnasium as gym
 import pytest
 
 import acld_gym  # noqa: F401  (registers the envs)
 from acld_gym.wrappers import UnitAction
+from tests.benchmark_scripts import load_script
 from train.bench.evaluate import lqr_validation_cost, validation_cost, validation_seeds
 from train.bench.sb3_policies import SB3Policy
 from train.voltage import VoltageMap
 
-_PATH = Path(__file__).resolve().parents[1] / "benchmarks" / "zoo_eval.py"
-_spec = importlib.util.spec_from_file_location("zoo_eval", _PATH)
-zoo_eval = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(zoo_eval)
+zoo_eval = load_script("zoo_eval")
 
 
 @pytest.fixture(scope="module")

@@ -293,7 +293,7 @@ def test_benchmark_through_ray_tune(tmp_path):
         (
             "sac",
             0.95,
-        ),  # measured (results-v1.json, 2 runs a seed): seed 0 0.856; 5 seeds 0.839-0.879
+        ),  # measured (results-v1.json, 3 runs a seed): seed 0 0.856; 5 seeds 0.839-0.879
     ],
 )
 def test_recipe_seed_on_case1(algo, bound):

@@ -131,6 +131,14 @@ def test_base_applies_the_recipe_under_a_files_own_settings(tmp_path):
     assert old == {**one_run, "model": {**one_run["model"], "ent_coef": 0.01}}
     _, ablation = read_config("ablation_ppo_lambda_095")  # chained: on 0.6.0's recipe
     assert ablation == {**old, "model": {**old["model"], "gae_lambda": 0.95}}
+    _, sac = read_config("sac")
+    _, two_runs = read_config("ablation_sac_two_runs")  # acld-gym 0.8.0's SAC recipe
+    assert sac["restarts"] == 3 and two_runs == {**sac, "restarts": 2}
+    _, lqr_scale = read_config("ablation_sac_lqr_scale")  # measured against 0.8.0's
+    assert lqr_scale == {
+        **two_runs,
+        "env_kwargs": {**two_runs["env_kwargs"], "reward_scale": "lqr"},
+    }
     (tmp_path / "a.yaml").write_text(
         "base: ppo\ntimesteps: 10\nmodel: {policy_kwargs: {log_std_init: -2.0}}\n"
     )

@@ -32,12 +32,12 @@ def test_committed_results_hold_every_seed_and_the_goals():
 
 
 def test_a_restarted_recipe_shows_its_runs_and_the_returned_runs_curve():
-    """SAC's recipe is two runs per seed (restarts: 2): the budget counts both, the table
-    says so, and the curve is the returned run's, ending at one run's steps."""
+    """SAC's recipe is three runs per seed (restarts: 3): the budget counts all three, the
+    table says so, and the curve is the returned run's, ending at one run's steps."""
     summary = json.loads(RESULTS.read_text())
     sac = summary["algorithms"]["sac"]
-    assert sac["restarts"] == 2 and sac["budget"] == 2 * sac["curve"][-1]["steps"]
-    assert f"| sac (sac) | {sac['budget']:,} (2 runs) |" in markdown(summary)
+    assert sac["restarts"] == 3 and sac["budget"] == 3 * sac["curve"][-1]["steps"]
+    assert f"| sac (sac) | {sac['budget']:,} (3 runs) |" in markdown(summary)
     assert "(1 runs)" not in markdown(summary)
 
 

@@ -132,8 +132,10 @@ def test_base_applies_the_recipe_under_a_files_own_settings(tmp_path):
     _, ablation = read_config("ablation_ppo_lambda_095")  # chained: on 0.6.0's recipe
     assert ablation == {**old, "model": {**old["model"], "gae_lambda": 0.95}}
     _, sac = read_config("sac")
-    _, two_runs = read_config("ablation_sac_two_runs")  # acld-gym 0.8.0's SAC recipe
-    assert sac["restarts"] == 3 and two_runs == {**sac, "restarts": 2}
+    _, three_runs = read_config("ablation_sac_three_runs")  # acld-gym 0.9.0's SAC recipe
+    assert three_runs == {**sac, "restarts": 3, "restart_above": None}
+    _, two_runs = read_config("ablation_sac_two_runs")  # 0.8.0's: chained on 0.9.0's
+    assert two_runs == {**three_runs, "restarts": 2}
     _, lqr_scale = read_config("ablation_sac_lqr_scale")  # measured against 0.8.0's
     assert lqr_scale == {
         **two_runs,

@@ -8,7 +8,16 @@ from pathlib import Path
 
 import pytest
 
-from train.bench.report import BEGIN, GOALS, curves_figure, main, markdown, replace_block
+from train.bench.report import (
+    BEGIN,
+    GOALS,
+    budget,
+    curves_figure,
+    main,
+    markdown,
+    replace_block,
+)
+from train.config import read_config
 
 RESULTS = Path("train/benchmark/results-v1.json")
 PAGE = Path("docs/training.md")
@@ -31,31 +40,39 @@ def test_committed_results_hold_every_seed_and_the_goals():
             assert all(0 < s[c] < 10 for c in ("1", "2", "3", "random"))
 
 
-def test_a_restarted_recipe_shows_its_runs_and_the_returned_runs_curve():
-    """SAC's recipe is three runs per seed (restarts: 3): the budget counts all three, the
-    table says so, and the curve is the returned run's, ending at one run's steps."""
-    summary = json.loads(RESULTS.read_text())
-    sac = summary["algorithms"]["sac"]
-    assert sac["restarts"] == 3 and sac["budget"] == 3 * sac["curve"][-1]["steps"]
-    assert f"| sac (sac) | {sac['budget']:,} (3 runs) |" in markdown(summary)
-    assert "(1 runs)" not in markdown(summary)
+def test_the_budget_cell_says_how_many_runs_a_seed_takes():
+    """One run: the steps alone; N runs whatever their cost (``restarts:``): "(N runs)";
+    a run retried only while it fails (``restart_above:``): the most, "(up to N runs)"."""
+    assert budget({"budget": 2_000_000, "restarts": 1}) == "2,000,000"
+    assert budget({"budget": 6_000_000, "restarts": 3}) == "6,000,000 (3 runs)"
+    retried = {"budget": 8_000_000, "restarts": 4, "restart_above": 0.54}
+    assert budget(retried) == "8,000,000 (up to 4 runs)"
 
 
-def test_a_recipe_that_retries_failed_runs_shows_the_most_and_each_seeds_runs():
-    """PPO's recipe retries a run only if it failed (restart_above): the budget is the most
-    a seed may take, and each seed's row says how many runs it took."""
+@pytest.mark.parametrize("algo", ["ppo", "sac"])
+def test_a_recipe_that_retries_failed_runs_shows_the_most_and_each_seeds_runs(algo):
+    """PPO's and SAC's recipes retry a run only while it fails (restart_above): the committed
+    entry is the recipe's, its budget the most a seed may take, its curve one run's, and each
+    seed's row says how many runs it took."""
     summary = json.loads(RESULTS.read_text())
-    ppo = summary["algorithms"]["ppo"]
-    assert ppo["restarts"] == 3 and ppo["restart_above"] == "lqr"
-    assert ppo["budget"] / 3 <= ppo["curve"][-1]["steps"] < ppo["budget"] / 2  # one run's
+    entry = summary["algorithms"][algo]
+    _, recipe = read_config(algo)
+    n = recipe["restarts"]
+    assert n > 1 and recipe["restart_above"] is not None
+    assert entry["restarts"] == n and entry["restart_above"] == recipe["restart_above"]
+    assert entry["budget"] == n * recipe["timesteps"]
+    assert entry["budget"] / n <= entry["curve"][-1]["steps"] < entry["budget"] / (n - 1)
     text = markdown(summary)
-    assert f"| ppo (ppo) | {ppo['budget']:,} (up to 3 runs) |" in text
-    for s in ppo["per_seed"]:
+    assert f"| {algo} ({algo}) | {entry['budget']:,} (up to {n} runs) |" in text
+    for s in entry["per_seed"]:
+        assert 1 <= s["runs"] <= n
         runs = f"{s['runs']} run" + ("s" if s["runs"] > 1 else "")
-        assert f"| ppo | {s['seed']} ({runs}) |" in text
-    assert "| sac | 0 |" in text  # every run of every seed: no count per seed
-    two = {**ppo, "per_seed": [{**ppo["per_seed"][0], "runs": 2}]}
-    assert "| ppo | 0 (2 runs) |" in markdown({**summary, "algorithms": {"ppo": two}})
+        assert f"| {algo} | {s['seed']} ({runs}) |" in text
+    seed = entry["per_seed"][0]["seed"]  # a seed that took two runs says so
+    two = {**entry, "per_seed": [{**entry["per_seed"][0], "runs": 2}]}
+    assert f"| {algo} | {seed} (2 runs) |" in markdown({**summary, "algorithms": {algo: two}})
+    every = {**two, "restart_above": None}  # every run of every seed: no count per seed
+    assert f"| {algo} | {seed} | " in markdown({**summary, "algorithms": {algo: every}})
 
 
 def test_write_replaces_only_the_block(tmp_path, capsys):

@@ -56,6 +56,16 @@ def _scalar(x):
     return x.item() if isinstance(x, np.generic) else x
 
 
+def _per_env(values) -> list:
+    """One vector-env info entry as a list with one value per sub-env: sub-env i's is
+    ``_scalar(values[i])`` (a row for a 2-D array), converted a column at a time (a numeric
+    column's ``tolist()`` gives the same Python values as ``item()``, without a call per
+    value: the step's infos were a tenth of SAC's training time)."""
+    if isinstance(values, np.ndarray) and values.dtype != object:
+        return values.tolist() if values.ndim == 1 else list(values)
+    return [_scalar(x) for x in values]
+
+
 class SB3VecEnv(VecEnv):
     """SB3 ``VecEnv`` over :class:`ACLDBeamVectorEnv` (``num_envs`` and the env's
     configuration -- ``config=`` and/or its fields as keywords --, or an existing
@@ -99,8 +109,9 @@ class SB3VecEnv(VecEnv):
         self._actions = None
         done = terminated | truncated
         keys = INFO_KEYS + (("reward_scale",) if "reward_scale" in info else ())
+        columns = [_per_env(info[key]) for key in keys]
         infos: list[dict[str, Any]] = [
-            {key: _scalar(info[key][i]) for key in keys} for i in range(self.num_envs)
+            dict(zip(keys, row, strict=True)) for row in zip(*columns, strict=True)
         ]
         if done.any():
             ended = np.flatnonzero(done)

@@ -183,6 +183,37 @@ def test_sb3_adapter_same_step_autoreset():
     venv.close()
 
 
+def test_sb3_adapter_infos_are_the_vector_envs_per_sub_env():
+    """``infos[i][key]`` is the vector env's ``info[key][i]`` as a Python value (numpy
+    scalars converted as ``item()`` does; the true state's row as an array), over an
+    episode's end; with ``reward_scale`` its value too."""
+    kw = {"episode_length": SHORT, "load_case": "random", "reward_scale": "passive"}
+    venv, ref = SB3VecEnv(num_envs=N, **kw), ACLDBeamVectorEnv(num_envs=N, **kw)
+    venv.seed(7)
+    venv.reset()
+    ref.reset(seed=7)
+    acts = np.random.default_rng(0).uniform(-150, 150, (50, N, 1)).astype(np.float32)
+    for k, a in enumerate(acts):
+        venv.step_async(a)
+        infos = venv.step_wait()[3]
+        info = ref.step(a)[4]
+        keys = (*INFO_KEYS, "reward_scale")
+        for i in range(N):
+            extra = {"terminal_observation", "TimeLimit.truncated"} if k == len(acts) - 1 else set()
+            assert set(infos[i]) == set(keys) | extra
+            for key in keys:
+                want = info[key][i]
+                got = infos[i][key]
+                if key == "xr_true":
+                    assert isinstance(got, np.ndarray)
+                    np.testing.assert_array_equal(got, want)
+                else:
+                    assert not isinstance(got, np.generic), key
+                    assert got == (want.item() if isinstance(want, np.generic) else want)
+                    assert type(got) is type(want.item() if isinstance(want, np.generic) else want)
+    assert all(i["TimeLimit.truncated"] for i in infos)
+
+
 def test_sb3_ppo_learns_and_evaluates():
     from stable_baselines3 import PPO
     from stable_baselines3.common.evaluation import evaluate_policy

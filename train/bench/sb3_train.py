@@ -6,6 +6,7 @@ env of :func:`train.vec.make_vec_env`, from scratch on the env's observation and
 from __future__ import annotations
 
 import copy
+import inspect
 from contextlib import contextmanager
 
 import numpy as np
@@ -129,7 +130,39 @@ def make_model(cfg: TrainConfig, venv, seed: int, **kwargs):
     if cfg.episode_scale:
         model_kwargs["rollout_buffer_class"] = EpisodeScaledRolloutBuffer
     model_kwargs.setdefault("verbose", 0)
-    return algo_class(cfg.algo)(policy, venv, seed=seed, device="cpu", **{**model_kwargs, **kwargs})
+    cls = algo_class(cfg.algo)
+    model_kwargs = _flat_n_step_buffer(cls, venv, {**model_kwargs, **kwargs})
+    return cls(policy, venv, seed=seed, device="cpu", **model_kwargs)
+
+
+def _flat_n_step_buffer(cls, venv, model_kwargs: dict) -> dict:
+    """``model_kwargs`` of an off-policy algorithm with n-step returns (``n_steps > 1``, no
+    buffer class of its own, a Box observation) with SB3's n-step buffer replaced by
+    :class:`train.bench.buffers.FlatNStepReplayBuffer`, which returns the same samples,
+    faster: ``n_steps`` and ``gamma`` move to ``replay_buffer_kwargs``, as SB3 passes
+    them to its own. Other kwargs are returned as they are."""
+    from gymnasium import spaces
+    from stable_baselines3.common.off_policy_algorithm import OffPolicyAlgorithm
+
+    n = model_kwargs.get("n_steps", 1)
+    if (
+        not issubclass(cls, OffPolicyAlgorithm)
+        or n <= 1
+        or model_kwargs.get("replay_buffer_class") is not None
+        or not isinstance(venv.observation_space, spaces.Box)
+    ):
+        return model_kwargs
+    from .buffers import FlatNStepReplayBuffer
+
+    gamma = model_kwargs.get("gamma", inspect.signature(cls.__init__).parameters["gamma"].default)
+    out = {k: v for k, v in model_kwargs.items() if k != "n_steps"}
+    out["replay_buffer_class"] = FlatNStepReplayBuffer
+    out["replay_buffer_kwargs"] = {
+        **(model_kwargs.get("replay_buffer_kwargs") or {}),
+        "n_steps": n,
+        "gamma": gamma,
+    }
+    return out
 
 
 class Selection:

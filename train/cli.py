@@ -159,9 +159,11 @@ def main(argv: list[str] | None = None) -> int:
     command = "python -m train " + " ".join(
         shlex.quote(a) for a in (sys.argv[1:] if argv is None else argv)
     )
-    runs = f" ({cfg.restarts} runs of {cfg.timesteps})" if cfg.restarts > 1 else ""
+    # several runs: all of them (restarts), or the next only while a run fails (restart_above)
+    upto = "up to " if cfg.restart_above is not None else ""
+    runs = f" ({upto}{cfg.restarts} runs of {cfg.timesteps})" if cfg.restarts > 1 else ""
     print(
-        f"training {cfg.algo.upper()} ({name}, {cfg.training}) for {cfg.budget} env "
+        f"training {cfg.algo.upper()} ({name}, {cfg.training}) for {upto}{cfg.budget} env "
         f"steps{runs}, seed {args.seed}",
         flush=True,
     )

@@ -72,6 +72,10 @@ def test_train_cli_is_a_benchmark_trial(algo, tmp_path, capsys):
     )
     out = capsys.readouterr().out
     assert "ISE / LQR" in out and "case random" in out
+    recipe = yaml.safe_load(cfg.read_text())  # a run is retried only while it fails:
+    runs, timesteps = recipe["restarts"], recipe["timesteps"]  # the budget is the most
+    assert recipe["restart_above"] is not None and runs > 1
+    assert f"for up to {runs * timesteps} env steps (up to {runs} runs of {timesteps})" in out
     assert (
         bench_main(
             [

@@ -1,0 +1,125 @@
+"""SAC's training speed with the package's n-step replay buffer
+(:class:`train.bench.buffers.FlatNStepReplayBuffer`) against stable-baselines3's own
+(``NStepReplayBuffer``), timed in the same run: one batch's sampling from a buffer the
+size of the SAC recipe's (``train/benchmark/sac.yaml``: 1M transitions of 64 sub-envs,
+5-step returns, batches of 2048), and the recipe's ``learn`` (collection + updates) for
+``--timesteps`` env steps after ``learning_starts``, both buffers from the same seed (the
+two runs' parameters are compared: they must be equal, as tests/train/test_buffers.py
+checks on a tiny run).
+
+Not a timed test: ``python benchmarks/bench_sac.py [--timesteps 200000] [--repeats 2]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from dataclasses import replace
+
+import numpy as np
+import torch
+from stable_baselines3.common.buffers import NStepReplayBuffer
+
+from train.bench.buffers import FlatNStepReplayBuffer
+from train.config import load_config
+
+SB3 = "SB3 NStepReplayBuffer"
+
+
+def sample_ms(cls, batches: int = 500) -> float:
+    """Milliseconds per ``sample(2048)`` of a buffer of the recipe's shape, 3000 rows full."""
+    cfg = load_config("sac")
+    from gymnasium import spaces
+
+    obs = spaces.Box(-np.inf, np.inf, (10,), np.float32)
+    act = spaces.Box(-1.0, 1.0, (1,), np.float32)
+    n = cfg.n_envs
+    buf = cls(
+        cfg.model["buffer_size"],
+        obs,
+        act,
+        device="cpu",
+        n_envs=n,
+        n_steps=cfg.model["n_steps"],
+        gamma=cfg.model["gamma"],
+        handle_timeout_termination=True,
+    )
+    rng = np.random.default_rng(0)
+    for _ in range(3000):
+        done = rng.random(n) < 1e-3
+        buf.add(
+            rng.normal(size=(n, 10)).astype(np.float32),
+            rng.normal(size=(n, 10)).astype(np.float32),
+            rng.uniform(-1, 1, (n, 1)).astype(np.float32),
+            rng.normal(size=n).astype(np.float32),
+            done,
+            [{"TimeLimit.truncated": bool(d)} for d in done],
+        )
+    np.random.seed(0)  # noqa: NPY002 (SB3 samples from numpy's global generator)
+    t0 = time.perf_counter()
+    for _ in range(batches):
+        buf.sample(cfg.model["batch_size"])
+    return (time.perf_counter() - t0) / batches * 1e3
+
+
+def learn(flat: bool, timesteps: int) -> tuple[float, dict]:
+    """(env steps/s of the SAC recipe's ``learn`` after ``learning_starts``, its final
+    parameters) with the flat buffer or SB3's own."""
+    from train.bench.sb3_train import make_model
+    from train.vec import make_vec_env
+
+    cfg = load_config("sac")
+    kwargs = {}
+    if not flat:  # SB3's own n-step buffer, as SB3 sets it up when n_steps > 1
+        m = cfg.model
+        cfg = replace(cfg, model={**m, "n_steps": 1})
+        kwargs = {
+            "replay_buffer_class": NStepReplayBuffer,
+            "replay_buffer_kwargs": {"n_steps": m["n_steps"], "gamma": m["gamma"]},
+        }
+    venv = make_vec_env(cfg, 0)
+    model = make_model(cfg, venv, 0, **kwargs)
+    expected = FlatNStepReplayBuffer if flat else NStepReplayBuffer
+    assert type(model.replay_buffer) is expected, type(model.replay_buffer)
+    start = cfg.model["learning_starts"]
+    model.learn(start, reset_num_timesteps=False)
+    t0 = time.perf_counter()
+    model.learn(timesteps, reset_num_timesteps=False)
+    rate = timesteps / (time.perf_counter() - t0)
+    venv.close()
+    return rate, model.policy.state_dict()
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__)
+    p.add_argument("--timesteps", type=int, default=200_000)
+    p.add_argument("--repeats", type=int, default=2)
+    a = p.parse_args()
+    torch.set_num_threads(1)
+    print("sample(2048) of the recipe's buffer [ms] (best of the repeats)")
+    for name, cls in (
+        ("SB3 NStepReplayBuffer", NStepReplayBuffer),
+        ("flat", FlatNStepReplayBuffer),
+    ):
+        print(f"  {name:<24} {min(sample_ms(cls) for _ in range(a.repeats)):8.3f}")
+    print(f"SAC recipe learn, {a.timesteps} env steps after learning_starts [env steps/s]")
+    rates: dict[str, list[float]] = {SB3: [], "flat": []}
+    params = {}
+    for _ in range(a.repeats):  # interleaved, so that drift in the machine's speed hits both
+        for name, flat in ((SB3, False), ("flat", True)):
+            rate, params[name] = learn(flat, a.timesteps)
+            rates[name].append(rate)
+    for name, r in rates.items():
+        print(f"  {name:<24} {max(r):8.0f}   (runs: {', '.join(f'{x:.0f}' for x in r)})")
+    same = all(
+        torch.equal(params["flat"][k], v) for k, v in params["SB3 NStepReplayBuffer"].items()
+    )
+    print(f"  same final parameters: {same}")
+    print(f"  speed-up: {max(rates['flat']) / max(rates[SB3]):.2f}x")
+
+
+if __name__ == "__main__":
+    from acld_gym.util.blas import one_blas_thread
+
+    with one_blas_thread():  # as the package's entry points run (acld_gym.util.blas)
+        main()

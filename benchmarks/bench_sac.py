@@ -26,39 +26,60 @@ from train.config import load_config
 SB3 = "SB3 NStepReplayBuffer"
 
 
-def sample_ms(cls, batches: int = 500) -> float:
-    """Milliseconds per ``sample(2048)`` of a buffer of the recipe's shape, 3000 rows full."""
-    cfg = load_config("sac")
+def filled_buffer(
+    cls,
+    size: int,
+    n_envs: int,
+    rows: int,
+    n_steps: int,
+    gamma: float,
+    done_rate: float,
+    obs_dim: int = 5,
+):
+    """A replay buffer ``cls`` of ``size`` rows of ``n_envs`` sub-envs (n-step returns:
+    ``n_steps``, ``gamma``; ``obs_dim``-value observations, 1-value actions) after ``rows`` adds
+    (wrapped when rows > size) of random transitions, each ending an episode with
+    probability ``done_rate``, half of those by the time limit; seeded, so two buffers
+    filled alike hold the same data."""
     from gymnasium import spaces
 
-    obs = spaces.Box(-np.inf, np.inf, (10,), np.float32)
-    act = spaces.Box(-1.0, 1.0, (1,), np.float32)
-    n = cfg.n_envs
     buf = cls(
-        cfg.model["buffer_size"],
-        obs,
-        act,
+        size,
+        spaces.Box(-np.inf, np.inf, (obs_dim,), np.float32),
+        spaces.Box(-1.0, 1.0, (1,), np.float32),
         device="cpu",
-        n_envs=n,
-        n_steps=cfg.model["n_steps"],
-        gamma=cfg.model["gamma"],
+        n_envs=n_envs,
+        n_steps=n_steps,
+        gamma=gamma,
         handle_timeout_termination=True,
     )
     rng = np.random.default_rng(0)
-    for _ in range(3000):
-        done = rng.random(n) < 1e-3
+    for _ in range(rows):
+        done = rng.random(n_envs) < done_rate
+        truncated = done & (rng.random(n_envs) < 0.5)
         buf.add(
-            rng.normal(size=(n, 10)).astype(np.float32),
-            rng.normal(size=(n, 10)).astype(np.float32),
-            rng.uniform(-1, 1, (n, 1)).astype(np.float32),
-            rng.normal(size=n).astype(np.float32),
+            rng.normal(size=(n_envs, obs_dim)).astype(np.float32),
+            rng.normal(size=(n_envs, obs_dim)).astype(np.float32),
+            rng.uniform(-1, 1, (n_envs, 1)).astype(np.float32),
+            rng.normal(size=n_envs).astype(np.float32),
             done,
-            [{"TimeLimit.truncated": bool(d)} for d in done],
+            [{"TimeLimit.truncated": bool(t)} for t in truncated],
         )
+    return buf
+
+
+def sample_ms(cls, batches: int = 500) -> float:
+    """Milliseconds per batch sampled from a buffer of the recipe's size, sub-envs, n-step
+    returns and batch size, 3000 rows full of 10-value observations (v1's 9 and log c)."""
+    cfg = load_config("sac")
+    m = cfg.model
+    buf = filled_buffer(
+        cls, m["buffer_size"], cfg.n_envs, 3000, m["n_steps"], m["gamma"], 1e-3, obs_dim=10
+    )
     np.random.seed(0)  # noqa: NPY002 (SB3 samples from numpy's global generator)
     t0 = time.perf_counter()
     for _ in range(batches):
-        buf.sample(cfg.model["batch_size"])
+        buf.sample(m["batch_size"])
     return (time.perf_counter() - t0) / batches * 1e3
 
 

@@ -5,6 +5,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 import torch
+from benchmark_scripts import load_script
 from gymnasium import spaces
 from stable_baselines3.common.buffers import NStepReplayBuffer
 from stable_baselines3.common.running_mean_std import RunningMeanStd
@@ -14,35 +15,12 @@ from tiny_sb3 import tiny_sac_recipe
 from train.bench.buffers import FlatNStepReplayBuffer
 
 OBS = spaces.Box(-np.inf, np.inf, (5,), np.float32)
-ACT = spaces.Box(-1.0, 1.0, (1,), np.float32)
 
 
 def _filled(cls, size: int, n_envs: int, rows: int, n_steps: int):
-    """A buffer of ``size`` rows after ``rows`` adds (wrapped when rows > size) of random
-    transitions, with episode ends (dones) and time-limit truncations among them."""
-    buf = cls(
-        size,
-        OBS,
-        ACT,
-        device="cpu",
-        n_envs=n_envs,
-        n_steps=n_steps,
-        gamma=0.99,
-        handle_timeout_termination=True,
-    )
-    rng = np.random.default_rng(0)
-    for _ in range(rows):
-        done = rng.random(n_envs) < 0.1
-        truncated = done & (rng.random(n_envs) < 0.5)
-        buf.add(
-            rng.normal(size=(n_envs, 5)).astype(np.float32),
-            rng.normal(size=(n_envs, 5)).astype(np.float32),
-            rng.uniform(-1, 1, (n_envs, 1)).astype(np.float32),
-            rng.normal(size=n_envs).astype(np.float32),
-            done,
-            [{"TimeLimit.truncated": bool(t)} for t in truncated],
-        )
-    return buf
+    """benchmarks/bench_sac.py's random buffer, a tenth of its transitions ending an episode
+    (half of those by the time limit)."""
+    return load_script("bench_sac").filled_buffer(cls, size, n_envs, rows, n_steps, 0.99, 0.1)
 
 
 def _norm_env():

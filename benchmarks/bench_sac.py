@@ -7,7 +7,7 @@ size of the SAC recipe's (``train/benchmark/sac.yaml``: 1M transitions of 64 sub
 two runs' parameters are compared: they must be equal, as tests/train/test_buffers.py
 checks on a tiny run).
 
-Not a timed test: ``python benchmarks/bench_sac.py [--timesteps 200000] [--repeats 2]``.
+Not a timed test: ``python benchmarks/bench_sac.py [--timesteps 100000] [--repeats 3]``.
 """
 
 from __future__ import annotations
@@ -68,19 +68,28 @@ def filled_buffer(
     return buf
 
 
-def sample_ms(cls, batches: int = 500) -> float:
+def sample_ms(blocks: int = 20, batches: int = 50) -> dict[str, list[float]]:
     """Milliseconds per batch sampled from a buffer of the recipe's size, sub-envs, n-step
-    returns and batch size, 3000 rows full of 10-value observations (v1's 9 and log c)."""
+    returns and batch size (3000 rows full of 10-value observations: v1's 9 and log c),
+    SB3's and the flat one alternating in ``blocks`` blocks of ``batches`` batches each, so
+    that drift in the machine's speed hits both: ``{name: [ms per batch of each block]}``."""
     cfg = load_config("sac")
     m = cfg.model
-    buf = filled_buffer(
-        cls, m["buffer_size"], cfg.n_envs, 3000, m["n_steps"], m["gamma"], 1e-3, obs_dim=10
-    )
+    bufs = {
+        name: filled_buffer(
+            cls, m["buffer_size"], cfg.n_envs, 3000, m["n_steps"], m["gamma"], 1e-3, obs_dim=10
+        )
+        for name, cls in ((SB3, NStepReplayBuffer), ("flat", FlatNStepReplayBuffer))
+    }
+    out: dict[str, list[float]] = {name: [] for name in bufs}
     np.random.seed(0)  # noqa: NPY002 (SB3 samples from numpy's global generator)
-    t0 = time.perf_counter()
-    for _ in range(batches):
-        buf.sample(m["batch_size"])
-    return (time.perf_counter() - t0) / batches * 1e3
+    for _ in range(blocks):
+        for name, buf in bufs.items():
+            t0 = time.perf_counter()
+            for _ in range(batches):
+                buf.sample(m["batch_size"])
+            out[name].append((time.perf_counter() - t0) / batches * 1e3)
+    return out
 
 
 def learn(flat: bool, timesteps: int) -> tuple[float, dict]:
@@ -113,16 +122,17 @@ def learn(flat: bool, timesteps: int) -> tuple[float, dict]:
 
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__)
-    p.add_argument("--timesteps", type=int, default=200_000)
-    p.add_argument("--repeats", type=int, default=2)
+    p.add_argument("--timesteps", type=int, default=100_000)
+    p.add_argument("--repeats", type=int, default=3)
     a = p.parse_args()
     torch.set_num_threads(1)
-    print("sample(2048) of the recipe's buffer [ms] (best of the repeats)")
-    for name, cls in (
-        ("SB3 NStepReplayBuffer", NStepReplayBuffer),
-        ("flat", FlatNStepReplayBuffer),
-    ):
-        print(f"  {name:<24} {min(sample_ms(cls) for _ in range(a.repeats)):8.3f}")
+    ms = sample_ms()
+    print(f"sample(2048) of the recipe's buffer [ms] (median of {len(ms[SB3])} blocks)")
+    for name, r in ms.items():
+        print(f"  {name:<24} {np.median(r):8.3f}   (blocks: {min(r):.3f}-{max(r):.3f})")
+    ratio = np.array(ms["flat"]) / np.array(ms[SB3])
+    span = f"{ratio.min():.2f}-{ratio.max():.2f}"
+    print(f"  flat / SB3 per block: median {np.median(ratio):.2f} ({span})")
     print(f"SAC recipe learn, {a.timesteps} env steps after learning_starts [env steps/s]")
     rates: dict[str, list[float]] = {SB3: [], "flat": []}
     params = {}
@@ -131,12 +141,11 @@ def main() -> None:
             rate, params[name] = learn(flat, a.timesteps)
             rates[name].append(rate)
     for name, r in rates.items():
-        print(f"  {name:<24} {max(r):8.0f}   (runs: {', '.join(f'{x:.0f}' for x in r)})")
-    same = all(
-        torch.equal(params["flat"][k], v) for k, v in params["SB3 NStepReplayBuffer"].items()
-    )
+        print(f"  {name:<24} {np.median(r):8.0f}   (runs: {', '.join(f'{x:.0f}' for x in r)})")
+    same = all(torch.equal(params["flat"][k], v) for k, v in params[SB3].items())
     print(f"  same final parameters: {same}")
-    print(f"  speed-up: {max(rates['flat']) / max(rates[SB3]):.2f}x")
+    pairs = np.array(rates["flat"]) / np.array(rates[SB3])
+    print(f"  flat / SB3 per pair of runs: {', '.join(f'{x:.2f}' for x in pairs)}")
 
 
 if __name__ == "__main__":

@@ -39,6 +39,7 @@ _positive_int = arg_type(int, 1, 10**12)
 _seed = arg_type(int, 0, MAX_SEED)
 _param_noise = arg_type(float, 0.0)  # its bound (per mesh) is checked by the env's config
 _episodes = arg_type(int, 1, 20)
+_cpus = arg_type(int, 1, 1024)
 
 
 def _load_case_arg(text: str):
@@ -96,6 +97,13 @@ def build_parser() -> argparse.ArgumentParser:
         type=_episodes,
         default=20,
         help="held-out random-load episodes of the evaluation, 1..20 (default 20)",
+    )
+    p.add_argument(
+        "--cpus",
+        type=_cpus,
+        default=1,
+        help="runs of a recipe with several (restarts: ppo, sac) trained at once, in worker "
+        "processes: the same agent in less wall time (default 1)",
     )
     p.add_argument(
         "--out",
@@ -162,13 +170,21 @@ def main(argv: list[str] | None = None) -> int:
     # several runs: all of them (restarts), or the next only while a run fails (restart_above)
     upto = "up to " if cfg.restart_above is not None else ""
     runs = f" ({upto}{cfg.restarts} runs of {cfg.timesteps})" if cfg.restarts > 1 else ""
+    if runs and args.cpus > 1:
+        runs = runs[:-1] + f", {min(args.cpus, cfg.restarts)} at once)"
     print(
         f"training {cfg.algo.upper()} ({name}, {cfg.training}) for {upto}{cfg.budget} env "
         f"steps{runs}, seed {args.seed}",
         flush=True,
     )
     rec, policy = run_trial(
-        name, data, args.seed, args.env_id, args.random_episodes, command=command
+        name,
+        data,
+        args.seed,
+        args.env_id,
+        args.random_episodes,
+        command=command,
+        workers=min(args.cpus, cfg.restarts),
     )
     save_agent(policy, rec, out)
     write_text(out / "trial.json", json.dumps(rec) + "\n")

@@ -247,6 +247,8 @@ def test_benchmark_rejects_bad_arguments(tmp_path):
         main(["--algos", "no_such_algo", "--out", str(tmp_path)])
     with pytest.raises(SystemExit):
         main(["--seeds", "0", "0", "--out", str(tmp_path)])
+    with pytest.raises(SystemExit):
+        main(["--cpus-per-trial", "0", "--out", str(tmp_path)])
 
 
 @pytest.mark.slow

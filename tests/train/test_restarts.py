@@ -204,3 +204,68 @@ def test_two_tiny_sac_runs_return_the_better_one():
     assert runs[0]["cost"] != runs[1]["cost"]  # independent runs
     again = evaluate.validation_cost(policy, "ACLDBeam-v1", evaluate.validation_seeds(2))
     assert again == pytest.approx(record["select"]["cost"], rel=1e-5)
+
+
+@pytest.mark.parametrize(
+    "restart_above, trained",
+    [(1e-9, 3), (1e9, 1)],  # no run meets it: all three, the lowest; the first meets it
+)
+def test_runs_at_once_are_the_runs_one_after_another(restart_above, trained):
+    """``workers=2`` trains the runs in worker processes, two at once: the same runs, taken
+    in the same order, so the same policy (parameters and actions) and record; a run
+    started ahead and not needed is ended and counted nowhere but in the CPU time."""
+    import numpy as np
+    import torch
+
+    from train.bench.trials import CaseISE
+
+    cfg = tiny_sac_recipe(
+        400,
+        restarts=3,
+        restart_above=restart_above,
+        select={"episodes": 2, "every": 200, "start": 0},
+    )
+    curve = CaseISE("ACLDBeam-v1", evaluate.eval_episodes(1))  # pickles to the workers
+    (p1, r1), (p2, r2) = (train_algo(cfg, 3, "ACLDBeam-v1", curve, workers=w) for w in (1, 2))
+    assert len(r1["restarts"]["runs"]) == trained and r1["steps"] == 400 * trained
+    assert "workers" not in r1["restarts"] and r2["restarts"].pop("workers") == 2
+    for key in ("steps", "select", "curve", "restarts"):
+        assert r2[key] == r1[key], key
+    s1, s2 = p1.model.policy.state_dict(), p2.model.policy.state_dict()
+    assert s1.keys() == s2.keys() and all(torch.equal(s1[k], s2[k]) for k in s1)
+    n_obs = gym.make("ACLDBeam-v1").observation_space.shape[0]
+    obs = (np.random.default_rng(0).normal(size=(8, n_obs)) * 1e-4).astype(np.float32)
+    assert np.array_equal(p1.predict(obs)[0], p2.predict(obs)[0])
+    assert not hasattr(p2.model, "replay_buffer")  # the worker sent the policy alone
+    assert r2["train_cpu_seconds"] > 0 and r2["train_seconds"] > 0
+
+
+@pytest.mark.parametrize("workers", [0, -1, 1.5, True, "2"])
+def test_bad_workers_are_named(workers):
+    with pytest.raises(ValueError, match="workers must be a positive integer"):
+        train_algo(_cfg(restarts=2), 0, "ACLDBeam-v1", workers=workers)
+
+
+def test_a_portable_policy_pickles_after_a_training_step_and_acts_the_same():
+    """What a worker sends back: the policy without its model's env and buffer, through
+    the pickler a process pool sends results with (torch's shared-memory tensor reductions
+    refuse the tensors autograd still holds, gSDE's last noise draw), acting the same."""
+    import pickle
+    from multiprocessing.reduction import ForkingPickler
+
+    import numpy as np
+
+    from tests.train.tiny_sb3 import tiny_ppo
+    from train.bench.sb3_train import train_sb3
+
+    policy, _ = train_sb3(tiny_ppo(), 0, "ACLDBeam-v1")
+    n_obs = gym.make("ACLDBeam-v1").observation_space.shape[0]
+    obs = (np.random.default_rng(1).normal(size=(6, n_obs)) * 1e-4).astype(np.float32)
+    net = policy.model.policy
+    net.log_std.requires_grad_(True)  # as while training (the recipe's annealing freezes it)
+    net.reset_noise(4)  # gSDE's draw of a rollout: exploration matrices attached to log_std
+    with pytest.raises(RuntimeError, match="non-leaf tensor"):
+        ForkingPickler.dumps(net)  # as a worker sends its result (torch's tensor reductions)
+    back = pickle.loads(ForkingPickler.dumps(policy.portable()))
+    assert np.array_equal(back.predict(obs)[0], policy.predict(obs)[0])
+    assert not hasattr(back.model, "env") and len(pickle.dumps(back)) < 200_000

@@ -58,7 +58,9 @@ def test_overrides_of_the_command_line():
 @pytest.mark.parametrize("algo", ["ppo", "sac"])
 def test_train_cli_is_a_benchmark_trial(algo, tmp_path, capsys):
     """``python -m train ALGO --seed N`` and ``python -m train.benchmark --seeds N`` give the
-    same agent, bit for bit; it loads (validated) and acts in volts."""
+    same agent, bit for bit, the one training its runs one after another, the other two at
+    once in worker processes (``--cpus-per-trial 2``); it loads (validated) and acts in
+    volts."""
     from train.benchmark import main as bench_main
     from train.cli import main as train_main
 
@@ -85,6 +87,8 @@ def test_train_cli_is_a_benchmark_trial(algo, tmp_path, capsys):
                 "3",
                 "--backend",
                 "local",
+                "--cpus-per-trial",
+                "2",
                 "--random-episodes",
                 "1",
                 "--no-bound",

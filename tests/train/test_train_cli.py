@@ -34,6 +34,7 @@ def _exit2(fn, argv, capsys, word):
         (["ppo", "--random-episodes", "0"], "--random-episodes"),
         (["ppo", "--env-id", "ACLDBeam-v9"], "--env-id"),
         (["ppo", "--backend", "ray"], "--backend"),
+        (["sac", "--cpus", "0"], "--cpus"),
     ],
 )
 def test_train_cli_bad_input(argv, word, capsys):

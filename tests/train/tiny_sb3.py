@@ -43,7 +43,7 @@ def tiny_sac_recipe(timesteps: int, **fields) -> TrainConfig:
     near it, and ``restarts=1`` needs none), with ``fields`` changed on top."""
     data = yaml.safe_load(open("train/benchmark/sac.yaml"))
     data.update(timesteps=timesteps, n_envs=4, eval_points=1, whiten_steps=128)
-    data.update(restart_above=None, **fields)
+    data.update({"restart_above": None, **fields})
     data["model"] = {**data["model"], "learning_starts": 200, "buffer_size": 2000, "batch_size": 64}
     return TrainConfig.from_dict(data)
 

@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import contextlib
 import time
 from typing import Any
 
 import numpy as np
+
+from acld_gym.util.blas import one_blas_thread
 
 from ..config import TrainConfig
 from .evaluate import CurveCallback, lqr_validation_cost, validation_seeds
@@ -32,11 +35,84 @@ def _train_once(cfg: TrainConfig, seed: int, env_id: str, timed) -> tuple[Any, d
     return train_sb3(cfg, seed, env_id, timed)
 
 
+def _run(
+    cfg: TrainConfig,
+    seed: int,
+    env_id: str,
+    callback: CurveCallback | None,
+    child: bool = False,
+) -> tuple[Any, dict, dict]:
+    """One run: ``(policy, record, times)``, ``record["curve"]`` its learning curve (ending
+    at the run's last step), ``times`` the wall and CPU time of the curve's evaluations
+    (``eval_seconds``, ``eval_cpu_seconds``) and the run's whole CPU time
+    (``cpu_seconds``). ``child``: the run is a worker process's (one BLAS thread,
+    as in the command-line entry points; the policy returned without its training state)."""
+    times = {"eval_seconds": 0.0, "eval_cpu_seconds": 0.0}
+    c0 = time.process_time()
+    curve: list = []
+
+    def timed(steps, policy):  # evaluation time is not training time
+        t0, c0 = time.perf_counter(), time.process_time()
+        if callback is not None:
+            curve.append({"steps": int(steps), **(callback(steps, policy) or {})})
+        times["eval_seconds"] += time.perf_counter() - t0
+        times["eval_cpu_seconds"] += time.process_time() - c0
+
+    with one_blas_thread() if child else contextlib.nullcontext():
+        policy, record = _train_once(cfg, seed, env_id, timed)
+        if callback is not None and (not curve or record["steps"] > curve[-1]["steps"]):
+            timed(record["steps"], policy)  # the curve reaches the run's last step
+    record["curve"] = curve
+    if child and hasattr(policy, "portable"):
+        policy = policy.portable()
+    times["cpu_seconds"] = time.process_time() - c0
+    return policy, record, times
+
+
+def _children_cpu_seconds() -> float | None:
+    """CPU time of this process's ended child processes (None where unknown)."""
+    try:
+        import resource
+    except ImportError:  # pragma: no cover - not on Unix
+        return None
+    ru = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return ru.ru_utime + ru.ru_stime
+
+
+def _runs(cfg: TrainConfig, seeds: list[int], env_id: str, callback, workers: int, cpu: list):
+    """The runs of ``seeds`` as :func:`_run` returns them, in order: one after the other in
+    this process (``workers`` 1), or up to ``workers`` at once in worker processes, each
+    run started as soon as a worker is free (the caller stops when it has what it
+    needs, and the runs still going are ended). With workers, ``cpu[0]`` grows by their
+    CPU time, the unused runs' included."""
+    if workers == 1:
+        for s in seeds:
+            yield _run(cfg, s, env_id, callback)
+        return
+    import multiprocessing
+
+    before = _children_cpu_seconds()
+    pool = multiprocessing.get_context("spawn").Pool(workers)
+    reported = 0.0
+    try:
+        pending = [pool.apply_async(_run, (cfg, s, env_id, callback, True)) for s in seeds]
+        for p in pending:
+            out = p.get()
+            reported += out[2]["cpu_seconds"]
+            yield out
+    finally:
+        pool.terminate()
+        pool.join()
+        after = _children_cpu_seconds()
+        cpu[0] += reported if before is None or after is None else after - before
+
+
 def train_algo(
     cfg: TrainConfig,
     seed: int,
     env_id: str,
     callback: CurveCallback | None = None,
+    workers: int = 1,
 ) -> tuple[Any, dict]:
     """Train ``cfg`` with ``seed`` on ``env_id``; returns ``(policy, record)`` with
     ``record["train_seconds"]`` and ``record["train_cpu_seconds"]`` (wall and CPU time
@@ -56,46 +132,63 @@ def train_algo(
     steps, ``record["curve"]`` the returned run's curve (its steps count from the start of
     that run: the curve is the training of the policy returned; the budget spent is
     ``record["steps"]``) and ``record["restarts"]`` each run's seed, chosen step, cost and
-    curve."""
-    spent = [0.0, 0.0]
-    curve: list = []  # the current run's
+    curve.
 
-    def timed(steps, policy):  # evaluation time is not training time
-        t0, c0 = time.perf_counter(), time.process_time()
-        if callback is not None:
-            curve.append({"steps": int(steps), **(callback(steps, policy) or {})})
-        spent[0] += time.perf_counter() - t0
-        spent[1] += time.process_time() - c0
-
+    ``workers`` > 1 trains up to that many of the runs at once, in worker processes
+    (``spawn``; ``callback`` must then pickle), the next starting as soon as one ends. The
+    runs are the same and are taken in the same order, so the policy and record are those
+    of ``workers=1`` (``record["restarts"]["workers"]`` says how many ran at once); only
+    the time changes. A run started ahead but not needed (an earlier one met
+    ``restart_above``) is ended and counts in neither the steps nor the runs, but in the
+    CPU time, which is all the workers'. The learning curve's evaluations then overlap
+    training in other processes and are not taken off the wall time (an upper bound);
+    the CPU time is the workers' whole."""
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise ValueError(f"workers must be a positive integer, got {workers!r}")
+    seeds = restart_seeds(seed, cfg.restarts)
+    workers = min(workers, len(seeds))
     t0, c0 = time.perf_counter(), time.process_time()
     best, runs, total = None, [], 0  # only the best run so far is kept alive (model, buffer)
+    evals, cpu = [0.0, 0.0], [0.0]  # the curve's evaluations (one process), workers' CPU
     threshold = cfg.restart_above
     if threshold == "lqr":  # the level to beat, on the selection's own validation loads
-        seeds = validation_seeds(cfg.select_config.episodes)
-        threshold = lqr_validation_cost(env_id, seeds)
-    for k, run_seed in enumerate(restart_seeds(seed, cfg.restarts)):
-        curve = []
-        policy, record = _train_once(cfg, run_seed, env_id, timed)
-        if callback is not None and (not curve or record["steps"] > curve[-1]["steps"]):
-            timed(record["steps"], policy)  # the curve reaches the run's last step
-        record["curve"] = curve
-        total += record["steps"]
-        if cfg.restarts > 1:
-            sel = record["select"]
-            runs.append(
-                {"seed": run_seed, "steps": sel["steps"], "cost": sel["cost"], "curve": curve}
-            )
-        if best is None or (runs and runs[-1]["cost"] < runs[best[0]]["cost"]):
-            best = (k, policy, record)  # the first of equal costs is kept
-        policy = record = None
-        if threshold is not None and runs[-1]["cost"] <= threshold:
-            break  # a good enough run: no more restarts
+        threshold = lqr_validation_cost(env_id, validation_seeds(cfg.select_config.episodes))
+    outcomes = _runs(cfg, seeds, env_id, callback, workers, cpu)
+    try:
+        for k, (policy, record, times) in enumerate(outcomes):
+            evals[0] += times["eval_seconds"]
+            evals[1] += times["eval_cpu_seconds"]
+            total += record["steps"]
+            if cfg.restarts > 1:
+                sel = record["select"]
+                runs.append(
+                    {
+                        "seed": seeds[k],
+                        "steps": sel["steps"],
+                        "cost": sel["cost"],
+                        "curve": record["curve"],
+                    }
+                )
+            if best is None or (runs and runs[-1]["cost"] < runs[best[0]]["cost"]):
+                best = (k, policy, record)  # the first of equal costs is kept
+            policy = record = None
+            if threshold is not None and runs[-1]["cost"] <= threshold:
+                break  # a good enough run: no more restarts
+    finally:
+        outcomes.close()  # ends the runs started ahead (workers > 1)
     chosen, policy, record = best
     if runs:
         record["steps"] = total
         record["restarts"] = {"chosen": chosen, "runs": runs}
         if threshold is not None:
             record["restarts"]["threshold"] = threshold
-    record["train_seconds"] = time.perf_counter() - t0 - spent[0]
-    record["train_cpu_seconds"] = time.process_time() - c0 - spent[1]
+        if workers > 1:
+            record["restarts"]["workers"] = workers
+    wall, own_cpu = time.perf_counter() - t0, time.process_time() - c0
+    if workers == 1:  # everything ran here: the times less the evaluations'
+        record["train_seconds"] = wall - evals[0]
+        record["train_cpu_seconds"] = own_cpu - evals[1]
+    else:  # the evaluations overlapped other runs' training: kept in, an upper bound
+        record["train_seconds"] = wall
+        record["train_cpu_seconds"] = own_cpu + cpu[0]
     return policy, record

@@ -6,6 +6,8 @@ volts (:class:`SB3Policy`)."""
 
 from __future__ import annotations
 
+import pickle
+
 import numpy as np
 import torch
 import torch.nn as nn
@@ -177,6 +179,22 @@ class EpisodeScaledRolloutBuffer(RolloutBuffer):
                 self.advantages[a:b, e] /= max(rms, 1e-12)
 
 
+class _PolicyOnly:
+    """What :class:`SB3Policy` and :func:`train.agent.export_sb3` read of an SB3 model:
+    its ``policy`` (the torch module). Pickles the module as plain bytes: a process pool
+    sends results with torch's tensor reductions (shared memory), which refuse the tensors
+    a training step leaves attached to autograd (gSDE's last noise draw)."""
+
+    def __init__(self, policy):
+        self.policy = policy
+
+    def __getstate__(self) -> dict:
+        return {"policy": pickle.dumps(self.policy, protocol=pickle.HIGHEST_PROTOCOL)}
+
+    def __setstate__(self, state: dict) -> None:
+        self.policy = pickle.loads(state["policy"])
+
+
 class SB3Policy:
     """A trained SB3 model with its frozen ``VecNormalize`` statistics as a policy on the
     env's raw observation, ``predict`` in volts (``voltage_map``: the training env's
@@ -203,6 +221,18 @@ class SB3Policy:
     def residual(self) -> str | None:
         """The voltage map's residual (None or ``"lqr"``)."""
         return self.voltage_map.residual
+
+    def portable(self) -> SB3Policy:
+        """This policy without its model's training state (env, replay buffer, logger,
+        schedules): the same ``predict`` and export, small enough to send between
+        processes (a SAC model with its buffer pickles to ~1 GB)."""
+        return SB3Policy(
+            _PolicyOnly(self.model.policy),
+            self.obs_norm,
+            self.features,
+            self.transform,
+            self.voltage_map,
+        )
 
     def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
         obs = np.asarray(observation, dtype=np.float32)

@@ -40,28 +40,25 @@ def run_trial(
     random_episodes: int = 20,
     out: str | Path | None = None,
     command: str | None = None,
+    workers: int = 1,
 ) -> tuple[dict, object]:
     """Train one (config, seed) and evaluate it; returns ``(record, policy)``: the trial's
     record (JSON-able: the learning curve, mean ISE per case at each evaluation, batched --
     with restarts, the returned run's, ``train_algo``;
     the final ISE per case, single-env rollouts; the training wall time, evaluations
     excluded; the command) and the final policy. With ``out``, the policy is saved as an
-    agent in :func:`agent_dir`."""
+    agent in :func:`agent_dir`. ``workers``: how many of the trial's runs (``restarts``)
+    train at once (:func:`train.bench.algos.train_algo`: the same result, in less time)."""
     import torch
 
     from .algos import train_algo
-    from .evaluate import batched_ise, eval_episodes, rollout_ise
+    from .evaluate import eval_episodes, rollout_ise
 
     torch.set_num_threads(1)
     cfg = TrainConfig.from_dict(config)
     episodes = eval_episodes(random_episodes)
-
-    def on_eval(steps: int, policy) -> dict:
-        ise = batched_ise(policy, env_id, episodes)
-        return {"ise": {str(c): v for c, v in ise.items()}}
-
     t0 = time.perf_counter()
-    policy, record = train_algo(cfg, seed, env_id, on_eval)
+    policy, record = train_algo(cfg, seed, env_id, CaseISE(env_id, episodes), workers)
     wall = time.perf_counter() - t0
     final = rollout_ise(policy, env_id, episodes)
     rec = {
@@ -89,6 +86,22 @@ def run_trial(
     if out is not None:
         save_agent(policy, rec, agent_dir(out, name, seed))
     return rec, policy
+
+
+class CaseISE:
+    """A point of a trial's learning curve: the policy's ISE per case (thesis cases and the
+    random set, batched rollouts), ``{"ise": {case: ise}}``; a class, not a closure, so
+    that runs in worker processes can take it along."""
+
+    def __init__(self, env_id: str, episodes: dict):
+        self.env_id = env_id
+        self.episodes = episodes
+
+    def __call__(self, steps: int, policy) -> dict:
+        from .evaluate import batched_ise
+
+        ise = batched_ise(policy, self.env_id, self.episodes)
+        return {"ise": {str(c): v for c, v in ise.items()}}
 
 
 def trial_path(out: Path, name: str, seed: int) -> Path:
@@ -172,6 +185,13 @@ def _tune_trainable(config: dict) -> None:  # pragma: no cover - runs inside Ray
     tune.report({"train_seconds": rec["train_seconds"], "record": json.dumps(rec)})
 
 
+def _trial_cpus(config: dict):  # pragma: no cover - called by Ray Tune
+    """A Ray trial's resources: one CPU per run it trains at once (``workers``)."""
+    from ray.tune import PlacementGroupFactory
+
+    return PlacementGroupFactory([{"CPU": json.loads(config["trial"])["workers"]}])
+
+
 def init_ray(address: str | None, num_cpus: int) -> None:
     """Connect to the Ray cluster at ``address``, or start a local one with ``num_cpus``;
     a session already running in this process (an earlier benchmark or sweep) is reused."""
@@ -187,12 +207,18 @@ def run_trials(
     backend: str = "local",
     num_cpus: int = 2,
     address: str | None = None,
+    workers: int = 1,
 ) -> list[dict]:
     """Run ``trials`` (keyword arguments of :func:`run_trial`) and write each record to
-    ``out/trials/``; ``backend="ray"`` runs them as Ray Tune trials (one CPU each)."""
+    ``out/trials/``; ``backend="ray"`` runs them as Ray Tune trials (``workers`` CPUs each:
+    a trial trains that many of its runs at once)."""
     records = []
     if not trials:  # nothing to train (e.g. --resume --no-train): no Ray start either
         return records
+    # a trial with fewer runs than workers takes one CPU per run
+    trials = [
+        {**t, "workers": min(workers, TrainConfig.from_dict(t["config"]).restarts)} for t in trials
+    ]
     if backend == "local":
         for t in trials:
             rec, _ = run_trial(**t, out=out)
@@ -209,7 +235,7 @@ def run_trials(
     # one grid point per run: run_trial's arguments as JSON text (Tune's loggers sort config
     # keys, and the load weights mix int and str keys)
     tuner = tune.Tuner(
-        tune.with_resources(_tune_trainable, {"cpu": 1}),
+        tune.with_resources(_tune_trainable, _trial_cpus),
         param_space={
             "trial": tune.grid_search(
                 [json.dumps({**t, "out": str(out.resolve())}) for t in trials]

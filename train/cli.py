@@ -184,7 +184,7 @@ def main(argv: list[str] | None = None) -> int:
         args.env_id,
         args.random_episodes,
         command=command,
-        workers=min(args.cpus, cfg.restarts),
+        workers=args.cpus,  # train_algo takes at most one per run
     )
     save_agent(policy, rec, out)
     write_text(out / "trial.json", json.dumps(rec) + "\n")

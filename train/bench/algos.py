@@ -52,11 +52,11 @@ def _run(
     curve: list = []
 
     def timed(steps, policy):  # evaluation time is not training time
-        t0, c0 = time.perf_counter(), time.process_time()
+        w, c = time.perf_counter(), time.process_time()
         if callback is not None:
             curve.append({"steps": int(steps), **(callback(steps, policy) or {})})
-        times["eval_seconds"] += time.perf_counter() - t0
-        times["eval_cpu_seconds"] += time.process_time() - c0
+        times["eval_seconds"] += time.perf_counter() - w
+        times["eval_cpu_seconds"] += time.process_time() - c
 
     with one_blas_thread() if child else contextlib.nullcontext():
         policy, record = _train_once(cfg, seed, env_id, timed)

@@ -31,9 +31,11 @@ Examples::
 
 A recipe with several runs per seed (``restarts``: PPO's and SAC's) trains up to
 ``--cpus-per-trial`` of them at once, in worker processes: the same runs, taken in the
-same order, so the same agent, in less wall time. By default the ``--num-cpus`` are shared
-among the trials (``--algos sac --seeds 7`` on 2 CPUs: two runs at once; five seeds: one
-each, two trials at a time).
+same order, so the same agent, in less wall time. By default such a trial takes every one
+of the ``--num-cpus`` and the trials run one after another (``--algos ppo sac --seeds 7``
+on 2 CPUs: PPO's seed, then SAC's, each with two runs at once), so a seed's wall time is
+its own runs' whatever else the command trains; ``--cpus-per-trial 1`` runs two trials
+at a time instead, more seeds per hour and a longer wait for each (:func:`trial_workers`).
 """
 
 from __future__ import annotations
@@ -132,7 +134,7 @@ def build_parser() -> argparse.ArgumentParser:
         default=None,
         help="CPUs of a trial whose recipe has several runs (restarts): it trains that many "
         "at once, in worker processes, to the same result in less time (default: "
-        "--num-cpus shared among the trials, at least 1; with --address 1)",
+        "--num-cpus, so such trials run one after another; with --address 1)",
     )
     p.add_argument("--address", default=None, help="Ray cluster address (default: local)")
     p.add_argument("--out", default="runs/benchmark", help="output directory")
@@ -153,6 +155,20 @@ def build_parser() -> argparse.ArgumentParser:
         "name the missing ones",
     )
     return p
+
+
+def trial_workers(cpus_per_trial: int | None, num_cpus: int, address: str | None) -> int:
+    """The CPUs of a trial whose recipe has several runs (``--cpus-per-trial``): by default
+    every one of ``--num-cpus`` (1 on a cluster, ``address``), so that such trials run one
+    at a time and each seed's wall time is bounded by its own runs, whatever else the
+    command trains (a trial with one run takes one CPU, :func:`train.bench.trials.run_trials`).
+
+    Until acld-gym 0.14.0 the CPUs were shared among the command's trials: ``--algos ppo
+    sac --seeds N`` gave each trial one, and a SAC seed that needs all four runs took about
+    20 min, over the 15-min goal of a seed (issue 20)."""
+    if cpus_per_trial is not None:
+        return cpus_per_trial
+    return 1 if address else num_cpus
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -225,10 +241,7 @@ def main(argv: list[str] | None = None) -> int:
         f"{len(trials)} runs ({len(records)} reused), backend {backend}, env {args.env_id}",
         flush=True,
     )
-    workers = args.cpus_per_trial
-    if workers is None:  # a lone seed gets the CPUs a batch of seeds shares
-        shared = 1 if backend == "local" else max(len(trials), 1)  # local: one trial at a time
-        workers = 1 if args.address else max(1, args.num_cpus // shared)
+    workers = trial_workers(args.cpus_per_trial, args.num_cpus, args.address)
     records += run_trials(trials, out, backend, args.num_cpus, args.address, workers)
     wall = time.perf_counter() - t0
     summary = summarize(records, refs)

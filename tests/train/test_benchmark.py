@@ -251,6 +251,38 @@ def test_benchmark_rejects_bad_arguments(tmp_path):
         main(["--cpus-per-trial", "0", "--out", str(tmp_path)])
 
 
+@pytest.mark.parametrize(
+    ("flags", "workers"),
+    [([], {"ppo": 2, "sac": 2}), (["--cpus-per-trial", "1"], {"ppo": 1, "sac": 1})],
+)
+def test_a_multi_run_trial_takes_every_cpu_by_default(tmp_path, monkeypatch, flags, workers):
+    """``--algos ppo sac --seeds N`` on 2 CPUs: each trial gets both (two runs at once, one
+    trial after another), so a SAC seed of four runs keeps within the 15-min goal; the
+    trials' own ``workers`` (``run_trials``) are ``min(this, restarts)``."""
+    import train.bench.evaluate as evaluate
+    import train.benchmark as benchmark
+
+    seen = {}
+
+    class Stop(Exception):
+        pass
+
+    def fake_run_trials(trials, out, backend, num_cpus, address, w):
+        seen.update({t["name"]: w for t in trials}, backend=backend)
+        raise Stop
+
+    monkeypatch.setattr(evaluate, "references", lambda *a, **k: {})
+    monkeypatch.setattr(benchmark, "run_trials", fake_run_trials)
+    argv = ["--algos", "ppo", "sac", "--seeds", "7", "--num-cpus", "2", "--out", str(tmp_path)]
+    for backend in (["--backend", "local"], []):  # [] : Ray if installed, else local
+        seen.clear()
+        with pytest.raises(Stop):
+            benchmark.main([*argv, *backend, *flags])
+        assert {k: v for k, v in seen.items() if k != "backend"} == workers
+    assert benchmark.trial_workers(None, 4, "ray://head:10001") == 1  # a cluster: one each
+    assert benchmark.trial_workers(3, 2, None) == 3
+
+
 @pytest.mark.slow
 def test_benchmark_through_ray_tune(tmp_path):
     pytest.importorskip("ray", reason="Ray Tune is the optional extra .[sweep]")

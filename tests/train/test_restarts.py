@@ -240,6 +240,30 @@ def test_runs_at_once_are_the_runs_one_after_another(restart_above, trained):
     assert r2["train_cpu_seconds"] > 0 and r2["train_seconds"] > 0
 
 
+def test_runs_at_once_release_their_semaphores():
+    """The worker pool's semaphores are released before ``train_algo`` returns, not when
+    the garbage collector next runs: in a Ray Tune trial that is at the process's exit,
+    after Ray has ended its resource tracker, which then printed a KeyError traceback
+    for each (the pool's objects hold one another in cycles)."""
+    import gc
+    from multiprocessing.synchronize import SemLock
+
+    def semaphores():
+        return {id(o) for o in gc.get_objects() if issubclass(type(o), SemLock)}
+
+    gc.collect()
+    before = semaphores()
+    gc.disable()  # only the release under test may collect the cycles
+    try:
+        cfg = tiny_sac_recipe(400, restarts=3, restart_above=1e9)  # one run; one ended
+        _, record = train_algo(cfg, 3, "ACLDBeam-v1", workers=2)
+        left = semaphores() - before
+    finally:
+        gc.enable()
+    assert record["restarts"]["workers"] == 2 and len(record["restarts"]["runs"]) == 1
+    assert not left, f"{len(left)} semaphores of the worker pool still alive"
+
+
 @pytest.mark.parametrize("workers", [0, -1, 1.5, True, "2"])
 def test_bad_workers_are_named(workers):
     with pytest.raises(ValueError, match="workers must be a positive integer"):

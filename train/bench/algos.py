@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import gc
 import time
 from typing import Any
 
@@ -93,7 +94,7 @@ def _runs(cfg: TrainConfig, seeds: list[int], env_id: str, callback, workers: in
 
     before = _children_cpu_seconds()
     pool = multiprocessing.get_context("spawn").Pool(workers)
-    reported = 0.0
+    reported, pending, p = 0.0, [], None
     try:
         pending = [pool.apply_async(_run, (cfg, s, env_id, callback, True)) for s in seeds]
         for p in pending:
@@ -105,6 +106,12 @@ def _runs(cfg: TrainConfig, seeds: list[int], env_id: str, callback, workers: in
         pool.join()
         after = _children_cpu_seconds()
         cpu[0] += reported if before is None or after is None else after - before
+        # release the pool's semaphores now, while this process's resource tracker runs:
+        # a Ray Tune trial's process outlives its tracker (Ray ends a trial's children),
+        # and semaphores collected at its exit made the tracker relaunch and print a
+        # KeyError traceback for each
+        del pending, p, pool  # (a pending result holds its pool)
+        gc.collect()
 
 
 def train_algo(

@@ -1,0 +1,145 @@
+"""A probe of the PPO recipe with a nonlinear actor that keeps the linear law: a residual MLP.
+
+The recipe's actor is linear on the whitened observation ``u = T' z``; its Gaussian mean is
+``w' u + b``. This probe widens the actor's latent to ``[u, h(u)]`` with ``h`` a tanh MLP
+(``--hidden``, default one layer of 64), so the mean is ``w' u + v' h(u) + b``: the linear
+law plus a learned nonlinear correction, both from SB3's usual initialisation (the output
+layer's gain 0.01). Everything else is ``train/benchmark/ppo.yaml``'s (one run per seed: the
+probe reports each run, failed ones too). gSDE then draws noise on the gains of the whole
+latent, ``[u, h]``, as it does on the recipe's ``u``.
+
+It prints one JSON line per seed: the run's cost on 256 validation loads
+(:func:`train.bench.evaluate.validation_cost`; LQR 0.535, the shipped random search 0.5129,
+the +/-120 V limit cycle ~1.94) and ISE / LQR on cases 1, 2, 3 and the held-out random loads
+(:func:`train.bench.evaluate.ise_rel_lqr`). Not a test; about 1 min per seed on one core::
+
+    python benchmarks/residual_actor.py --seeds 0 1 2 3 4
+
+Its numbers are in docs/training.md ("Reinforcement learning from scratch", the probes
+table). The actor is not exported as an agent (:class:`train.agent.ActorProgram` has no
+concatenation); the policy is evaluated through SB3, on the raw observation once the
+whitening is folded into the residual module (:func:`fold_whitening`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import dataclasses
+import json
+import sys
+import time
+from collections.abc import Iterator
+
+import numpy as np
+import torch
+import torch.nn as nn
+
+from train.bench.sb3_policies import AsymmetricCriticPolicy
+
+
+class Residual(nn.Module):
+    """The actor's latent ``[u, h(u)]`` of an input ``x`` with ``u = T' x``: ``T`` is the
+    identity while training (the env whitens), the whitening once it is folded in."""
+
+    def __init__(self, dim: int, hidden: list[int]):
+        super().__init__()
+        layers: list[nn.Module] = []
+        width = dim
+        for h in hidden:
+            layers += [nn.Linear(width, h), nn.Tanh()]
+            width = h
+        self.mlp = nn.Sequential(*layers)
+        self.register_buffer("T", torch.eye(dim))
+        self.latent_dim = dim + width
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        u = x @ self.T
+        return torch.cat([u, self.mlp(u)], dim=-1)
+
+
+class ResidualActorPolicy(AsymmetricCriticPolicy):
+    """The recipe's asymmetric actor-critic with :class:`Residual` as the actor's latent
+    (``policy_kwargs``: ``hidden``, the MLP's widths). The critic is the recipe's."""
+
+    def __init__(self, *args, hidden: list[int] | tuple[int, ...] = (64,), **kwargs):
+        if not hidden or any(int(h) < 1 for h in hidden):
+            raise ValueError(f"hidden: expected one or more positive widths, got {hidden!r}")
+        self.hidden = [int(h) for h in hidden]
+        super().__init__(*args, **kwargs)
+
+    def _build_mlp_extractor(self) -> None:
+        super()._build_mlp_extractor()
+        net = Residual(self.features_dim, self.hidden)
+        self.mlp_extractor.policy_net = net
+        self.mlp_extractor.latent_dim_pi = net.latent_dim
+
+    def _get_constructor_parameters(self) -> dict:
+        return {**super()._get_constructor_parameters(), "hidden": self.hidden}
+
+
+def fold_whitening(model, transform: np.ndarray) -> None:
+    """Fold ``u = T' z`` into the residual module, so that the actor takes the raw
+    observation (what :func:`train.bench.sb3_train.fold_whitening` does to a linear actor's
+    first layer)."""
+    net = model.policy.mlp_extractor.policy_net
+    with torch.no_grad():
+        net.T.copy_(torch.as_tensor(np.asarray(transform), dtype=net.T.dtype))
+
+
+@contextlib.contextmanager
+def residual_folding() -> Iterator[None]:
+    """:func:`train.bench.sb3_train.train_sb3` with :func:`fold_whitening` in place of the
+    linear actor's fold, for the duration of the block."""
+    import train.bench.sb3_train as sb3_train
+
+    linear = sb3_train.fold_whitening
+    sb3_train.fold_whitening = fold_whitening
+    try:
+        yield
+    finally:
+        sb3_train.fold_whitening = linear
+
+
+def config(hidden: list[int]):
+    """``train/benchmark/ppo.yaml``'s config with the residual actor, one run."""
+    from train.config import load_config
+
+    cfg = load_config("ppo")
+    model = dict(cfg.model)
+    model["policy"] = ResidualActorPolicy
+    model["policy_kwargs"] = {**model.get("policy_kwargs", {}), "hidden": list(hidden)}
+    return dataclasses.replace(cfg, model=model, restarts=1, restart_above=None)
+
+
+def run(seed: int, hidden: list[int], env_id: str = "ACLDBeam-v1") -> dict:
+    """Train one run of seed ``seed`` and evaluate it."""
+    from train.bench.evaluate import ise_rel_lqr, validation_cost, validation_seeds
+    from train.bench.sb3_train import train_sb3
+
+    t0 = time.perf_counter()
+    with residual_folding():
+        policy, _ = train_sb3(config(hidden), seed, env_id)
+    wall = time.perf_counter() - t0
+    rel = ise_rel_lqr(policy, env_id)
+    return {
+        "seed": seed,
+        "hidden": hidden,
+        "train_wall_s": round(wall),
+        "validation_cost_256": round(validation_cost(policy, env_id, validation_seeds(256)), 4),
+        "ise_rel_lqr": {str(k): round(float(v), 3) for k, v in rel.items()},
+    }
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--seeds", type=int, nargs="+", default=[0])
+    p.add_argument("--hidden", type=int, nargs="+", default=[64], help="the MLP's widths")
+    args = p.parse_args(argv)
+    for seed in args.seeds:
+        print(json.dumps(run(seed, args.hidden)), flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

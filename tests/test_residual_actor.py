@@ -1,0 +1,77 @@
+"""``benchmarks/residual_actor.py``: the residual actor's latent is ``[u, h(u)]`` (its mean is
+the linear law plus a nonlinear correction), folding the whitening into it keeps the law on
+the raw observation, the fold is swapped in only inside its block, and a bad ``hidden`` is
+refused by name."""
+
+import dataclasses
+
+import gymnasium as gym
+import numpy as np
+import pytest
+import torch
+
+import train.bench.sb3_train as sb3_train
+from tests.benchmark_scripts import load_script
+from train.bench.sb3_policies import SB3Policy
+
+ra = load_script("residual_actor")
+
+
+@pytest.fixture
+def model():
+    cfg = ra.config([8])
+    cfg = dataclasses.replace(cfg, n_envs=4, model={**cfg.model, "batch_size": 256})
+    venv = sb3_train.make_vec_env(cfg, 0, "ACLDBeam-v1")
+    try:
+        yield sb3_train.make_model(cfg, venv, 0)
+    finally:
+        venv.close()
+
+
+def _obs(n: int, seed: int) -> np.ndarray:
+    d = gym.make("ACLDBeam-v1").observation_space.shape[0]
+    return np.random.default_rng(seed).normal(size=(n, d)).astype(np.float32)
+
+
+def test_the_mean_is_the_linear_law_plus_a_nonlinear_correction(model):
+    net, head = model.policy.mlp_extractor.policy_net, model.policy.action_net
+    d = _obs(1, 0).shape[1]
+    assert isinstance(net, ra.Residual) and head.in_features == d + 8
+    u = torch.as_tensor(_obs(6, 1))
+    with torch.no_grad():
+        latent = net(u)
+        assert torch.equal(latent[:, :d], u)  # the linear part sees u itself (T = I)
+        assert torch.allclose(latent[:, d:], net.mlp(u))
+        h = latent[:, d:]
+        assert not torch.allclose(net(2 * u)[:, d:], 2 * h)  # and the rest is nonlinear
+
+
+def test_folding_the_whitening_keeps_the_law_on_the_raw_observation(model):
+    with torch.no_grad():  # gains large enough that the correction and the clip both show
+        model.policy.action_net.weight.normal_(0.0, 0.3, generator=torch.Generator().manual_seed(0))
+    T = np.random.default_rng(2).normal(size=(_obs(1, 0).shape[1],) * 2)
+    z = _obs(64, 3)
+    before, _ = SB3Policy(model, None, None, transform=T).predict(z)
+    linear = sb3_train.fold_whitening
+    with ra.residual_folding():
+        assert sb3_train.fold_whitening is ra.fold_whitening
+        sb3_train.fold_whitening(model, T)
+    assert sb3_train.fold_whitening is linear
+    after, _ = SB3Policy(model, None, None).predict(z)
+    assert 0 < np.mean(np.abs(before) < 120.0) < 1  # some inside the limit, some at it
+    np.testing.assert_allclose(after, before, atol=1e-3)
+
+
+def test_the_linear_fold_is_restored_after_an_error():
+    linear = sb3_train.fold_whitening
+    with pytest.raises(RuntimeError, match="boom"), ra.residual_folding():
+        raise RuntimeError("boom")
+    assert sb3_train.fold_whitening is linear
+
+
+@pytest.mark.parametrize("hidden", [[], [0], [64, -1]])
+def test_bad_hidden_is_refused_by_name(hidden):
+    with pytest.raises(ValueError, match=r"hidden: expected one or more positive widths"):
+        ra.ResidualActorPolicy(
+            gym.spaces.Box(-1, 1, (3,)), gym.spaces.Box(-1, 1, (1,)), lambda _: 1e-3, hidden=hidden
+        )

@@ -237,7 +237,9 @@ def test_runs_at_once_are_the_runs_one_after_another(restart_above, trained):
     obs = (np.random.default_rng(0).normal(size=(8, n_obs)) * 1e-4).astype(np.float32)
     assert np.array_equal(p1.predict(obs)[0], p2.predict(obs)[0])
     assert not hasattr(p2.model, "replay_buffer")  # the worker sent the policy alone
-    assert r2["train_cpu_seconds"] > 0 and r2["train_seconds"] > 0
+    assert r2["train_seconds"] > 0
+    # the workers' CPU time is counted (this process only waits for them)
+    assert r2["train_cpu_seconds"] > 0.5 * r1["train_cpu_seconds"] > 0
 
 
 def test_runs_at_once_release_their_semaphores():

@@ -80,38 +80,55 @@ def _children_cpu_seconds() -> float | None:
     return ru.ru_utime + ru.ru_stime
 
 
-def _runs(cfg: TrainConfig, seeds: list[int], env_id: str, callback, workers: int, cpu: list):
-    """The runs of ``seeds`` as :func:`_run` returns them, in order: one after the other in
-    this process (``workers`` 1), or up to ``workers`` at once in worker processes, each
-    run started as soon as a worker is free (the caller stops when it has what it
-    needs, and the runs still going are ended). With workers, ``cpu[0]`` grows by their
-    CPU time, the unused runs' included."""
-    if workers == 1:
-        for s in seeds:
-            yield _run(cfg, s, env_id, callback)
-        return
-    import multiprocessing
+class _Runs:
+    """The runs of ``seeds`` as :func:`_run` returns them, in order, as an iterator: one
+    after the other in this process (``workers`` 1), or up to ``workers`` at once in
+    worker processes, each run started as soon as a worker is free. The caller stops when
+    it has what it needs and calls :meth:`close`, which ends the runs still going; then
+    :attr:`worker_cpu_seconds` is the workers' CPU time, the unused runs' included (0 with
+    one worker: the runs' CPU time is this process's)."""
 
-    before = _children_cpu_seconds()
-    pool = multiprocessing.get_context("spawn").Pool(workers)
-    reported, pending, p = 0.0, [], None
-    try:
-        pending = [pool.apply_async(_run, (cfg, s, env_id, callback, True)) for s in seeds]
-        for p in pending:
-            out = p.get()
-            reported += out[2]["cpu_seconds"]
-            yield out
-    finally:
-        pool.terminate()
-        pool.join()
-        after = _children_cpu_seconds()
-        cpu[0] += reported if before is None or after is None else after - before
-        # release the pool's semaphores now, while this process's resource tracker runs:
-        # a Ray Tune trial's process outlives its tracker (Ray ends a trial's children),
-        # and semaphores collected at its exit made the tracker relaunch and print a
-        # KeyError traceback for each
-        del pending, p, pool  # (a pending result holds its pool)
-        gc.collect()
+    def __init__(
+        self, cfg: TrainConfig, seeds: list[int], env_id: str, callback, workers: int
+    ) -> None:
+        self.worker_cpu_seconds = 0.0
+        self._outcomes = (
+            (_run(cfg, s, env_id, callback) for s in seeds)
+            if workers == 1
+            else self._at_once(cfg, seeds, env_id, callback, workers)
+        )
+
+    def __iter__(self):
+        return self._outcomes
+
+    def close(self) -> None:
+        self._outcomes.close()
+
+    def _at_once(self, cfg: TrainConfig, seeds: list[int], env_id: str, callback, workers: int):
+        import multiprocessing
+
+        before = _children_cpu_seconds()
+        pool = multiprocessing.get_context("spawn").Pool(workers)
+        reported, pending, p = 0.0, [], None
+        try:
+            pending = [pool.apply_async(_run, (cfg, s, env_id, callback, True)) for s in seeds]
+            for p in pending:
+                out = p.get()
+                reported += out[2]["cpu_seconds"]
+                yield out
+        finally:
+            pool.terminate()
+            pool.join()
+            after = _children_cpu_seconds()
+            self.worker_cpu_seconds += (
+                reported if before is None or after is None else after - before
+            )
+            # release the pool's semaphores now, while this process's resource tracker
+            # runs: a Ray Tune trial's process outlives its tracker (Ray ends a trial's
+            # children), and semaphores collected at its exit made the tracker relaunch
+            # and print a KeyError traceback for each
+            del pending, p, pool  # (a pending result holds its pool)
+            gc.collect()
 
 
 def train_algo(
@@ -156,11 +173,11 @@ def train_algo(
     workers = min(workers, len(seeds))
     t0, c0 = time.perf_counter(), time.process_time()
     best, runs, total = None, [], 0  # only the best run so far is kept alive (model, buffer)
-    evals, cpu = [0.0, 0.0], [0.0]  # the curve's evaluations (one process), workers' CPU
+    evals = [0.0, 0.0]  # the curve's evaluations (one process): wall and CPU time
     threshold = cfg.restart_above
     if threshold == "lqr":  # the level to beat, on the selection's own validation loads
         threshold = lqr_validation_cost(env_id, validation_seeds(cfg.select_config.episodes))
-    outcomes = _runs(cfg, seeds, env_id, callback, workers, cpu)
+    outcomes = _Runs(cfg, seeds, env_id, callback, workers)
     try:
         for k, (policy, record, times) in enumerate(outcomes):
             evals[0] += times["eval_seconds"]
@@ -197,5 +214,5 @@ def train_algo(
         record["train_cpu_seconds"] = own_cpu - evals[1]
     else:  # the evaluations overlapped other runs' training: kept in, an upper bound
         record["train_seconds"] = wall
-        record["train_cpu_seconds"] = own_cpu + cpu[0]
+        record["train_cpu_seconds"] = own_cpu + outcomes.worker_cpu_seconds
     return policy, record

@@ -5,8 +5,9 @@ The recipe's actor is linear on the whitened observation ``u = T' z``; its Gauss
 (``--hidden``, default one layer of 64), so the mean is ``w' u + v' h(u) + b``: the linear
 law plus a learned nonlinear correction, both from SB3's usual initialisation (the output
 layer's gain 0.01). Everything else is ``train/benchmark/ppo.yaml``'s (one run per seed: the
-probe reports each run, failed ones too). gSDE then draws noise on the gains of the whole
-latent, ``[u, h]``, as it does on the recipe's ``u``.
+probe reports each run, failed ones too). gSDE draws its noise on the gains of the whole
+latent, ``[u, h]``, as it does on the recipe's ``u`` (``--noise latent``), or on the linear
+law's gains alone, the correction deterministic (``--noise linear``).
 
 It prints one JSON line per seed: the run's cost on 256 validation loads
 (:func:`train.bench.evaluate.validation_cost`; LQR 0.535, the shipped random search 0.5129,
@@ -14,6 +15,7 @@ the +/-120 V limit cycle ~1.94) and ISE / LQR on cases 1, 2, 3 and the held-out 
 (:func:`train.bench.evaluate.ise_rel_lqr`). Not a test; about 1 min per seed on one core::
 
     python benchmarks/residual_actor.py --seeds 0 1 2 3 4
+    python benchmarks/residual_actor.py --seeds 0 1 2 3 4 --noise linear
 
 Its numbers are in docs/training.md ("Reinforcement learning from scratch", the probes
 table). The actor is not exported as an agent (:class:`train.agent.ActorProgram` has no
@@ -34,6 +36,7 @@ from collections.abc import Iterator
 import numpy as np
 import torch
 import torch.nn as nn
+from stable_baselines3.common.distributions import StateDependentNoiseDistribution
 
 from train.bench.sb3_policies import AsymmetricCriticPolicy
 
@@ -58,15 +61,33 @@ class Residual(nn.Module):
         return torch.cat([u, self.mlp(u)], dim=-1)
 
 
+NOISES = ("latent", "linear")
+
+
 class ResidualActorPolicy(AsymmetricCriticPolicy):
     """The recipe's asymmetric actor-critic with :class:`Residual` as the actor's latent
-    (``policy_kwargs``: ``hidden``, the MLP's widths). The critic is the recipe's."""
+    (``policy_kwargs``: ``hidden``, the MLP's widths; ``noise``, what gSDE's noise acts on:
+    ``"latent"``, all of ``[u, h]``, or ``"linear"``, ``u`` alone). The critic is the
+    recipe's."""
 
-    def __init__(self, *args, hidden: list[int] | tuple[int, ...] = (64,), **kwargs):
+    def __init__(
+        self, *args, hidden: list[int] | tuple[int, ...] = (64,), noise: str = "latent", **kwargs
+    ):
         if not hidden or any(int(h) < 1 for h in hidden):
             raise ValueError(f"hidden: expected one or more positive widths, got {hidden!r}")
+        if noise not in NOISES:
+            raise ValueError(f"noise: expected one of {list(NOISES)}, got {noise!r}")
         self.hidden = [int(h) for h in hidden]
+        self.noise = noise
         super().__init__(*args, **kwargs)
+
+    def _get_action_dist_from_latent(self, latent_pi: torch.Tensor):
+        if self.noise == "linear" and isinstance(self.action_dist, StateDependentNoiseDistribution):
+            d = self.features_dim  # gSDE's noise on the gains of u only: h's entries zeroed
+            sde = torch.cat([latent_pi[..., :d], torch.zeros_like(latent_pi[..., d:])], dim=-1)
+            mean = self.action_net(latent_pi)
+            return self.action_dist.proba_distribution(mean, self.log_std, sde)
+        return super()._get_action_dist_from_latent(latent_pi)
 
     def _build_mlp_extractor(self) -> None:
         super()._build_mlp_extractor()
@@ -75,7 +96,7 @@ class ResidualActorPolicy(AsymmetricCriticPolicy):
         self.mlp_extractor.latent_dim_pi = net.latent_dim
 
     def _get_constructor_parameters(self) -> dict:
-        return {**super()._get_constructor_parameters(), "hidden": self.hidden}
+        return {**super()._get_constructor_parameters(), "hidden": self.hidden, "noise": self.noise}
 
 
 def fold_whitening(model, transform: np.ndarray) -> None:
@@ -101,30 +122,35 @@ def residual_folding() -> Iterator[None]:
         sb3_train.fold_whitening = linear
 
 
-def config(hidden: list[int]):
+def config(hidden: list[int], noise: str = "latent"):
     """``train/benchmark/ppo.yaml``'s config with the residual actor, one run."""
     from train.config import load_config
 
     cfg = load_config("ppo")
     model = dict(cfg.model)
     model["policy"] = ResidualActorPolicy
-    model["policy_kwargs"] = {**model.get("policy_kwargs", {}), "hidden": list(hidden)}
+    model["policy_kwargs"] = {
+        **model.get("policy_kwargs", {}),
+        "hidden": list(hidden),
+        "noise": noise,
+    }
     return dataclasses.replace(cfg, model=model, restarts=1, restart_above=None)
 
 
-def run(seed: int, hidden: list[int], env_id: str = "ACLDBeam-v1") -> dict:
+def run(seed: int, hidden: list[int], noise: str = "latent", env_id: str = "ACLDBeam-v1") -> dict:
     """Train one run of seed ``seed`` and evaluate it."""
     from train.bench.evaluate import ise_rel_lqr, validation_cost, validation_seeds
     from train.bench.sb3_train import train_sb3
 
     t0 = time.perf_counter()
     with residual_folding():
-        policy, _ = train_sb3(config(hidden), seed, env_id)
+        policy, _ = train_sb3(config(hidden, noise), seed, env_id)
     wall = time.perf_counter() - t0
     rel = ise_rel_lqr(policy, env_id)
     return {
         "seed": seed,
         "hidden": hidden,
+        "noise": noise,
         "train_wall_s": round(wall),
         "validation_cost_256": round(validation_cost(policy, env_id, validation_seeds(256)), 4),
         "ise_rel_lqr": {str(k): round(float(v), 3) for k, v in rel.items()},
@@ -135,9 +161,10 @@ def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--seeds", type=int, nargs="+", default=[0])
     p.add_argument("--hidden", type=int, nargs="+", default=[64], help="the MLP's widths")
+    p.add_argument("--noise", choices=NOISES, default="latent", help="what gSDE's noise acts on")
     args = p.parse_args(argv)
     for seed in args.seeds:
-        print(json.dumps(run(seed, args.hidden)), flush=True)
+        print(json.dumps(run(seed, args.hidden, args.noise)), flush=True)
     return 0
 
 

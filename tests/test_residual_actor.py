@@ -1,7 +1,8 @@
 """``benchmarks/residual_actor.py``: the residual actor's latent is ``[u, h(u)]`` (its mean is
 the linear law plus a nonlinear correction), folding the whitening into it keeps the law on
-the raw observation, the fold is swapped in only inside its block, and a bad ``hidden`` is
-refused by name."""
+the raw observation, the fold is swapped in only inside its block, gSDE's noise acts on
+the whole latent or on the linear gains alone, and a bad ``hidden`` or ``noise`` is refused
+by name."""
 
 import dataclasses
 
@@ -17,15 +18,19 @@ from train.bench.sb3_policies import SB3Policy
 ra = load_script("residual_actor")
 
 
-@pytest.fixture
-def model():
-    cfg = ra.config([8])
+def _model(noise: str = "latent"):
+    cfg = ra.config([8], noise)
     cfg = dataclasses.replace(cfg, n_envs=4, model={**cfg.model, "batch_size": 256})
     venv = sb3_train.make_vec_env(cfg, 0, "ACLDBeam-v1")
     try:
-        yield sb3_train.make_model(cfg, venv, 0)
+        return sb3_train.make_model(cfg, venv, 0)
     finally:
         venv.close()
+
+
+@pytest.fixture
+def model():
+    return _model()
 
 
 def _obs(n: int, seed: int) -> np.ndarray:
@@ -69,9 +74,38 @@ def test_the_linear_fold_is_restored_after_an_error():
     assert sb3_train.fold_whitening is linear
 
 
+@pytest.mark.parametrize("noise, moves", [("latent", True), ("linear", False)])
+def test_noise_acts_on_the_whole_latent_or_on_the_linear_gains_alone(noise, moves):
+    """gSDE's action noise (its std per observation) depends on the MLP's features with
+    ``noise="latent"`` and not with ``"linear"``; the mean depends on them either way."""
+    model = _model(noise)
+    obs = torch.as_tensor(np.concatenate([_obs(6, 4), np.zeros((6, 1), np.float32)], axis=1))
+
+    def dist():
+        with torch.no_grad():
+            d = model.policy.get_distribution(obs).distribution
+        return d.mean.clone(), d.stddev.clone()
+
+    mean0, std0 = dist()
+    with torch.no_grad():
+        for p in model.policy.mlp_extractor.policy_net.mlp.parameters():
+            p.add_(torch.randn(p.shape, generator=torch.Generator().manual_seed(5)))
+        model.policy.action_net.weight.fill_(0.1)  # so the mean reads the features
+    mean1, std1 = dist()
+    assert not torch.allclose(mean0, mean1)
+    assert torch.allclose(std0, std1) is not moves
+
+
 @pytest.mark.parametrize("hidden", [[], [0], [64, -1]])
 def test_bad_hidden_is_refused_by_name(hidden):
     with pytest.raises(ValueError, match=r"hidden: expected one or more positive widths"):
         ra.ResidualActorPolicy(
             gym.spaces.Box(-1, 1, (3,)), gym.spaces.Box(-1, 1, (1,)), lambda _: 1e-3, hidden=hidden
+        )
+
+
+def test_bad_noise_is_refused_by_name():
+    with pytest.raises(ValueError, match=r"noise: expected one of \['latent', 'linear'\]"):
+        ra.ResidualActorPolicy(
+            gym.spaces.Box(-1, 1, (3,)), gym.spaces.Box(-1, 1, (1,)), lambda _: 1e-3, noise="h"
         )

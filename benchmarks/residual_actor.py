@@ -20,18 +20,16 @@ the +/-120 V limit cycle ~1.94) and ISE / LQR on cases 1, 2, 3 and the held-out 
 Its numbers are in docs/training.md ("Reinforcement learning from scratch", the probes
 table). The actor is not exported as an agent (:class:`train.agent.ActorProgram` has no
 concatenation); the policy is evaluated through SB3, on the raw observation once the
-whitening is folded into the residual module (:func:`fold_whitening`).
+whitening is folded into the residual module (:meth:`ResidualActorPolicy.fold_whitening`).
 """
 
 from __future__ import annotations
 
 import argparse
-import contextlib
 import dataclasses
 import json
 import sys
 import time
-from collections.abc import Iterator
 
 import numpy as np
 import torch
@@ -95,31 +93,16 @@ class ResidualActorPolicy(AsymmetricCriticPolicy):
         self.mlp_extractor.policy_net = net
         self.mlp_extractor.latent_dim_pi = net.latent_dim
 
+    def fold_whitening(self, transform: np.ndarray) -> None:
+        """Fold ``u = T' z`` into the residual module, so that the actor takes the raw
+        observation (:func:`train.bench.sb3_train.fold_whitening` calls it, in place of its
+        fold into a linear actor's first layer)."""
+        net = self.mlp_extractor.policy_net
+        with torch.no_grad():
+            net.T.copy_(torch.as_tensor(transform, dtype=net.T.dtype))
+
     def _get_constructor_parameters(self) -> dict:
         return {**super()._get_constructor_parameters(), "hidden": self.hidden, "noise": self.noise}
-
-
-def fold_whitening(model, transform: np.ndarray) -> None:
-    """Fold ``u = T' z`` into the residual module, so that the actor takes the raw
-    observation (what :func:`train.bench.sb3_train.fold_whitening` does to a linear actor's
-    first layer)."""
-    net = model.policy.mlp_extractor.policy_net
-    with torch.no_grad():
-        net.T.copy_(torch.as_tensor(np.asarray(transform), dtype=net.T.dtype))
-
-
-@contextlib.contextmanager
-def residual_folding() -> Iterator[None]:
-    """:func:`train.bench.sb3_train.train_sb3` with :func:`fold_whitening` in place of the
-    linear actor's fold, for the duration of the block."""
-    import train.bench.sb3_train as sb3_train
-
-    linear = sb3_train.fold_whitening
-    sb3_train.fold_whitening = fold_whitening
-    try:
-        yield
-    finally:
-        sb3_train.fold_whitening = linear
 
 
 def config(hidden: list[int], noise: str = "latent"):
@@ -143,8 +126,7 @@ def run(seed: int, hidden: list[int], noise: str = "latent", env_id: str = "ACLD
     from train.bench.sb3_train import train_sb3
 
     t0 = time.perf_counter()
-    with residual_folding():
-        policy, _ = train_sb3(config(hidden, noise), seed, env_id)
+    policy, _ = train_sb3(config(hidden, noise), seed, env_id)
     wall = time.perf_counter() - t0
     rel = ise_rel_lqr(policy, env_id)
     return {

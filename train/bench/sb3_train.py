@@ -97,7 +97,12 @@ def fold_whitening(model, transform: np.ndarray) -> None:
     """Fold the whitening ``u = T^T z`` into the actor's first layer (``W u = (W T^T) z``),
     so that the trained actor takes the raw observation (and exports as a plain SB3
     actor). Only the deterministic actor stays meaningful afterwards (critic and gSDE
-    noise still expect u): call it when training is over."""
+    noise still expect u): call it when training is over. A policy whose actor is not a
+    chain of layers folds it itself, with a method ``fold_whitening(transform)``."""
+    own = getattr(model.policy, "fold_whitening", None)
+    if callable(own):
+        own(np.asarray(transform))
+        return
     layer = next(m for m in actor_parts(model)[1] if isinstance(m, nn.Linear))
     with torch.no_grad():
         t = torch.as_tensor(np.asarray(transform).T, dtype=layer.weight.dtype)

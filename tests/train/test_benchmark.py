@@ -193,6 +193,21 @@ def test_fold_whitening_and_quadratic_features():
         assert np.allclose(before, after, atol=1e-3)
 
 
+def test_a_policy_with_its_own_fold_gets_the_whitening():
+    """``fold_whitening`` hands the whitening to a policy that folds it itself (an actor
+    that is not a chain of layers, ``benchmarks/residual_actor.py``'s), and touches nothing
+    else of it."""
+    from types import SimpleNamespace
+
+    from train.bench.sb3_train import fold_whitening
+
+    got = []
+    model = SimpleNamespace(policy=SimpleNamespace(fold_whitening=got.append))
+    T = np.arange(9.0).reshape(3, 3)
+    fold_whitening(model, T.tolist())
+    assert len(got) == 1 and isinstance(got[0], np.ndarray) and np.array_equal(got[0], T)
+
+
 def test_episode_scaled_advantages():
     from train.bench.sb3_policies import EpisodeScaledRolloutBuffer
 

@@ -9,10 +9,11 @@ probe reports each run, failed ones too). gSDE draws its noise on the gains of t
 latent, ``[u, h]``, as it does on the recipe's ``u`` (``--noise latent``), or on the linear
 law's gains alone, the correction deterministic (``--noise linear``).
 
-It prints one JSON line per seed: the run's cost on 256 validation loads
-(:func:`train.bench.evaluate.validation_cost`; LQR 0.535, the shipped random search 0.5129,
-the +/-120 V limit cycle ~1.94) and ISE / LQR on cases 1, 2, 3 and the held-out random loads
-(:func:`train.bench.evaluate.ise_rel_lqr`). Not a test; about 1 min per seed on one core::
+It prints one JSON line per seed: the run's cost on 256 validation loads (the recipe's own
+check at the run's end, ``select``: :func:`train.bench.evaluate.validation_cost`; LQR 0.535,
+the shipped random search 0.5129, the +/-120 V limit cycle ~1.94) and ISE / LQR on cases 1,
+2, 3 and the held-out random loads (:func:`train.bench.evaluate.ise_rel_lqr`). Not a test;
+about 1 min per seed on one core::
 
     python benchmarks/residual_actor.py --seeds 0 1 2 3 4
     python benchmarks/residual_actor.py --seeds 0 1 2 3 4 --noise linear
@@ -122,11 +123,11 @@ def config(hidden: list[int], noise: str = "latent"):
 
 def run(seed: int, hidden: list[int], noise: str = "latent", env_id: str = "ACLDBeam-v1") -> dict:
     """Train one run of seed ``seed`` and evaluate it."""
-    from train.bench.evaluate import ise_rel_lqr, validation_cost, validation_seeds
+    from train.bench.evaluate import ise_rel_lqr
     from train.bench.sb3_train import train_sb3
 
     t0 = time.perf_counter()
-    policy, _ = train_sb3(config(hidden, noise), seed, env_id)
+    policy, record = train_sb3(config(hidden, noise), seed, env_id)
     wall = time.perf_counter() - t0
     rel = ise_rel_lqr(policy, env_id)
     return {
@@ -134,7 +135,7 @@ def run(seed: int, hidden: list[int], noise: str = "latent", env_id: str = "ACLD
         "hidden": hidden,
         "noise": noise,
         "train_wall_s": round(wall),
-        "validation_cost_256": round(validation_cost(policy, env_id, validation_seeds(256)), 4),
+        "validation_cost_256": round(record["select"]["cost"], 4),
         "ise_rel_lqr": {str(k): round(float(v), 3) for k, v in rel.items()},
     }
 

@@ -5,6 +5,7 @@ the whole latent or on the linear gains alone, and a bad ``hidden`` or ``noise``
 by name."""
 
 import dataclasses
+import functools
 
 import gymnasium as gym
 import numpy as np
@@ -33,14 +34,19 @@ def model():
     return _model()
 
 
+@functools.cache
+def _width() -> int:
+    """The env's observation width (the env built once)."""
+    return gym.make("ACLDBeam-v1").observation_space.shape[0]
+
+
 def _obs(n: int, seed: int) -> np.ndarray:
-    d = gym.make("ACLDBeam-v1").observation_space.shape[0]
-    return np.random.default_rng(seed).normal(size=(n, d)).astype(np.float32)
+    return np.random.default_rng(seed).normal(size=(n, _width())).astype(np.float32)
 
 
 def test_the_mean_is_the_linear_law_plus_a_nonlinear_correction(model):
     net, head = model.policy.mlp_extractor.policy_net, model.policy.action_net
-    d = _obs(1, 0).shape[1]
+    d = _width()
     assert isinstance(net, ra.Residual) and head.in_features == d + 8
     u = torch.as_tensor(_obs(6, 1))
     with torch.no_grad():
@@ -57,7 +63,7 @@ def test_folding_the_whitening_keeps_the_law_on_the_raw_observation(model):
     whitened one."""
     with torch.no_grad():  # gains large enough that the correction and the clip both show
         model.policy.action_net.weight.normal_(0.0, 0.3, generator=torch.Generator().manual_seed(0))
-    T = np.random.default_rng(2).normal(size=(_obs(1, 0).shape[1],) * 2)
+    T = np.random.default_rng(2).normal(size=(_width(),) * 2)
     z = _obs(64, 3)
     before, _ = SB3Policy(model, None, None, transform=T).predict(z)
     sb3_train.fold_whitening(model, T)

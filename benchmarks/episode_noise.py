@@ -1,0 +1,120 @@
+"""A probe of the PPO recipe with gSDE's noise held for a whole episode (or any number of
+steps), as the random search holds each perturbation of its gains for whole episodes.
+
+The recipe (``train/benchmark/ppo.yaml``) draws gSDE's noise on the actor's gains, a matrix
+``E ~ N(0, sigma^2)`` per sub-env, once per 64-step rollout, so a 1000-step episode sees
+about 16 draws. This probe draws ``eps ~ N(0, 1)`` per sub-env once per episode and acts
+with ``E = eps * sigma`` (``sigma`` the current one, so a PPO update still changes the noise
+mid-episode by its scale). The native batched env starts its sub-envs together and every
+episode runs its 1000 steps unless it leaves the deflection limit, so the probe redraws
+``eps`` every 1000 rollout steps (:class:`EpisodeNoisePolicy`; ``--hold N``: every N steps);
+everything else is the recipe's, one run per seed.
+
+It prints one JSON line per seed: the run's cost on 256 validation loads (the recipe's own
+check at the run's end; LQR 0.535, the shipped random search 0.5129, the +/-120 V limit
+cycle ~1.94) and ISE / LQR on cases 1, 2, 3 and the held-out random loads. Not a test;
+about 1 min per seed on one core::
+
+    python benchmarks/episode_noise.py --seeds 0 1 2 3 4
+    python benchmarks/episode_noise.py --seeds 0 1 2 3 4 --hold 128
+
+Its numbers are in docs/training.md ("Reinforcement learning from scratch", the probes
+table).
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import sys
+import time
+
+import torch
+from torch.distributions import Normal
+
+from train.bench.sb3_policies import AsymmetricCriticPolicy
+
+#: Env steps per episode of ACLDBeam-v1 (1 s at 1 ms).
+EPISODE_STEPS = 1000
+
+
+class EpisodeNoisePolicy(AsymmetricCriticPolicy):
+    """The recipe's actor-critic with gSDE's standard-normal draw held per sub-env for
+    ``hold`` calls of :meth:`forward` (one per env step of a rollout; default
+    :data:`EPISODE_STEPS`) and scaled by the current ``sigma`` whenever SB3 asks for new
+    noise (each rollout)."""
+
+    def __init__(self, *args, hold: int = EPISODE_STEPS, **kwargs):
+        if not (isinstance(hold, int) and hold >= 1):
+            raise ValueError(f"hold: expected a positive number of steps, got {hold!r}")
+        self.hold = hold
+        super().__init__(*args, **kwargs)
+        self.eps: torch.Tensor | None = None
+        self.steps = 0
+
+    def _act_with_eps(self) -> None:
+        dist = self.action_dist
+        std = dist.get_std(self.log_std)
+        dist.weights_dist = Normal(torch.zeros_like(std), std)
+        dist.exploration_mat = dist.weights_dist.rsample()
+        dist.exploration_matrices = self.eps * std
+
+    def reset_noise(self, n_envs: int = 1) -> None:
+        std = self.action_dist.get_std(self.log_std)
+        if self.eps is None or self.eps.shape[0] != n_envs:
+            self.eps = torch.randn((n_envs, *std.shape))
+            self.steps = 0
+        self._act_with_eps()
+
+    def forward(self, obs: torch.Tensor, deterministic: bool = False):
+        if self.eps is not None and self.steps and self.steps % self.hold == 0:
+            self.eps = torch.randn_like(self.eps)  # e.g. the sub-envs' next episodes
+            self._act_with_eps()
+        self.steps += 1
+        return super().forward(obs, deterministic)
+
+    def _get_constructor_parameters(self) -> dict:
+        return {**super()._get_constructor_parameters(), "hold": self.hold}
+
+
+def config(hold: int = EPISODE_STEPS):
+    """``train/benchmark/ppo.yaml``'s config with :class:`EpisodeNoisePolicy`, one run."""
+    from train.config import load_config
+
+    cfg = load_config("ppo")
+    kwargs = {**cfg.model.get("policy_kwargs", {}), "hold": hold}
+    model = {**cfg.model, "policy": EpisodeNoisePolicy, "policy_kwargs": kwargs}
+    return dataclasses.replace(cfg, model=model, restarts=1, restart_above=None)
+
+
+def run(seed: int, hold: int = EPISODE_STEPS, env_id: str = "ACLDBeam-v1") -> dict:
+    """Train one run of seed ``seed`` and evaluate it."""
+    from train.bench.evaluate import ise_rel_lqr
+    from train.bench.sb3_train import train_sb3
+
+    t0 = time.perf_counter()
+    policy, record = train_sb3(config(hold), seed, env_id)
+    wall = time.perf_counter() - t0
+    rel = ise_rel_lqr(policy, env_id)
+    return {
+        "seed": seed,
+        "hold": hold,
+        "train_wall_s": round(wall),
+        "validation_cost_256": round(record["select"]["cost"], 4),
+        "ise_rel_lqr": {str(k): round(float(v), 3) for k, v in rel.items()},
+    }
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--seeds", type=int, nargs="+", default=[0])
+    p.add_argument("--hold", type=int, default=EPISODE_STEPS, help="steps per noise draw")
+    args = p.parse_args(argv)
+    for seed in args.seeds:
+        print(json.dumps(run(seed, args.hold)), flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,53 @@
+"""``benchmarks/episode_noise.py``: gSDE's standard-normal draw is held per sub-env for a
+whole episode, across SB3's per-rollout noise requests, scaled by the current sigma, and
+redrawn when the episode's steps are done."""
+
+import dataclasses
+
+import numpy as np
+import torch
+
+import train.bench.sb3_train as sb3_train
+from tests.benchmark_scripts import load_script
+
+en = load_script("episode_noise")
+
+
+def _policy(n_envs: int = 4):
+    cfg = en.config()
+    cfg = dataclasses.replace(cfg, n_envs=n_envs, model={**cfg.model, "batch_size": 256})
+    venv = sb3_train.make_vec_env(cfg, 0, "ACLDBeam-v1")
+    try:
+        return sb3_train.make_model(cfg, venv, 0).policy, venv.observation_space.shape[0]
+    finally:
+        venv.close()
+
+
+def test_the_draw_is_held_across_rollouts_and_scaled_by_the_current_sigma():
+    policy, _ = _policy()
+    policy.reset_noise(4)
+    eps = policy.eps.clone()
+    first = policy.action_dist.exploration_matrices.detach().clone()
+    std = policy.action_dist.get_std(policy.log_std).detach()
+    torch.testing.assert_close(first, eps * std)
+    with torch.no_grad():
+        policy.log_std += np.log(2.0)  # a PPO update doubles sigma
+    policy.reset_noise(4)  # the next rollout's request
+    assert torch.equal(policy.eps, eps)
+    torch.testing.assert_close(policy.action_dist.exploration_matrices.detach(), 2 * first)
+    assert len(set(eps.flatten().tolist())) == eps.numel()  # one draw per sub-env and gain
+
+
+def test_the_draw_is_renewed_after_an_episode_of_steps():
+    policy, width = _policy()
+    policy.reset_noise(4)
+    eps = policy.eps.clone()
+    obs = torch.zeros((4, width))
+    with torch.no_grad():
+        for _ in range(en.EPISODE_STEPS):
+            policy(obs)
+        assert torch.equal(policy.eps, eps)  # the whole episode on one draw
+        policy(obs)  # the first step of the next episode
+    assert not torch.equal(policy.eps, eps)
+    std = policy.action_dist.get_std(policy.log_std).detach()
+    torch.testing.assert_close(policy.action_dist.exploration_matrices.detach(), policy.eps * std)

@@ -12,10 +12,9 @@ has no counterpart of gSDE's noise on the gains. Everything else is the recipe's
 (``train/benchmark/ppo.yaml``: the asymmetric quadratic critic, whitening, reward per
 load, entropy bonus, schedule), one run per seed.
 
-It prints one JSON line per seed: the run's cost on 256 validation loads (the recipe's own
-check at the run's end; LQR 0.535, the shipped random search 0.5129, the +/-120 V limit
-cycle ~1.94) and ISE / LQR on cases 1, 2, 3 and the held-out random loads. Not a test;
-about 1 min per seed on one core::
+It prints one JSON line per seed: the run's validation cost and ISE / LQR on cases 1, 2, 3
+and the held-out random loads (``benchmarks/probe.py``). Not a test; about 1 min per seed
+on one core::
 
     python benchmarks/beta_actor.py --seeds 0 1 2 3 4
     python benchmarks/beta_actor.py --seeds 0 1 2 3 4 --ent-coef 0
@@ -28,17 +27,15 @@ is folded into its first layer.
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
-import json
 import math
 import sys
-import time
 from functools import partial
 
 import torch
 import torch.nn as nn
 import torch.nn.functional as F
+from probe import run_recipe, seeds_main  # benchmarks/probe.py, beside this script
 from stable_baselines3.common.distributions import Distribution
 
 from train.bench.sb3_policies import AsymmetricCriticPolicy
@@ -119,30 +116,15 @@ def config(ent_coef: float | None = None):
 
 def run(seed: int, ent_coef: float | None = None, env_id: str = "ACLDBeam-v1") -> dict:
     """Train one run of seed ``seed`` and evaluate it."""
-    from train.bench.evaluate import ise_rel_lqr
-    from train.bench.sb3_train import train_sb3
-
-    t0 = time.perf_counter()
-    policy, record = train_sb3(config(ent_coef), seed, env_id)
-    wall = time.perf_counter() - t0
-    rel = ise_rel_lqr(policy, env_id)
-    return {
-        "seed": seed,
-        "ent_coef": config(ent_coef).model["ent_coef"],
-        "train_wall_s": round(wall),
-        "validation_cost_256": round(record["select"]["cost"], 4),
-        "ise_rel_lqr": {str(k): round(float(v), 3) for k, v in rel.items()},
-    }
+    cfg = config(ent_coef)
+    return run_recipe(cfg, seed, env_id, ent_coef=cfg.model["ent_coef"])
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--seeds", type=int, nargs="+", default=[0])
-    p.add_argument("--ent-coef", type=float, default=None, help="default: the recipe's")
-    args = p.parse_args(argv)
-    for seed in args.seeds:
-        print(json.dumps(run(seed, args.ent_coef)), flush=True)
-    return 0
+    def add_arguments(p):
+        p.add_argument("--ent-coef", type=float, default=None, help="default: the recipe's")
+
+    return seeds_main(__doc__, lambda seed, a: run(seed, a.ent_coef), argv, add_arguments)
 
 
 if __name__ == "__main__":

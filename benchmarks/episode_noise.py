@@ -10,10 +10,9 @@ episode runs its 1000 steps unless it leaves the deflection limit, so the probe 
 ``eps`` every 1000 rollout steps (:class:`EpisodeNoisePolicy`; ``--hold N``: every N steps);
 everything else is the recipe's, one run per seed.
 
-It prints one JSON line per seed: the run's cost on 256 validation loads (the recipe's own
-check at the run's end; LQR 0.535, the shipped random search 0.5129, the +/-120 V limit
-cycle ~1.94) and ISE / LQR on cases 1, 2, 3 and the held-out random loads. Not a test;
-about 1 min per seed on one core::
+It prints one JSON line per seed: the run's validation cost and ISE / LQR on cases 1, 2, 3
+and the held-out random loads (``benchmarks/probe.py``). Not a test; about 1 min per seed
+on one core::
 
     python benchmarks/episode_noise.py --seeds 0 1 2 3 4
     python benchmarks/episode_noise.py --seeds 0 1 2 3 4 --hold 128
@@ -24,13 +23,11 @@ table).
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
-import json
 import sys
-import time
 
 import torch
+from probe import run_recipe, seeds_main  # benchmarks/probe.py, beside this script
 from torch.distributions import Normal
 
 from train.bench.sb3_policies import AsymmetricCriticPolicy
@@ -90,30 +87,14 @@ def config(hold: int = EPISODE_STEPS):
 
 def run(seed: int, hold: int = EPISODE_STEPS, env_id: str = "ACLDBeam-v1") -> dict:
     """Train one run of seed ``seed`` and evaluate it."""
-    from train.bench.evaluate import ise_rel_lqr
-    from train.bench.sb3_train import train_sb3
-
-    t0 = time.perf_counter()
-    policy, record = train_sb3(config(hold), seed, env_id)
-    wall = time.perf_counter() - t0
-    rel = ise_rel_lqr(policy, env_id)
-    return {
-        "seed": seed,
-        "hold": hold,
-        "train_wall_s": round(wall),
-        "validation_cost_256": round(record["select"]["cost"], 4),
-        "ise_rel_lqr": {str(k): round(float(v), 3) for k, v in rel.items()},
-    }
+    return run_recipe(config(hold), seed, env_id, hold=hold)
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--seeds", type=int, nargs="+", default=[0])
-    p.add_argument("--hold", type=int, default=EPISODE_STEPS, help="steps per noise draw")
-    args = p.parse_args(argv)
-    for seed in args.seeds:
-        print(json.dumps(run(seed, args.hold)), flush=True)
-    return 0
+    def add_arguments(p):
+        p.add_argument("--hold", type=int, default=EPISODE_STEPS, help="steps per noise draw")
+
+    return seeds_main(__doc__, lambda seed, a: run(seed, a.hold), argv, add_arguments)
 
 
 if __name__ == "__main__":

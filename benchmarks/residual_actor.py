@@ -9,11 +9,9 @@ probe reports each run, failed ones too). gSDE draws its noise on the gains of t
 latent, ``[u, h]``, as it does on the recipe's ``u`` (``--noise latent``), or on the linear
 law's gains alone, the correction deterministic (``--noise linear``).
 
-It prints one JSON line per seed: the run's cost on 256 validation loads (the recipe's own
-check at the run's end, ``select``: :func:`train.bench.evaluate.validation_cost`; LQR 0.535,
-the shipped random search 0.5129, the +/-120 V limit cycle ~1.94) and ISE / LQR on cases 1,
-2, 3 and the held-out random loads (:func:`train.bench.evaluate.ise_rel_lqr`). Not a test;
-about 1 min per seed on one core::
+It prints one JSON line per seed: the run's validation cost and ISE / LQR on cases 1, 2, 3
+and the held-out random loads (``benchmarks/probe.py``). Not a test; about 1 min per seed
+on one core::
 
     python benchmarks/residual_actor.py --seeds 0 1 2 3 4
     python benchmarks/residual_actor.py --seeds 0 1 2 3 4 --noise linear
@@ -26,15 +24,13 @@ whitening is folded into the residual module (:meth:`ResidualActorPolicy.fold_wh
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
-import json
 import sys
-import time
 
 import numpy as np
 import torch
 import torch.nn as nn
+from probe import run_recipe, seeds_main  # benchmarks/probe.py, beside this script
 from stable_baselines3.common.distributions import StateDependentNoiseDistribution
 
 from train.bench.sb3_policies import AsymmetricCriticPolicy
@@ -123,32 +119,17 @@ def config(hidden: list[int], noise: str = "latent"):
 
 def run(seed: int, hidden: list[int], noise: str = "latent", env_id: str = "ACLDBeam-v1") -> dict:
     """Train one run of seed ``seed`` and evaluate it."""
-    from train.bench.evaluate import ise_rel_lqr
-    from train.bench.sb3_train import train_sb3
-
-    t0 = time.perf_counter()
-    policy, record = train_sb3(config(hidden, noise), seed, env_id)
-    wall = time.perf_counter() - t0
-    rel = ise_rel_lqr(policy, env_id)
-    return {
-        "seed": seed,
-        "hidden": hidden,
-        "noise": noise,
-        "train_wall_s": round(wall),
-        "validation_cost_256": round(record["select"]["cost"], 4),
-        "ise_rel_lqr": {str(k): round(float(v), 3) for k, v in rel.items()},
-    }
+    return run_recipe(config(hidden, noise), seed, env_id, hidden=hidden, noise=noise)
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--seeds", type=int, nargs="+", default=[0])
-    p.add_argument("--hidden", type=int, nargs="+", default=[64], help="the MLP's widths")
-    p.add_argument("--noise", choices=NOISES, default="latent", help="what gSDE's noise acts on")
-    args = p.parse_args(argv)
-    for seed in args.seeds:
-        print(json.dumps(run(seed, args.hidden, args.noise)), flush=True)
-    return 0
+    def add_arguments(p):
+        p.add_argument("--hidden", type=int, nargs="+", default=[64], help="the MLP's widths")
+        p.add_argument(
+            "--noise", choices=NOISES, default="latent", help="what gSDE's noise acts on"
+        )
+
+    return seeds_main(__doc__, lambda seed, a: run(seed, a.hidden, a.noise), argv, add_arguments)
 
 
 if __name__ == "__main__":

@@ -1,0 +1,53 @@
+"""What the PPO probes of ``benchmarks/`` share (``residual_actor.py``, ``episode_noise.py``,
+``beta_actor.py``): one run of a changed recipe per seed, trained and evaluated as the
+benchmark does, and a command line printing one JSON line per seed.
+
+A run's line: its settings, its training wall time, its cost on 256 validation loads (the
+recipe's own check at the run's end, :func:`train.bench.evaluate.validation_cost`; LQR
+0.535, the shipped random search 0.5129, the +/-120 V limit cycle ~1.94) and ISE / LQR on
+cases 1, 2, 3 and the held-out random loads (:func:`train.bench.evaluate.ise_rel_lqr`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from collections.abc import Callable
+
+
+def run_recipe(cfg, seed: int, env_id: str = "ACLDBeam-v1", **settings) -> dict:
+    """Train one run of ``cfg`` (a :class:`train.config.TrainConfig`) for ``seed`` and
+    evaluate it; ``settings`` are reported after the seed."""
+    from train.bench.evaluate import ise_rel_lqr
+    from train.bench.sb3_train import train_sb3
+
+    t0 = time.perf_counter()
+    policy, record = train_sb3(cfg, seed, env_id)
+    wall = time.perf_counter() - t0
+    rel = ise_rel_lqr(policy, env_id)
+    return {
+        "seed": seed,
+        **settings,
+        "train_wall_s": round(wall),
+        "validation_cost_256": round(record["select"]["cost"], 4),
+        "ise_rel_lqr": {str(k): round(float(v), 3) for k, v in rel.items()},
+    }
+
+
+def seeds_main(
+    doc: str,
+    run: Callable[[int, argparse.Namespace], dict],
+    argv: list[str] | None = None,
+    add_arguments: Callable[[argparse.ArgumentParser], None] | None = None,
+) -> int:
+    """The probe's command line: ``--seeds`` (default 0) and the probe's own arguments
+    (``add_arguments``); prints ``run(seed, args)`` as a JSON line per seed."""
+    p = argparse.ArgumentParser(description=doc.split("\n\n")[0])
+    p.add_argument("--seeds", type=int, nargs="+", default=[0])
+    if add_arguments is not None:
+        add_arguments(p)
+    args = p.parse_args(argv)
+    for seed in args.seeds:
+        print(json.dumps(run(seed, args)), flush=True)
+    return 0

@@ -27,7 +27,6 @@ is folded into its first layer.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import sys
 from functools import partial
@@ -35,7 +34,7 @@ from functools import partial
 import torch
 import torch.nn as nn
 import torch.nn.functional as F
-from probe import run_recipe, seeds_main  # benchmarks/probe.py, beside this script
+from probe import one_run, run_recipe, seeds_main  # benchmarks/probe.py, beside this script
 from stable_baselines3.common.distributions import Distribution
 
 from train.bench.sb3_policies import AsymmetricCriticPolicy
@@ -101,17 +100,10 @@ class BetaActorPolicy(AsymmetricCriticPolicy):
 
 
 def config(ent_coef: float | None = None):
-    """``train/benchmark/ppo.yaml``'s config with :class:`BetaActorPolicy`, one run
-    (``ent_coef``: the entropy coefficient, if not the recipe's)."""
-    from train.config import load_config
-
-    cfg = load_config("ppo")
-    model = {k: v for k, v in cfg.model.items() if k not in ("use_sde", "sde_sample_freq")}
-    kwargs = {k: v for k, v in model.get("policy_kwargs", {}).items() if k != "log_std_init"}
-    model = {**model, "policy": BetaActorPolicy, "policy_kwargs": kwargs}
-    if ent_coef is not None:
-        model["ent_coef"] = float(ent_coef)
-    return dataclasses.replace(cfg, model=model, restarts=1, restart_above=None)
+    """``train/benchmark/ppo.yaml``'s config with :class:`BetaActorPolicy` and without gSDE,
+    one run (``ent_coef``: the entropy coefficient, if not the recipe's)."""
+    model = {} if ent_coef is None else {"ent_coef": float(ent_coef)}
+    return one_run(BetaActorPolicy, drop=("use_sde", "sde_sample_freq", "log_std_init"), **model)
 
 
 def run(seed: int, ent_coef: float | None = None, env_id: str = "ACLDBeam-v1") -> dict:

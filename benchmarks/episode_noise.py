@@ -23,11 +23,10 @@ table).
 
 from __future__ import annotations
 
-import dataclasses
 import sys
 
 import torch
-from probe import run_recipe, seeds_main  # benchmarks/probe.py, beside this script
+from probe import one_run, run_recipe, seeds_main  # benchmarks/probe.py, beside this script
 from torch.distributions import Normal
 
 from train.bench.sb3_policies import AsymmetricCriticPolicy
@@ -77,12 +76,7 @@ class EpisodeNoisePolicy(AsymmetricCriticPolicy):
 
 def config(hold: int = EPISODE_STEPS):
     """``train/benchmark/ppo.yaml``'s config with :class:`EpisodeNoisePolicy`, one run."""
-    from train.config import load_config
-
-    cfg = load_config("ppo")
-    kwargs = {**cfg.model.get("policy_kwargs", {}), "hold": hold}
-    model = {**cfg.model, "policy": EpisodeNoisePolicy, "policy_kwargs": kwargs}
-    return dataclasses.replace(cfg, model=model, restarts=1, restart_above=None)
+    return one_run(EpisodeNoisePolicy, {"hold": hold})
 
 
 def run(seed: int, hold: int = EPISODE_STEPS, env_id: str = "ACLDBeam-v1") -> dict:

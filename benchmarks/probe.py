@@ -1,6 +1,7 @@
 """What the PPO probes of ``benchmarks/`` share (``residual_actor.py``, ``episode_noise.py``,
-``beta_actor.py``): one run of a changed recipe per seed, trained and evaluated as the
-benchmark does, and a command line printing one JSON line per seed.
+``beta_actor.py``): the recipe with another policy, one run per seed (:func:`one_run`),
+trained and evaluated as the benchmark does (:func:`run_recipe`), and a command line
+printing one JSON line per seed (:func:`seeds_main`).
 
 A run's line: its settings, its training wall time, its cost on 256 validation loads (the
 recipe's own check at the run's end, :func:`train.bench.evaluate.validation_cost`; LQR
@@ -11,9 +12,26 @@ cases 1, 2, 3 and the held-out random loads (:func:`train.bench.evaluate.ise_rel
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
+
+
+def one_run(policy, policy_kwargs: dict | None = None, drop: Iterable[str] = (), **model):
+    """``train/benchmark/ppo.yaml``'s config with ``policy`` (its ``policy_kwargs`` added to
+    the recipe's) and one run per seed, its failures reported rather than retried; the
+    keys in ``drop`` are removed from the recipe's model and policy keyword arguments, and
+    ``model`` replaces model keyword arguments."""
+    from train.config import load_config
+
+    cfg = load_config("ppo")
+    drop = set(drop)
+    kept = {k: v for k, v in cfg.model.items() if k not in drop}
+    kwargs = {k: v for k, v in kept.get("policy_kwargs", {}).items() if k not in drop}
+    kwargs.update(policy_kwargs or {})
+    new = {**kept, **model, "policy": policy, "policy_kwargs": kwargs}
+    return dataclasses.replace(cfg, model=new, restarts=1, restart_above=None)
 
 
 def run_recipe(cfg, seed: int, env_id: str = "ACLDBeam-v1", **settings) -> dict:

@@ -24,13 +24,12 @@ whitening is folded into the residual module (:meth:`ResidualActorPolicy.fold_wh
 
 from __future__ import annotations
 
-import dataclasses
 import sys
 
 import numpy as np
 import torch
 import torch.nn as nn
-from probe import run_recipe, seeds_main  # benchmarks/probe.py, beside this script
+from probe import one_run, run_recipe, seeds_main  # benchmarks/probe.py, beside this script
 from stable_baselines3.common.distributions import StateDependentNoiseDistribution
 
 from train.bench.sb3_policies import AsymmetricCriticPolicy
@@ -104,17 +103,7 @@ class ResidualActorPolicy(AsymmetricCriticPolicy):
 
 def config(hidden: list[int], noise: str = "latent"):
     """``train/benchmark/ppo.yaml``'s config with the residual actor, one run."""
-    from train.config import load_config
-
-    cfg = load_config("ppo")
-    model = dict(cfg.model)
-    model["policy"] = ResidualActorPolicy
-    model["policy_kwargs"] = {
-        **model.get("policy_kwargs", {}),
-        "hidden": list(hidden),
-        "noise": noise,
-    }
-    return dataclasses.replace(cfg, model=model, restarts=1, restart_above=None)
+    return one_run(ResidualActorPolicy, {"hidden": list(hidden), "noise": noise})
 
 
 def run(seed: int, hidden: list[int], noise: str = "latent", env_id: str = "ACLDBeam-v1") -> dict:

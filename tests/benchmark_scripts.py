@@ -18,3 +18,18 @@ def load_script(name: str) -> ModuleType:
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
+
+
+def tiny_model(cfg, env_id: str = "ACLDBeam-v1"):
+    """The SB3 model of a probe's config ``cfg`` on 4 sub-envs with minibatches of 256,
+    built and not trained, and the training env's observation width."""
+    import dataclasses
+
+    import train.bench.sb3_train as sb3_train
+
+    cfg = dataclasses.replace(cfg, n_envs=4, model={**cfg.model, "batch_size": 256})
+    venv = sb3_train.make_vec_env(cfg, 0, env_id)
+    try:
+        return sb3_train.make_model(cfg, venv, 0), venv.observation_space.shape[0]
+    finally:
+        venv.close()

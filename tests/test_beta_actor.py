@@ -2,26 +2,14 @@
 of ``2 x - 1``, ``x ~ Beta(alpha, beta)``, its deterministic action is that mean, its
 parameters are linear in the observation, and folding the whitening keeps the law."""
 
-import dataclasses
-
 import numpy as np
 import torch
 
 import train.bench.sb3_train as sb3_train
-from tests.benchmark_scripts import load_script
+from tests.benchmark_scripts import load_script, tiny_model
 from train.bench.sb3_policies import SB3Policy
 
 ba = load_script("beta_actor")
-
-
-def _model():
-    cfg = ba.config()
-    cfg = dataclasses.replace(cfg, n_envs=4, model={**cfg.model, "batch_size": 256})
-    venv = sb3_train.make_vec_env(cfg, 0, "ACLDBeam-v1")
-    try:
-        return sb3_train.make_model(cfg, venv, 0), venv.observation_space.shape[0]
-    finally:
-        venv.close()
 
 
 def _dist(params):
@@ -53,7 +41,7 @@ def test_samples_lie_in_the_range_with_the_distributions_mean():
 
 
 def test_the_policy_acts_with_the_beta_and_folding_the_whitening_keeps_its_law():
-    model, width = _model()
+    model, width = tiny_model(ba.config())
     policy = model.policy
     assert isinstance(policy.action_dist, ba.BetaDistribution) and not model.use_sde
     assert policy.action_net.in_features == width - 1  # the actor drops log c

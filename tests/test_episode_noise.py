@@ -2,25 +2,17 @@
 whole episode, across SB3's per-rollout noise requests, scaled by the current sigma, and
 redrawn when the episode's steps are done."""
 
-import dataclasses
-
 import numpy as np
 import torch
 
-import train.bench.sb3_train as sb3_train
-from tests.benchmark_scripts import load_script
+from tests.benchmark_scripts import load_script, tiny_model
 
 en = load_script("episode_noise")
 
 
-def _policy(n_envs: int = 4):
-    cfg = en.config()
-    cfg = dataclasses.replace(cfg, n_envs=n_envs, model={**cfg.model, "batch_size": 256})
-    venv = sb3_train.make_vec_env(cfg, 0, "ACLDBeam-v1")
-    try:
-        return sb3_train.make_model(cfg, venv, 0).policy, venv.observation_space.shape[0]
-    finally:
-        venv.close()
+def _policy():
+    model, width = tiny_model(en.config())
+    return model.policy, width
 
 
 def test_the_draw_is_held_across_rollouts_and_scaled_by_the_current_sigma():

@@ -4,7 +4,6 @@ the raw observation (the package's fold calls the policy's own), gSDE's noise ac
 the whole latent or on the linear gains alone, and a bad ``hidden`` or ``noise`` is refused
 by name."""
 
-import dataclasses
 import functools
 
 import gymnasium as gym
@@ -13,20 +12,14 @@ import pytest
 import torch
 
 import train.bench.sb3_train as sb3_train
-from tests.benchmark_scripts import load_script
+from tests.benchmark_scripts import load_script, tiny_model
 from train.bench.sb3_policies import SB3Policy
 
 ra = load_script("residual_actor")
 
 
 def _model(noise: str = "latent"):
-    cfg = ra.config([8], noise)
-    cfg = dataclasses.replace(cfg, n_envs=4, model={**cfg.model, "batch_size": 256})
-    venv = sb3_train.make_vec_env(cfg, 0, "ACLDBeam-v1")
-    try:
-        return sb3_train.make_model(cfg, venv, 0)
-    finally:
-        venv.close()
+    return tiny_model(ra.config([8], noise))[0]
 
 
 @pytest.fixture

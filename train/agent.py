@@ -186,7 +186,7 @@ def actor_parts(model) -> tuple[Any, list, bool]:
 
     pol = model.policy
     actor = getattr(pol, "actor", None)
-    if actor is not None and hasattr(actor, "latent_pi"):  # SAC, TQC: tanh(mu(latent))
+    if actor is not None and hasattr(actor, "latent_pi"):  # SAC, TQC, CrossQ: tanh(mu(latent))
         mu = actor.mu
         layers = [*actor.latent_pi, *(mu if isinstance(mu, nn.Sequential) else [mu])]
         return actor.features_extractor, layers, True
@@ -203,9 +203,10 @@ def actor_parts(model) -> tuple[Any, list, bool]:
 
 
 def export_sb3(model, obs_norm=None) -> ActorProgram:
-    """The deterministic actor of an SB3 ``MlpPolicy`` (PPO, SAC, TD3, TQC, ARS, ...) and its
-    ``VecNormalize`` observation statistics as an :class:`ActorProgram` (equal to SB3's
-    ``predict`` to float32 round-off; tests/train/test_distill.py)."""
+    """The deterministic actor of an SB3 ``MlpPolicy`` (PPO, SAC, TD3, TQC, CrossQ, ARS,
+    ...) and its ``VecNormalize`` observation statistics as an :class:`ActorProgram` (equal
+    to SB3's ``predict`` to float32 round-off; tests/train/test_distill.py and, for
+    CrossQ's batch renormalisation, tests/train/test_benchmark.py)."""
     import torch.nn as nn
     from stable_baselines3.common.torch_layers import FlattenExtractor
 
@@ -237,6 +238,12 @@ def export_sb3(model, obs_norm=None) -> ActorProgram:
             arrays[f"b{layer}"] = m.bias.detach().double().numpy().copy()
             ops.append({"op": "linear", "layer": layer})
             layer += 1
+        elif _is_batch_norm(m):  # CrossQ's; in eval mode an affine map of each feature
+            w, b = _batch_norm_affine(m)
+            arrays[f"W{layer}"] = np.diag(w)
+            arrays[f"b{layer}"] = b
+            ops.append({"op": "linear", "layer": layer})
+            layer += 1
         elif isinstance(m, nn.Tanh):
             ops.append({"op": "tanh"})
         elif isinstance(m, nn.ReLU):
@@ -248,6 +255,31 @@ def export_sb3(model, obs_norm=None) -> ActorProgram:
     if squash:
         ops.append({"op": "tanh"})
     return ActorProgram(ops, arrays)
+
+
+def _is_batch_norm(m) -> bool:
+    """Whether ``m`` is sb3-contrib's ``BatchRenorm`` (CrossQ's layers)."""
+    try:
+        from sb3_contrib.common.torch_layers import BatchRenorm
+    except ImportError:  # sb3-contrib not installed: no BatchRenorm to meet
+        return False
+    return isinstance(m, BatchRenorm)
+
+
+def _batch_norm_affine(m) -> tuple[np.ndarray, np.ndarray]:
+    r"""The per-feature map :math:`x \mapsto w x + b` of sb3-contrib's ``BatchRenorm`` in
+    evaluation mode, as SB3's ``predict`` runs it: :math:`w = \gamma / \sqrt{\sigma^2 +
+    \epsilon}`, :math:`b = \beta - w \mu` with the running mean :math:`\mu` and variance
+    :math:`\sigma^2` (``ra_mean``, ``ra_var``) and the affine ``scale`` :math:`\gamma` and
+    ``bias`` :math:`\beta` (1 and 0 if not ``affine``)."""
+
+    def arr(t):
+        return t.detach().double().numpy().copy()
+
+    mean, var = arr(m.ra_mean), arr(m.ra_var)
+    gamma, beta = (arr(m.scale), arr(m.bias)) if m.affine else (1.0, 0.0)
+    w = np.broadcast_to(gamma / np.sqrt(var + float(m.eps)), mean.shape).copy()
+    return w, np.broadcast_to(beta, mean.shape) - w * mean
 
 
 def linear_program(

@@ -169,6 +169,52 @@ def test_ppo_with_whitening_quadratic_critic_and_episode_scale():
     )
 
 
+def _crossq_config(**changes):
+    """The CrossQ probe's config (train/benchmark/ablation_crossq.yaml) on a tiny budget."""
+    from train.config import TrainConfig
+
+    data = yaml.safe_load(open("train/benchmark/ablation_crossq.yaml"))
+    data.update(timesteps=1200, n_envs=2, eval_points=1, select=None, **changes)
+    data["model"] = {**data["model"], "learning_starts": 400, "batch_size": 64}
+    return TrainConfig.from_dict(data)
+
+
+def test_crossq_trains_and_exports_its_batch_renormalisation():
+    """sb3-contrib's CrossQ through the benchmark's stack: its actor's batch renormalisation
+    layers export as their evaluation-mode affine maps, so the agent's program is SB3's
+    deterministic ``predict`` (running statistics, not the batch's)."""
+    from sb3_contrib.common.torch_layers import BatchRenorm
+
+    from train.bench.algos import train_algo
+    from train.benchmark import policy_program
+
+    policy, record = train_algo(_crossq_config(), 0, "ACLDBeam-v1")
+    assert record["steps"] >= 1200 and record["transform"] is None
+    norms = [m for m in policy.model.policy.actor.modules() if isinstance(m, BatchRenorm)]
+    assert norms and all(int(m.steps) > 0 for m in norms)  # trained: statistics moved
+    assert not np.allclose(norms[0].ra_mean.numpy(), 0.0)
+    z = np.random.default_rng(2).normal(size=(6, 9)).astype(np.float32)
+    v, _ = policy.predict(z)
+    prog = policy_program(policy)
+    assert sum(op["op"] == "linear" for op in prog.ops) == 3 + len(norms)
+    # the applied voltage: 120 clip(3 a), the config's action headroom
+    assert np.allclose(
+        120 * np.clip(3 * prog(z.astype(np.float64)), -1, 1).reshape(-1, 1), v, atol=1e-3
+    )
+
+
+def test_whitening_needs_a_first_linear_layer():
+    """The whitening folds into the actor's first Linear layer; CrossQ's actor starts with
+    batch renormalisation, so a config asking for it fails before the whitening's env
+    steps, naming the key."""
+    from train.bench.algos import train_algo
+
+    seen = []  # the learning curve's points: the first is due before the whitening
+    with pytest.raises(TypeError, match="whiten_steps.*BatchRenorm"):
+        train_algo(_crossq_config(whiten_steps=1000), 0, "ACLDBeam-v1", lambda s, _: seen.append(s))
+    assert seen == []
+
+
 def test_fold_whitening_and_quadratic_features():
     import torch
     from stable_baselines3 import PPO, SAC

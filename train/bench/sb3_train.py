@@ -93,6 +93,22 @@ def ent_coef_schedule(cfg: TrainConfig) -> LinearSchedule | None:
     return _schedule("ent_coef", value) if isinstance(value, dict) else None
 
 
+def first_linear(model) -> nn.Linear:
+    """The actor's first layer, which :func:`fold_whitening` folds the whitening into: a
+    ``Linear`` layer, else ``TypeError`` (an actor that starts with a per-feature layer,
+    such as CrossQ's batch renormalisation, cannot take a full linear map into it; train
+    such a policy with ``whiten_steps: 0``). Checked before the whitening is estimated."""
+    layers = actor_parts(model)[1]
+    if not layers or not isinstance(layers[0], nn.Linear):
+        first = type(layers[0]).__name__ if layers else "no layer"
+        raise TypeError(
+            f"whiten_steps: the whitening folds into the actor's first layer, which must be "
+            f"a Linear layer; {type(model.policy).__name__}'s actor starts with {first} "
+            f"(use whiten_steps: 0)"
+        )
+    return layers[0]
+
+
 def fold_whitening(model, transform: np.ndarray) -> None:
     """Fold the whitening ``u = T^T z`` into the actor's first layer (``W u = (W T^T) z``),
     so that the trained actor takes the raw observation (and exports as a plain SB3
@@ -103,7 +119,7 @@ def fold_whitening(model, transform: np.ndarray) -> None:
     if callable(own):
         own(np.asarray(transform))
         return
-    layer = next(m for m in actor_parts(model)[1] if isinstance(m, nn.Linear))
+    layer = first_linear(model)
     with torch.no_grad():
         t = torch.as_tensor(np.asarray(transform).T, dtype=layer.weight.dtype)
         layer.weight.copy_(layer.weight @ t)
@@ -363,6 +379,8 @@ def train_sb3(
 
     if cfg.whiten_steps:
         assert isinstance(white, VecWhiten)
+        if not callable(getattr(model.policy, "fold_whitening", None)):
+            first_linear(model)  # before the whitening's env steps, not after training
         if callback is not None and schedule.due(0):
             callback(0, snapshot())
         white.collect = []

@@ -238,8 +238,8 @@ def export_sb3(model, obs_norm=None) -> ActorProgram:
             arrays[f"b{layer}"] = m.bias.detach().double().numpy().copy()
             ops.append({"op": "linear", "layer": layer})
             layer += 1
-        elif _is_batch_norm(m):  # CrossQ's; in eval mode an affine map of each feature
-            w, b = _batch_norm_affine(m)
+        elif _is_batch_renorm(m):  # CrossQ's; in eval mode an affine map of each feature
+            w, b = _batch_renorm_affine(m)
             arrays[f"W{layer}"] = np.diag(w)
             arrays[f"b{layer}"] = b
             ops.append({"op": "linear", "layer": layer})
@@ -257,7 +257,7 @@ def export_sb3(model, obs_norm=None) -> ActorProgram:
     return ActorProgram(ops, arrays)
 
 
-def _is_batch_norm(m) -> bool:
+def _is_batch_renorm(m) -> bool:
     """Whether ``m`` is sb3-contrib's ``BatchRenorm`` (CrossQ's layers)."""
     try:
         from sb3_contrib.common.torch_layers import BatchRenorm
@@ -266,7 +266,7 @@ def _is_batch_norm(m) -> bool:
     return isinstance(m, BatchRenorm)
 
 
-def _batch_norm_affine(m) -> tuple[np.ndarray, np.ndarray]:
+def _batch_renorm_affine(m) -> tuple[np.ndarray, np.ndarray]:
     r"""The per-feature map :math:`x \mapsto w x + b` of sb3-contrib's ``BatchRenorm`` in
     evaluation mode, as SB3's ``predict`` runs it: :math:`w = \gamma / \sqrt{\sigma^2 +
     \epsilon}`, :math:`b = \beta - w \mu` with the running mean :math:`\mu` and variance

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 import yaml
 
+from tests.train.tiny_sb3 import tiny_crossq
 from train.bench.stats import iqm, iqm_with_ci, stratified_bootstrap_ci
 
 
@@ -169,16 +170,6 @@ def test_ppo_with_whitening_quadratic_critic_and_episode_scale():
     )
 
 
-def _crossq_config(**changes):
-    """The CrossQ probe's config (train/benchmark/ablation_crossq.yaml) on a tiny budget."""
-    from train.config import TrainConfig
-
-    data = yaml.safe_load(open("train/benchmark/ablation_crossq.yaml"))
-    data.update(timesteps=1200, n_envs=2, eval_points=1, select=None, **changes)
-    data["model"] = {**data["model"], "learning_starts": 400, "batch_size": 64}
-    return TrainConfig.from_dict(data)
-
-
 def test_crossq_trains_and_exports_its_batch_renormalisation():
     """sb3-contrib's CrossQ through the benchmark's stack: its actor's batch renormalisation
     layers export as their evaluation-mode affine maps, so the agent's program is SB3's
@@ -188,7 +179,7 @@ def test_crossq_trains_and_exports_its_batch_renormalisation():
     from train.bench.algos import train_algo
     from train.benchmark import policy_program
 
-    policy, record = train_algo(_crossq_config(), 0, "ACLDBeam-v1")
+    policy, record = train_algo(tiny_crossq(), 0, "ACLDBeam-v1")
     assert record["steps"] >= 1200 and record["transform"] is None
     norms = [m for m in policy.model.policy.actor.modules() if isinstance(m, BatchRenorm)]
     assert norms and all(int(m.steps) > 0 for m in norms)  # trained: statistics moved
@@ -211,7 +202,7 @@ def test_whitening_needs_a_first_linear_layer():
 
     seen = []  # the learning curve's points: the first is due before the whitening
     with pytest.raises(TypeError, match="whiten_steps.*BatchRenorm"):
-        train_algo(_crossq_config(whiten_steps=1000), 0, "ACLDBeam-v1", lambda s, _: seen.append(s))
+        train_algo(tiny_crossq(whiten_steps=1000), 0, "ACLDBeam-v1", lambda s, _: seen.append(s))
     assert seen == []
 
 

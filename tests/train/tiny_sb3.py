@@ -1,5 +1,6 @@
-"""What the training-loop unit tests share: a tiny SAC configuration and a stand-in for an
-SB3 model (``Averaging``, ``Selection`` and ``train_algo`` read only ``model.policy``)."""
+"""What the training-loop unit tests share: tiny SAC, PPO and CrossQ configurations and a
+stand-in for an SB3 model (``Averaging``, ``Selection`` and ``train_algo`` read only
+``model.policy``)."""
 
 import torch
 import yaml
@@ -45,6 +46,16 @@ def tiny_sac_recipe(timesteps: int, **fields) -> TrainConfig:
     data.update(timesteps=timesteps, n_envs=4, eval_points=1, whiten_steps=128)
     data.update({"restart_above": None, **fields})
     data["model"] = {**data["model"], "learning_starts": 200, "buffer_size": 2000, "batch_size": 64}
+    return TrainConfig.from_dict(data)
+
+
+def tiny_crossq(**fields) -> TrainConfig:
+    """The CrossQ probe (train/benchmark/ablation_crossq.yaml) shrunk to 1200 env steps on 2
+    sub-envs (learning from 400 on, minibatches of 64, no checkpoint selection), with
+    ``fields`` changed on top."""
+    data = yaml.safe_load(open("train/benchmark/ablation_crossq.yaml"))
+    data.update(timesteps=1200, n_envs=2, eval_points=1, select=None, **fields)
+    data["model"] = {**data["model"], "learning_starts": 400, "batch_size": 64}
     return TrainConfig.from_dict(data)
 
 

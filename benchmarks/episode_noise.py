@@ -26,13 +26,10 @@ from __future__ import annotations
 import sys
 
 import torch
-from probe import one_run, run_recipe, seeds_main  # benchmarks/probe.py, beside this script
+from probe import EPISODE_STEPS, one_run, run_recipe, seeds_main  # benchmarks/probe.py
 from torch.distributions import Normal
 
 from train.bench.sb3_policies import AsymmetricCriticPolicy
-
-#: Env steps per episode of ACLDBeam-v1 (1 s at 1 ms).
-EPISODE_STEPS = 1000
 
 
 class EpisodeNoisePolicy(AsymmetricCriticPolicy):

@@ -17,6 +17,9 @@ import json
 import time
 from collections.abc import Callable, Iterable
 
+#: Env steps per episode of ACLDBeam-v1 (1 s at 1 ms).
+EPISODE_STEPS = 1000
+
 
 def one_run(policy, policy_kwargs: dict | None = None, drop: Iterable[str] = (), **model):
     """``train/benchmark/ppo.yaml``'s config with ``policy`` (its ``policy_kwargs`` added to

@@ -239,6 +239,13 @@ class TrainConfig:
         PPO only: the advantages of each episode in a rollout are divided by their
         root mean square (:class:`train.bench.sb3_policies.EpisodeScaledRolloutBuffer`;
         the critic's targets are unchanged).
+    paired_loads : bool
+        SB3 algorithms: sub-envs ``2i`` and ``2i + 1`` of each load case get one seed
+        (:class:`acld_gym.envs.sb3.SB3VecEnv`'s ``seed_group=2``), so the pair runs the
+        same loads and sensor noise: common random numbers, for antithetic exploration
+        (``policy_kwargs: {antithetic_noise: true}``,
+        :class:`train.bench.sb3_policies.SplitCriticPolicy`). Needs an even number of
+        sub-envs per load case. Default false: sub-env i gets ``seed + i``.
     env_kwargs : dict
         SB3 algorithms: options of the *training* env (fields of
         :class:`acld_gym.envs.config.EnvConfig`, e.g. ``reward_scale: passive``,
@@ -303,6 +310,7 @@ class TrainConfig:
     eval_points: int = 10
     whiten_steps: int = 0
     episode_scale: bool = False
+    paired_loads: bool = False
     env_kwargs: dict = field(default_factory=dict)
     residual: str | None = None
     action_headroom: float = 1.0
@@ -382,6 +390,16 @@ class TrainConfig:
             raise ValueError(
                 f"episode_scale must be true or false, and true for ppo only; "
                 f"got {self.episode_scale!r}"
+            )
+        if not isinstance(self.paired_loads, bool) or (self.paired_loads and not sb3):
+            raise ValueError(
+                f"paired_loads must be true or false, and true for the SB3 algorithms "
+                f"only; got {self.paired_loads!r}"
+            )
+        if self.paired_loads and any(n % 2 for n in self.envs_per_load.values()):
+            raise ValueError(
+                f"paired_loads needs an even number of sub-envs per load case; n_envs "
+                f"{self.n_envs} over loads {self.loads} gives {self.envs_per_load}"
             )
         if not isinstance(self.env_kwargs, dict):
             raise ValueError(
@@ -486,6 +504,17 @@ class TrainConfig:
     def load_weights(self) -> dict:
         """``loads`` with parsed case keys."""
         return {parse_load_case(c): w for c, w in self.loads.items()}
+
+    @property
+    def envs_per_load(self) -> dict:
+        """Sub-envs of the training env per load case (parsed keys), in proportion to
+        ``loads``, at least one each, ``n_envs`` in all unless there are more cases."""
+        weights = self.load_weights
+        total = float(sum(weights.values()))
+        counts = {c: max(1, int(round(self.n_envs * w / total))) for c, w in weights.items()}
+        last = list(counts)[-1]
+        counts[last] = max(1, self.n_envs - sum(v for c, v in counts.items() if c != last))
+        return counts
 
     @property
     def mesh(self) -> str:

@@ -263,15 +263,6 @@ class ConcatVecEnv(VecEnv):
             v.set_options(options)
 
 
-def _split_envs(weights: dict, n_envs: int) -> dict:
-    """Sub-envs per load case, in proportion to ``weights`` (at least one each)."""
-    total = float(sum(weights.values()))
-    counts = {c: max(1, int(round(n_envs * w / total))) for c, w in weights.items()}
-    last = list(counts)[-1]
-    counts[last] = max(1, n_envs - sum(v for c, v in counts.items() if c != last))
-    return counts
-
-
 def find_wrapper(venv: VecEnv, cls: type) -> VecEnv | None:
     """The outermost ``cls`` in a chain of SB3 ``VecEnvWrapper`` (or None)."""
     while venv is not None:
@@ -285,9 +276,10 @@ def make_vec_env(
     cfg, seed: int, env_id: str = acld_gym.ENV_ID, backend: str = "native"
 ) -> VecNormalize:
     """The training env of a :class:`train.config.TrainConfig`, seeded (sub-env i gets
-    ``seed + i``): per training load case a batched env of ``env_id`` with the config's
-    ``env_kwargs`` (sub-envs split as :func:`_split_envs`), :class:`VecAgentEnv` with the
-    config's ``residual``, ``action_headroom`` and ``shaping``, :class:`VecWhiten` if
+    ``seed + i``, or with ``cfg.paired_loads`` ``seed + i // 2`` within each load case):
+    per training load case a batched env of ``env_id`` with the config's ``env_kwargs``
+    (sub-envs split as ``cfg.envs_per_load``), :class:`VecAgentEnv` with the config's
+    ``residual``, ``action_headroom`` and ``shaping``, :class:`VecWhiten` if
     ``cfg.whiten_steps`` (identity until :func:`train.bench.sb3_train.train_sb3` sets it),
     direction features if ``cfg.features``, and ``VecNormalize`` with ``cfg.normalize``.
 
@@ -299,11 +291,14 @@ def make_vec_env(
 
     if backend not in ("native", "subproc"):
         raise ValueError(f"backend must be 'native' or 'subproc', got {backend!r}")
+    if cfg.paired_loads and backend != "native":
+        raise ValueError(f"paired_loads needs backend 'native', got {backend!r}")
     parts = []
-    for case, n in _split_envs(cfg.load_weights, cfg.n_envs).items():
+    for case, n in cfg.envs_per_load.items():
         kwargs = dict(cfg.env_kwargs, load_case=case)
         if backend == "native":
-            parts.append(SB3VecEnv(venv=gym.make_vec(env_id, num_envs=n, **kwargs).unwrapped))
+            vec = gym.make_vec(env_id, num_envs=n, **kwargs).unwrapped
+            parts.append(SB3VecEnv(venv=vec, seed_group=2 if cfg.paired_loads else 1))
         else:
             from stable_baselines3.common.env_util import make_vec_env as sb3_make_vec_env
             from stable_baselines3.common.vec_env import SubprocVecEnv

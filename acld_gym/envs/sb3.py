@@ -31,7 +31,7 @@ from acld_gym.envs.config import EnvConfig
 from acld_gym.envs.step import INFO_KEYS
 from acld_gym.envs.vector_env import ACLDBeamVectorEnv
 from acld_gym.physics.loads import check_load_case
-from acld_gym.util.validate import check_seed
+from acld_gym.util.validate import check_int, check_seed
 
 #: Attributes the env derives its tables and design from at construction.
 _CONFIGURED = (
@@ -69,24 +69,37 @@ def _per_env(values) -> list:
 class SB3VecEnv(VecEnv):
     """SB3 ``VecEnv`` over :class:`ACLDBeamVectorEnv` (``num_envs`` and the env's
     configuration -- ``config=`` and/or its fields as keywords --, or an existing
-    ``venv=``)."""
+    ``venv=``).
+
+    ``seed_group`` (default 1): :meth:`seed` gives each run of ``seed_group`` consecutive
+    sub-envs one seed, so they draw the same episodes (loads, sensor noise) as long as
+    they end together: common random numbers, e.g. for antithetic exploration in pairs
+    (``seed_group=2``). An episode that leaves the deflection limit early puts its group
+    out of step from then on. It must divide the number of sub-envs."""
 
     def __init__(
         self,
         num_envs: int = 1,
         venv: ACLDBeamVectorEnv | None = None,
         config: EnvConfig | None = None,
+        seed_group: int = 1,
         **env_kwargs,
     ):
         if venv is None:
             venv = ACLDBeamVectorEnv(num_envs=num_envs, config=config, **env_kwargs)
         elif env_kwargs or config is not None:
             raise ValueError("pass either venv= or the env's configuration, not both")
+        check_int("seed_group", seed_group, 1, venv.num_envs)
+        if venv.num_envs % seed_group:
+            raise ValueError(
+                f"seed_group: expected a divisor of the {venv.num_envs} sub-envs, got {seed_group}"
+            )
+        self.seed_group = seed_group
         self.venv = venv
         super().__init__(venv.num_envs, venv.single_observation_space, venv.single_action_space)
         self.render_mode = venv.render_mode
         self._actions: np.ndarray | None = None
-        self._seed: int | None = None
+        self._seed: int | list[int] | None = None
         self._reset_options: dict = {}
 
     def reset(self) -> np.ndarray:
@@ -125,9 +138,13 @@ class SB3VecEnv(VecEnv):
         self.venv.close()
 
     def seed(self, seed: int | None = None) -> Sequence[None | int]:
-        """Seeds the next ``reset()``: sub-env i gets ``seed + i``."""
-        self._seed = check_seed(seed)
-        return [None if seed is None else seed + i for i in range(self.num_envs)]
+        """Seeds the next ``reset()``: sub-env i gets ``seed + i // seed_group`` (``seed +
+        i`` by default)."""
+        first = check_seed(seed)
+        g = self.seed_group
+        seeds = [None if first is None else first + i // g for i in range(self.num_envs)]
+        self._seed = seeds if (g > 1 and first is not None) else first
+        return seeds
 
     def set_options(self, options: list[dict] | dict | None = None) -> None:
         if isinstance(options, list):

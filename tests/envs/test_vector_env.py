@@ -224,3 +224,27 @@ def test_sb3_ppo_learns_and_evaluates():
     model.learn(total_timesteps=256)
     mean, std = evaluate_policy(model, VecMonitor(venv), n_eval_episodes=4)
     assert np.isfinite(mean) and np.isfinite(std)
+
+
+def test_sb3_adapter_seed_groups_share_their_episodes():
+    """``seed_group=2``: sub-envs 2i and 2i+1 get seed + i, so under the same actions they
+    run the same random loads and sensor noise, over an episode's end too; sub-env 2i is
+    the default adapter's sub-env i (seed + i). A group size that does not divide the
+    sub-envs is refused, naming it."""
+    kw = {"episode_length": SHORT, "load_case": "random"}
+    paired, plain = SB3VecEnv(num_envs=4, seed_group=2, **kw), SB3VecEnv(num_envs=2, **kw)
+    assert paired.seed(11) == [11, 11, 12, 12] and plain.seed(11) == [11, 12]
+    op, oq = paired.reset(), plain.reset()
+    np.testing.assert_array_equal(op[0::2], op[1::2])
+    np.testing.assert_array_equal(op[0::2], oq)
+    assert not np.array_equal(op[0], op[2])
+    acts = np.random.default_rng(0).uniform(-150, 150, (120, 2, 1)).astype(np.float32)
+    for a in acts:  # 120 steps: over the end of the 50-step episodes
+        op, rp, dp, ip = paired.step(np.repeat(a, 2, axis=0))
+        oq, rq, dq, iq = plain.step(a)
+        np.testing.assert_array_equal(op[0::2], op[1::2])
+        np.testing.assert_array_equal(op[0::2], oq)
+        np.testing.assert_array_equal(rp[0::2], rq)
+    for bad, msg in ((3, "divisor"), (0, "seed_group must be"), (True, "seed_group must be")):
+        with pytest.raises(ValueError, match=msg):
+            SB3VecEnv(num_envs=4, seed_group=bad)

@@ -14,6 +14,10 @@ from train.bench.sb3_policies import AsymmetricCriticPolicy
 
 
 def _model():
+    return _model_with()
+
+
+def _model_with(**policy_kwargs):
     from stable_baselines3 import PPO
     from stable_baselines3.common.env_util import make_vec_env
 
@@ -33,7 +37,7 @@ def _model():
         batch_size=64,
         seed=0,
         device="cpu",
-        policy_kwargs={"net_arch": {"pi": [], "vf": []}},
+        policy_kwargs={"net_arch": {"pi": [], "vf": []}, **policy_kwargs},
     )
 
 
@@ -122,3 +126,71 @@ def test_make_model_gives_the_sac_critic_the_configs_action_headroom():
             make_model(_sac_config(action_headroom=2.0), venv, 0)
     finally:
         venv.close()
+
+
+def test_drop_last_drops_n_privileged_entries_and_predict_pads_them():
+    from gymnasium import spaces
+
+    from train.bench.sb3_policies import DropLast, SB3Policy
+
+    box = spaces.Box(-np.inf, np.inf, (5,), np.float32)
+    x = torch.arange(10.0).reshape(2, 5)
+    assert torch.equal(DropLast(box)(x), x[:, :4])
+    assert torch.equal(DropLast(box, n=2)(x), x[:, :3])
+    for bad in (0, 5, 1.0):
+        with pytest.raises(ValueError, match="n: expected an integer"):
+            DropLast(box, n=bad)
+    # an actor on 8 of the 10 entries (two privileged) predicts on the 8 alone
+    model = _model_with(features_extractor_kwargs={"n": 2})
+    assert model.policy.features_extractor.features_dim == 8
+    z = np.random.default_rng(2).normal(size=(3, 8)).astype(np.float32)
+    v, _ = SB3Policy(model, None, None).predict(z)
+    with torch.no_grad():
+        full = torch.as_tensor(np.concatenate([z, np.full((3, 2), 5.0, np.float32)], axis=1))
+        a = model.policy._predict(full, deterministic=True).numpy()
+    assert np.allclose(np.ravel(v), 120 * np.clip(a, -1, 1).ravel())  # the padding unread
+
+
+def test_antithetic_noise_comes_in_pairs_and_needs_gsde():
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.env_util import make_vec_env
+
+    from train.bench.sb3_policies import SplitCriticPolicy
+
+    venv = make_vec_env("ACLDBeam-v1", n_envs=4, env_kwargs={"episode_length": 0.05})
+    kw = {"net_arch": {"pi": [], "vf": []}}
+    model = PPO(
+        SplitCriticPolicy,
+        venv,
+        n_steps=16,
+        batch_size=64,
+        use_sde=True,
+        seed=0,
+        device="cpu",
+        policy_kwargs={**kw, "antithetic_noise": True},
+    )
+    pol = model.policy
+    pol.reset_noise(4)
+    e = pol.action_dist.exploration_matrices
+    assert e.shape[0] == 4 and torch.equal(e[1::2], -e[0::2]) and not torch.equal(e[0], -e[2])
+    obs = torch.as_tensor(np.repeat(venv.reset()[:1], 4, axis=0))
+    with torch.no_grad():  # the same state: the pair's actions lie either side of the mean
+        acts = pol(obs)[0]
+        mean = pol._predict(obs, deterministic=True)
+    assert torch.allclose(acts[0::2] - mean[0::2], mean[1::2] - acts[1::2], atol=1e-6)
+    with pytest.raises(ValueError, match="even number of sub-envs"):
+        pol.reset_noise(3)
+    assert pol._get_constructor_parameters()["antithetic_noise"] is True
+    plain = PPO(SplitCriticPolicy, venv, n_steps=16, use_sde=True, seed=0, device="cpu")
+    plain.policy.reset_noise(4)  # default: independent noise per sub-env
+    e = plain.policy.action_dist.exploration_matrices
+    assert not torch.allclose(e[1::2], -e[0::2])
+    for bad, sde in ((True, False), ("yes", True)):
+        with pytest.raises(ValueError, match="antithetic_noise must be"):
+            PPO(
+                SplitCriticPolicy,
+                venv,
+                use_sde=sde,
+                device="cpu",
+                policy_kwargs={**kw, "antithetic_noise": bad},
+            )

@@ -67,6 +67,9 @@ BASE = dict(algo="ppo", timesteps=10, n_envs=2, model={"policy": "MlpPolicy"})
         ({"normalize": {"norm_obbs": True}}, "norm_obbs"),
         ({"features": "fourier"}, "features"),
         ({"episode_scale": 1}, "episode_scale"),
+        ({"paired_loads": 1}, "paired_loads must be"),
+        ({"paired_loads": True, "n_envs": 3}, "paired_loads needs an even.*'random': 3"),
+        ({"paired_loads": True, "n_envs": 4, "loads": {1: 1, 2: 3}}, "paired_loads needs"),
         ({"whiten_steps": 100, "features": "direction"}, "whiten_steps"),
         ({"distill": {"itertions": 3}}, "itertions"),
         ({"distill": {"teacher": "mpc"}, "residual": "lqr"}, "residual"),
@@ -92,6 +95,18 @@ def test_vrs_takes_no_sb3_options():
         TrainConfig(algo="vrs", timesteps=10, action_headroom=2.0)
     with pytest.raises(ValueError, match="select and average are for the SB3"):
         TrainConfig(algo="vrs", timesteps=10, select={"episodes": 2, "every": 10})
+    with pytest.raises(ValueError, match="paired_loads.*SB3"):
+        TrainConfig(algo="vrs", timesteps=10, paired_loads=True)
+
+
+def test_envs_per_load_splits_the_sub_envs_by_weight():
+    split = TrainConfig(**{**BASE, "n_envs": 8, "loads": {1: 1, "random": 3}}).envs_per_load
+    assert split == {1: 2, "random": 6}
+    assert TrainConfig(**{**BASE, "n_envs": 2, "loads": {1: 1, 2: 1, 3: 1}}).envs_per_load == {
+        1: 1,
+        2: 1,
+        3: 1,
+    }  # at least one sub-env per load case
 
 
 def test_bad_files(tmp_path):

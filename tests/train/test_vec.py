@@ -1,5 +1,7 @@
 """train.vec: the action map, the shaping potential and the wrapped training env."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 import scipy.linalg as sla
@@ -160,3 +162,21 @@ def test_subproc_backend_is_the_same_env():
     finally:
         native.close()
         sub.close()
+
+
+def test_make_vec_env_pairs_the_sub_envs_with_paired_loads():
+    """``paired_loads``: sub-envs 2i and 2i+1 of each load case run the same episodes under
+    the same actions; with the subprocess backend it is refused."""
+    cfg = load_config("ppo").with_overrides(n_envs=6, loads={1: 1, "random": 2})
+    cfg = replace(cfg, paired_loads=True)
+    venv = make_vec_env(cfg, seed=3)
+    obs = venv.reset()
+    assert obs.shape == (6, 10)
+    act = np.repeat(np.random.default_rng(1).uniform(-1, 1, (3, 1)), 2, axis=0)
+    for _ in range(30):
+        obs, rew, _, _ = venv.step(act.astype(np.float32))
+    np.testing.assert_array_equal(obs[0::2], obs[1::2])
+    np.testing.assert_array_equal(rew[0::2], rew[1::2])
+    assert not np.array_equal(obs[2], obs[4])  # the random pairs differ from each other
+    with pytest.raises(ValueError, match="paired_loads needs backend 'native'"):
+        make_vec_env(cfg, 0, backend="subproc")

@@ -25,6 +25,7 @@ from stable_baselines3.sac.policies import SACPolicy
 import acld_gym  # noqa: F401  (registers the env ids)
 from acld_gym.util.validate import check_real
 
+from ..agent import actor_parts
 from ..features import DirectionFeatures, direction_features
 
 __all__ = [
@@ -59,15 +60,20 @@ class QuadraticFeatures(BaseFeaturesExtractor):
 
 
 class DropLast(BaseFeaturesExtractor):
-    """The observation without its last entry: the actor of an asymmetric actor-critic,
-    which must not read the privileged log(reward scale) the env appends
-    (``observe_reward_scale``, :mod:`acld_gym.envs.scale`)."""
+    """The observation without its last ``n`` entries (default 1): the actor of an
+    asymmetric actor-critic, which must not read the privileged entries the training env
+    appends, the log(reward scale) (``observe_reward_scale``, :mod:`acld_gym.envs.scale`)
+    and any after it."""
 
-    def __init__(self, observation_space: spaces.Box):
-        super().__init__(observation_space, features_dim=int(observation_space.shape[0]) - 1)
+    def __init__(self, observation_space: spaces.Box, n: int = 1):
+        dim = int(observation_space.shape[0])
+        if not (isinstance(n, int) and 1 <= n < dim):
+            raise ValueError(f"n: expected an integer in [1, {dim - 1}], got {n!r}")
+        self.n = n
+        super().__init__(observation_space, features_dim=dim - n)
 
     def forward(self, observations: torch.Tensor) -> torch.Tensor:
-        return observations[:, :-1]
+        return observations[:, : -self.n]
 
 
 class ScaledQuadraticFeatures(QuadraticFeatures):
@@ -125,14 +131,42 @@ class SplitCriticPolicy(ActorCriticPolicy):
     (:class:`QuadraticFeatures`; with ``net_arch: {vf: []}`` the value is a quadratic
     form of the observation, suited to a linear-quadratic problem), ``"direction"``
     (:class:`train.features.DirectionFeatures`) or ``"flatten"``. The actor sees the
-    (flattened) observation, e.g. linear with ``net_arch: {pi: []}``."""
+    (flattened) observation, e.g. linear with ``net_arch: {pi: []}``.
+    ``antithetic_noise`` (a ``policy_kwargs`` key, with ``use_sde``): gSDE's noise in
+    antithetic pairs of sub-envs (:meth:`reset_noise`)."""
 
-    def __init__(self, *args, critic_features: str = "quadratic", **kwargs):
+    def __init__(
+        self, *args, critic_features: str = "quadratic", antithetic_noise: bool = False, **kwargs
+    ):
         if critic_features not in CRITIC_FEATURES:
             raise ValueError(f"critic_features must be one of {list(CRITIC_FEATURES)}")
+        if not isinstance(antithetic_noise, bool) or (
+            antithetic_noise and not kwargs.get("use_sde", False)
+        ):
+            raise ValueError(
+                f"antithetic_noise must be true or false, and true with use_sde only; "
+                f"got {antithetic_noise!r}"
+            )
         self.critic_features = critic_features
+        self.antithetic_noise = antithetic_noise
         kwargs["share_features_extractor"] = False
         super().__init__(*args, **kwargs)
+
+    def reset_noise(self, n_envs: int = 1) -> None:
+        """gSDE's new noise on the actor's gains, one matrix E per sub-env; with
+        ``antithetic_noise`` in pairs, sub-env ``2i + 1`` acting with ``-E`` where ``2i``
+        acts with ``E`` (with sub-envs seeded in pairs, ``paired_loads`` of
+        :class:`train.config.TrainConfig`, the pair's load-driven returns cancel in the
+        policy gradient, as in the random search's antithetic differences)."""
+        super().reset_noise(n_envs)
+        if not self.antithetic_noise:
+            return
+        if n_envs % 2:
+            raise ValueError(f"antithetic_noise needs an even number of sub-envs, got {n_envs}")
+        dist = self.action_dist
+        e = dist.exploration_matrices.detach().clone()
+        e[1::2] = -e[0::2]
+        dist.exploration_matrices = e
 
     def _build_mlp_extractor(self) -> None:
         self.vf_features_extractor = CRITIC_FEATURES[self.critic_features](self.observation_space)
@@ -147,6 +181,7 @@ class SplitCriticPolicy(ActorCriticPolicy):
     def _get_constructor_parameters(self) -> dict:
         data = super()._get_constructor_parameters()
         data["critic_features"] = self.critic_features
+        data["antithetic_noise"] = self.antithetic_noise
         return data
 
 
@@ -245,9 +280,10 @@ class SB3Policy:
             x = direction_features(x).astype(np.float32)
         if self.obs_norm is not None:
             x = self.obs_norm.normalize_obs(x)
-        if self.model.policy.features_extractor_class is DropLast:  # an asymmetric agent: its
-            # actor drops the last entry (log c) the plain env does not have
-            x = np.concatenate([x, np.zeros((len(x), 1), np.float32)], axis=1)
+        extractor = actor_parts(self.model)[0]
+        if isinstance(extractor, DropLast):  # an asymmetric agent: its actor drops the
+            # privileged entries (log c, ...) the plain env does not have
+            x = np.concatenate([x, np.zeros((len(x), extractor.n), np.float32)], axis=1)
         import torch
 
         with torch.no_grad():  # the deterministic action of model.predict, without its checks

@@ -1,0 +1,40 @@
+"""``benchmarks/antithetic.py``: the probe is the recipe with the package's paired loads
+and antithetic gain noise (each switchable), one run per seed, and its training env and
+policy pair the sub-envs as it says."""
+
+import numpy as np
+import torch
+
+from tests.benchmark_scripts import load_script, tiny_model
+
+an = load_script("antithetic")
+
+
+def test_the_probe_is_the_recipe_with_pairs_and_antithetic_noise():
+    from train.config import load_config
+
+    recipe, cfg = load_config("ppo"), an.config()
+    assert cfg.paired_loads and cfg.model["policy_kwargs"]["antithetic_noise"] is True
+    assert cfg.restarts == 1 and not recipe.paired_loads
+    assert cfg.env_kwargs == recipe.env_kwargs
+    bench = load_config("ablation_ppo_antithetic")  # the same with the recipe's retry
+    assert bench.paired_loads and bench.model["policy_kwargs"] == cfg.model["policy_kwargs"]
+    off = an.config(pairs=False, antithetic=False, reward_scale="lqr", ent_coef=0.05)
+    assert not off.paired_loads and off.model["policy_kwargs"]["antithetic_noise"] is False
+    assert off.env_kwargs["reward_scale"] == "lqr" and off.model["ent_coef"] == 0.05
+
+
+def test_the_pairs_see_one_load_and_opposite_gain_noise():
+    from dataclasses import replace
+
+    from train.vec import make_vec_env
+
+    venv = make_vec_env(replace(an.config(), n_envs=4), 0)
+    obs = venv.reset()
+    venv.close()
+    np.testing.assert_array_equal(obs[0::2], obs[1::2])
+    assert not np.array_equal(obs[0], obs[2])
+    model, _ = tiny_model(an.config())
+    model.policy.reset_noise(4)
+    e = model.policy.action_dist.exploration_matrices
+    assert torch.equal(e[1::2], -e[0::2])

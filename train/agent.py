@@ -177,6 +177,18 @@ class ActorProgram:
         return np.clip(z, -1.0, 1.0).reshape(-1, 1)
 
 
+def actor_extractor(model):
+    """The features extractor of an SB3 model's deterministic actor (what
+    :func:`actor_parts` returns first), whatever the layers after it."""
+    pol = model.policy
+    actor = getattr(pol, "actor", None)
+    if actor is not None:  # SAC, TQC, CrossQ, TD3
+        return actor.features_extractor
+    if hasattr(pol, "mlp_extractor"):  # PPO / A2C
+        return pol.pi_features_extractor
+    return pol.features_extractor  # ARS (sb3-contrib)
+
+
 def actor_parts(model) -> tuple[Any, list, bool]:
     """The deterministic actor of an SB3 model as ``(features extractor, layers in order,
     squash)``: ``squash`` is True where SB3 applies a tanh after the last layer. One walk
@@ -185,21 +197,18 @@ def actor_parts(model) -> tuple[Any, list, bool]:
     import torch.nn as nn
 
     pol = model.policy
+    extractor = actor_extractor(model)
     actor = getattr(pol, "actor", None)
     if actor is not None and hasattr(actor, "latent_pi"):  # SAC, TQC, CrossQ: tanh(mu(latent))
         mu = actor.mu
         layers = [*actor.latent_pi, *(mu if isinstance(mu, nn.Sequential) else [mu])]
-        return actor.features_extractor, layers, True
+        return extractor, layers, True
     if actor is not None and hasattr(actor, "mu"):  # TD3: mu is the whole net, Tanh last
-        return actor.features_extractor, list(actor.mu), False
+        return extractor, list(actor.mu), False
     if not hasattr(pol, "mlp_extractor"):  # ARS (sb3-contrib): action_net is the actor
-        return pol.features_extractor, list(pol.action_net), False
+        return extractor, list(pol.action_net), False
     # PPO / A2C: Gaussian mean, clipped to the box
-    return (
-        pol.pi_features_extractor,
-        [*pol.mlp_extractor.policy_net, pol.action_net],
-        bool(pol.squash_output),
-    )
+    return extractor, [*pol.mlp_extractor.policy_net, pol.action_net], bool(pol.squash_output)
 
 
 def export_sb3(model, obs_norm=None) -> ActorProgram:

@@ -25,7 +25,7 @@ from stable_baselines3.sac.policies import SACPolicy
 import acld_gym  # noqa: F401  (registers the env ids)
 from acld_gym.util.validate import check_real
 
-from ..agent import actor_parts
+from ..agent import actor_extractor
 from ..features import DirectionFeatures, direction_features
 
 __all__ = [
@@ -280,7 +280,7 @@ class SB3Policy:
             x = direction_features(x).astype(np.float32)
         if self.obs_norm is not None:
             x = self.obs_norm.normalize_obs(x)
-        extractor = actor_parts(self.model)[0]
+        extractor = actor_extractor(self.model)
         if isinstance(extractor, DropLast):  # an asymmetric agent: its actor drops the
             # privileged entries (log c, ...) the plain env does not have
             x = np.concatenate([x, np.zeros((len(x), extractor.n), np.float32)], axis=1)

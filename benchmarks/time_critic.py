@@ -44,7 +44,7 @@ from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 from stable_baselines3.common.vec_env import VecEnvWrapper, VecNormalize
 
 import train.bench.sb3_train as sb3_train
-from train.bench.sb3_policies import CRITIC_FEATURES, DropLast, SplitCriticPolicy
+from train.bench.sb3_policies import DropLast, QuadraticFeatures, SplitCriticPolicy
 from train.vec import VecWhiten, make_vec_env
 
 #: Time constants [s] of the critic's time basis b_k(r) = 1 - exp(-r T / tau_k).
@@ -98,24 +98,22 @@ def make_time_vec_env(cfg, seed: int, env_id: str):
 
 class TimeScaledQuadraticFeatures(BaseFeaturesExtractor):
     r"""Features :math:`b_k(r)\,[1, w, w w^T]` of the observation ``[u, log c, r]``,
-    :math:`w = u/\sqrt{c}`, for every k (:data:`TAUS`): each vanishes at r = 0."""
+    :math:`w = u/\sqrt{c}` (``[w, w w^T]``: :class:`train.bench.sb3_policies.QuadraticFeatures`),
+    for every k (:data:`TAUS`): each vanishes at r = 0."""
 
     def __init__(self, observation_space: spaces.Box):
         self.d = int(observation_space.shape[0]) - 2
-        q = 1 + self.d + self.d * self.d
-        super().__init__(observation_space, features_dim=q * len(TAUS))
+        quadratic = QuadraticFeatures(spaces.Box(-np.inf, np.inf, (self.d,), np.float32))
+        super().__init__(observation_space, features_dim=(1 + quadratic.features_dim) * len(TAUS))
+        self.quadratic = quadratic
         self.register_buffer("tau", torch.tensor(TAUS, dtype=torch.float32))
 
     def forward(self, obs: torch.Tensor) -> torch.Tensor:
         d = self.d
         w = obs[:, :d] * torch.exp(-0.5 * obs[:, d : d + 1])
-        outer = (w.unsqueeze(2) * w.unsqueeze(1)).flatten(1)
-        q = torch.cat([torch.ones_like(w[:, :1]), w, outer], dim=-1)
+        q = torch.cat([torch.ones_like(w[:, :1]), self.quadratic(w)], dim=-1)
         b = 1.0 - torch.exp(-obs[:, d + 1 : d + 2] / self.tau)  # r T / tau with T = 1 s
         return (q.unsqueeze(2) * b.unsqueeze(1)).flatten(1)
-
-
-CRITIC_FEATURES.setdefault("time_scaled_quadratic", TimeScaledQuadraticFeatures)
 
 
 class TimeCriticPolicy(SplitCriticPolicy):
@@ -125,15 +123,13 @@ class TimeCriticPolicy(SplitCriticPolicy):
     def __init__(self, *args, **kwargs):
         kwargs.setdefault("features_extractor_class", DropLast)
         kwargs.setdefault("features_extractor_kwargs", {"n": 2})
-        super().__init__(*args, critic_features="time_scaled_quadratic", **kwargs)
+        super().__init__(*args, **kwargs)
         with torch.no_grad():
             self.value_net.bias.zero_()
         self.value_net.bias.requires_grad_(False)
 
-    def _get_constructor_parameters(self) -> dict:
-        data = super()._get_constructor_parameters()
-        data.pop("critic_features", None)
-        return data
+    def make_critic_extractor(self) -> TimeScaledQuadraticFeatures:
+        return TimeScaledQuadraticFeatures(self.observation_space)
 
 
 def config(gamma: float | None = None):

@@ -168,8 +168,13 @@ class SplitCriticPolicy(ActorCriticPolicy):
         e[1::2] = -e[0::2]
         dist.exploration_matrices = e
 
+    def make_critic_extractor(self) -> BaseFeaturesExtractor:
+        """The critic's features extractor on the observation space: ``critic_features``'
+        class (:data:`CRITIC_FEATURES`); a subclass may build another."""
+        return CRITIC_FEATURES[self.critic_features](self.observation_space)
+
     def _build_mlp_extractor(self) -> None:
-        self.vf_features_extractor = CRITIC_FEATURES[self.critic_features](self.observation_space)
+        self.vf_features_extractor = self.make_critic_extractor()
         self.mlp_extractor = _SplitMlp(
             self.features_dim,
             self.vf_features_extractor.features_dim,
@@ -251,6 +256,9 @@ class SB3Policy:
         self.features = features
         self.transform = None if transform is None else np.asarray(transform, np.float64)
         self.voltage_map = VoltageMap() if voltage_map is None else voltage_map
+        extractor = actor_extractor(model)  # an asymmetric agent's actor drops the
+        # privileged entries (log c, ...) the plain env does not have: predict pads them
+        self.privileged = extractor.n if isinstance(extractor, DropLast) else 0
 
     @property
     def residual(self) -> str | None:
@@ -280,10 +288,8 @@ class SB3Policy:
             x = direction_features(x).astype(np.float32)
         if self.obs_norm is not None:
             x = self.obs_norm.normalize_obs(x)
-        extractor = actor_extractor(self.model)
-        if isinstance(extractor, DropLast):  # an asymmetric agent: its actor drops the
-            # privileged entries (log c, ...) the plain env does not have
-            x = np.concatenate([x, np.zeros((len(x), extractor.n), np.float32)], axis=1)
+        if self.privileged:
+            x = np.concatenate([x, np.zeros((len(x), self.privileged), np.float32)], axis=1)
         import torch
 
         with torch.no_grad():  # the deterministic action of model.predict, without its checks

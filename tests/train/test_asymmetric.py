@@ -151,7 +151,7 @@ def test_drop_last_drops_n_privileged_entries_and_predict_pads_them():
     assert np.allclose(np.ravel(v), 120 * np.clip(a, -1, 1).ravel())  # the padding unread
 
 
-def test_antithetic_noise_comes_in_pairs_and_needs_gsde():
+def test_antithetic_noise_comes_in_pairs_and_needs_gsde(tmp_path):
     from stable_baselines3 import PPO
     from stable_baselines3.common.env_util import make_vec_env
 
@@ -178,9 +178,18 @@ def test_antithetic_noise_comes_in_pairs_and_needs_gsde():
         acts = pol(obs)[0]
         mean = pol._predict(obs, deterministic=True)
     assert torch.allclose(acts[0::2] - mean[0::2], mean[1::2] - acts[1::2], atol=1e-6)
-    with pytest.raises(ValueError, match="even number of sub-envs"):
+    before = pol.action_dist.exploration_matrices.clone()
+    with pytest.raises(ValueError, match="1 or an even number of noise draws.*got 3"):
         pol.reset_noise(3)
+    assert torch.equal(pol.action_dist.exploration_matrices, before)  # left as it was
+    pol.reset_noise(1)  # one draw has no pair: gSDE's own (SB3's load makes this call)
+    assert pol.action_dist.exploration_matrices.shape[0] == 1
     assert pol._get_constructor_parameters()["antithetic_noise"] is True
+    model.save(tmp_path / "anti.zip")  # rl-zoo3 and SB3 users load such a model
+    loaded = PPO.load(tmp_path / "anti.zip", device="cpu")
+    assert loaded.policy.antithetic_noise is True
+    with torch.no_grad():
+        assert torch.equal(loaded.policy._predict(obs, deterministic=True), mean)
     plain = PPO(SplitCriticPolicy, venv, n_steps=16, use_sde=True, seed=0, device="cpu")
     plain.policy.reset_noise(4)  # default: independent noise per sub-env
     e = plain.policy.action_dist.exploration_matrices

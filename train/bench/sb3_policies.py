@@ -157,12 +157,18 @@ class SplitCriticPolicy(ActorCriticPolicy):
         ``antithetic_noise`` in pairs, sub-env ``2i + 1`` acting with ``-E`` where ``2i``
         acts with ``E`` (with sub-envs seeded in pairs, ``paired_loads`` of
         :class:`train.config.TrainConfig`, the pair's load-driven returns cancel in the
-        policy gradient, as in the random search's antithetic differences)."""
+        policy gradient, as in the random search's antithetic differences). A single draw
+        (``n_envs=1``: SB3's ``PPO.load`` and a one-env rollout) has no pair and is gSDE's
+        own; any other odd number is a ``ValueError``, before a draw, so the policy's noise
+        is left as it was."""
+        if self.antithetic_noise and n_envs % 2 and n_envs != 1:
+            raise ValueError(
+                f"antithetic_noise needs 1 or an even number of noise draws (n_envs: sub-envs, "
+                f"or PPO's batch_size), got {n_envs}"
+            )
         super().reset_noise(n_envs)
-        if not self.antithetic_noise:
+        if not self.antithetic_noise or n_envs == 1:
             return
-        if n_envs % 2:
-            raise ValueError(f"antithetic_noise needs an even number of sub-envs, got {n_envs}")
         dist = self.action_dist
         e = dist.exploration_matrices.detach().clone()
         e[1::2] = -e[0::2]

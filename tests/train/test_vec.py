@@ -1,6 +1,5 @@
 """train.vec: the action map, the shaping potential and the wrapped training env."""
 
-
 import numpy as np
 import pytest
 import scipy.linalg as sla

@@ -140,20 +140,8 @@ def test_parse_load_case_names_the_choices(value):
 def test_base_applies_the_recipe_under_a_files_own_settings(tmp_path):
     """``base:`` names a recipe; the file's settings go on top, nested mappings key by key."""
     _, ppo = read_config("ppo")
-    _, independent = read_config("ablation_ppo_independent")  # acld-gym 0.8.0-0.14.0's recipe
-    assert independent == {
-        **ppo,
-        "paired_loads": False,
-        "model": {
-            **ppo["model"],
-            "ent_coef": 0.03,
-            "policy_kwargs": {**ppo["model"]["policy_kwargs"], "antithetic_noise": False},
-        },
-    }
-    _, adopted = read_config("ablation_ppo_antithetic_ent_05")  # the probe 0.15.0 adopted
-    assert adopted == {**independent, "paired_loads": True, "model": {**ppo["model"]}}
-    _, one_run = read_config("ablation_ppo_one_run")  # acld-gym 0.7.0's recipe: one run
-    assert one_run == {**independent, "restarts": 1, "restart_above": None, "select": None}
+    _, one_run = read_config("ablation_ppo_one_run")  # acld-gym 0.7.0's recipe: ppo, one run
+    assert one_run == {**ppo, "restarts": 1, "restart_above": None, "select": None}
     _, old = read_config("ablation_ppo_ent_01")  # 0.6.0's: chained on 0.7.0's, one change
     assert old == {**one_run, "model": {**one_run["model"], "ent_coef": 0.01}}
     _, ablation = read_config("ablation_ppo_lambda_095")  # chained: on 0.6.0's recipe

@@ -37,14 +37,18 @@ def one_run(policy, policy_kwargs: dict | None = None, drop: Iterable[str] = (),
     return dataclasses.replace(cfg, model=new, restarts=1, restart_above=None)
 
 
-def run_recipe(cfg, seed: int, env_id: str = "ACLDBeam-v1", **settings) -> dict:
+def run_recipe(
+    cfg, seed: int, env_id: str = "ACLDBeam-v1", make_env: Callable | None = None, **settings
+) -> dict:
     """Train one run of ``cfg`` (a :class:`train.config.TrainConfig`) for ``seed`` and
-    evaluate it; ``settings`` are reported after the seed."""
+    evaluate it; ``make_env`` is the training env's factory if not the recipe's
+    (:func:`train.bench.sb3_train.train_sb3`); ``settings`` are reported after the seed."""
     from train.bench.evaluate import ise_rel_lqr
     from train.bench.sb3_train import train_sb3
 
     t0 = time.perf_counter()
-    policy, record = train_sb3(cfg, seed, env_id)
+    factory = {} if make_env is None else {"make_env": make_env}
+    policy, record = train_sb3(cfg, seed, env_id, **factory)
     wall = time.perf_counter() - t0
     rel = ise_rel_lqr(policy, env_id)
     return {

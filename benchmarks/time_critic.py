@@ -43,7 +43,6 @@ from probe import EPISODE_STEPS, one_run, run_recipe, seeds_main  # benchmarks/p
 from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 from stable_baselines3.common.vec_env import VecEnvWrapper, VecNormalize
 
-import train.bench.sb3_train as sb3_train
 from train.bench.sb3_policies import DropLast, QuadraticFeatures, SplitCriticPolicy
 from train.vec import VecWhiten, make_vec_env
 
@@ -141,11 +140,7 @@ def config(gamma: float | None = None):
 def run(seed: int, gamma: float | None = None, env_id: str = "ACLDBeam-v1") -> dict:
     """Train one run of seed ``seed`` and evaluate it."""
     cfg = config(gamma)
-    plain, sb3_train.make_vec_env = sb3_train.make_vec_env, make_time_vec_env
-    try:  # the probe's training env for this run
-        return run_recipe(cfg, seed, env_id, gamma=cfg.gamma)
-    finally:
-        sb3_train.make_vec_env = plain
+    return run_recipe(cfg, seed, env_id, make_env=make_time_vec_env, gamma=cfg.gamma)
 
 
 def main(argv: list[str] | None = None) -> int:

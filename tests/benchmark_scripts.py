@@ -20,15 +20,17 @@ def load_script(name: str) -> ModuleType:
     return module
 
 
-def tiny_model(cfg, env_id: str = "ACLDBeam-v1"):
+def tiny_model(cfg, env_id: str = "ACLDBeam-v1", make_env=None):
     """The SB3 model of a probe's config ``cfg`` on 4 sub-envs with minibatches of 256,
-    built and not trained, and the training env's observation width."""
+    built and not trained, on the training env of ``make_env`` (the recipe's,
+    :func:`train.vec.make_vec_env`, if None), and the training env's observation width."""
     import dataclasses
 
     import train.bench.sb3_train as sb3_train
+    from train.vec import make_vec_env
 
     cfg = dataclasses.replace(cfg, n_envs=4, model={**cfg.model, "batch_size": 256})
-    venv = sb3_train.make_vec_env(cfg, 0, env_id)
+    venv = (make_vec_env if make_env is None else make_env)(cfg, 0, env_id)
     try:
         return sb3_train.make_model(cfg, venv, 0), venv.observation_space.shape[0]
     finally:

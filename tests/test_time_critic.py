@@ -34,11 +34,8 @@ def test_the_remaining_time_is_appended_and_zero_at_the_time_limit():
         assert "truncated after 50 steps" in str(exc)
 
 
-def test_the_critic_vanishes_at_the_end_is_scale_invariant_and_unread_by_the_actor(monkeypatch):
-    import train.bench.sb3_train as sb3_train
-
-    monkeypatch.setattr(sb3_train, "make_vec_env", tc.make_time_vec_env)
-    model, width = tiny_model(tc.config())
+def test_the_critic_vanishes_at_the_end_is_scale_invariant_and_unread_by_the_actor():
+    model, width = tiny_model(tc.config(), make_env=tc.make_time_vec_env)
     assert width == 11  # 9 + log c + r
     pol = model.policy
     with torch.no_grad():

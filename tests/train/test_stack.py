@@ -154,3 +154,25 @@ def test_documented_benchmark_commands_parse():
         args = bench_parser().parse_args(argv)
         for spec in [*(args.algos or []), *args.config]:
             read_config(spec)
+
+
+def test_train_sb3_trains_on_the_env_its_factory_builds_and_checks_its_layers():
+    """``train_sb3(make_env=...)``: a probe's own training env (benchmarks/time_critic.py)
+    without patching the module; the factory is called once with the run's config, seed and
+    env id, and a factory that does not return the recipe's outer ``VecNormalize`` is
+    refused by name."""
+    from tests.train.tiny_sb3 import tiny_ppo
+    from train.bench.sb3_train import train_sb3
+    from train.vec import make_vec_env
+
+    calls = []
+
+    def factory(cfg, seed, env_id):
+        calls.append((cfg, seed, env_id))
+        return make_vec_env(cfg, seed, env_id)
+
+    cfg = tiny_ppo()
+    _, record = train_sb3(cfg, 3, "ACLDBeam-v1", make_env=factory)
+    assert calls == [(cfg, 3, "ACLDBeam-v1")] and record["steps"] >= cfg.timesteps
+    with pytest.raises(TypeError, match="make_env must return a VecNormalize.*VecWhiten"):
+        train_sb3(cfg, 3, "ACLDBeam-v1", make_env=lambda c, s, e: make_vec_env(c, s, e).venv)

@@ -7,11 +7,13 @@ from __future__ import annotations
 
 import copy
 import inspect
+from collections.abc import Callable
 from contextlib import contextmanager
 
 import numpy as np
 import torch
 import torch.nn as nn
+from stable_baselines3.common.vec_env import VecNormalize
 
 import acld_gym  # noqa: F401  (registers the env ids)
 from acld_gym.wrappers import whitening
@@ -341,15 +343,28 @@ def train_sb3(
     seed: int,
     env_id: str,
     callback: CurveCallback | None = None,
+    *,
+    make_env: Callable[[TrainConfig, int, str], VecNormalize] = make_vec_env,
 ) -> tuple[SB3Policy, dict]:
     """Train an SB3 / sb3-contrib algorithm for ``cfg.timesteps`` env steps (with
     ``cfg.whiten_steps``: first that many steps of the initial policy, from which the
     whitening is estimated, then the rest of the budget of training; with
-    ``cfg.distill``: the DAgger start first, its env steps not counted)."""
+    ``cfg.distill``: the DAgger start first, its env steps not counted).
+
+    ``make_env(cfg, seed, env_id)`` builds the training env: :func:`train.vec.make_vec_env`
+    unless a probe wraps its own (it must return the same layers, ``VecNormalize`` over
+    :class:`train.vec.VecWhiten` where ``cfg.whiten_steps`` is set); the evaluation and the
+    validation checks run on the plain env whatever it is."""
     from stable_baselines3.common.callbacks import BaseCallback
 
     torch.set_num_threads(1)
-    venv = make_vec_env(cfg, seed, env_id)
+    venv = make_env(cfg, seed, env_id)
+    if not isinstance(venv, VecNormalize):
+        venv.close()
+        raise TypeError(
+            f"make_env must return a VecNormalize (train.vec.make_vec_env's outer layer), "
+            f"got {type(venv).__name__}"
+        )
     model = make_model(cfg, venv, seed)
     ent_sched = ent_coef_schedule(cfg)
     vmap = VoltageMap(cfg.residual, cfg.mesh, cfg.action_headroom)

@@ -220,8 +220,10 @@ class TrainConfig:
         fields of :class:`train.bench.search.RandomSearch`). SB3's ``learning_rate`` and
         ``clip_range``, and PPO's ``ent_coef``, may be ``{linear: [start, end]}``, linear
         in the progress from ``start`` to ``end`` (``ent_coef``: set before each update,
-        :func:`train.bench.sb3_train.ent_coef_schedule`); ``policy_kwargs.activation_fn``
-        is given by name.
+        :func:`train.bench.sb3_train.ent_coef_schedule`); ``learning_rate`` also
+        ``{linear: [start, end], warmup: w}``, scaled up from 0 over the first fraction
+        ``w`` of training (:class:`train.bench.sb3_train.LinearSchedule`);
+        ``policy_kwargs.activation_fn`` is given by name.
     eval_points : int
         Learning-curve points (evaluations) over the budget, besides the one at step 0
         (log-spaced, :class:`train.bench.evaluate.eval_schedule`).

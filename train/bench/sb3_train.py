@@ -43,21 +43,45 @@ __all__ = [
 
 
 class LinearSchedule:
-    """An SB3 schedule (of the progress remaining, 1 -> 0) linear from ``start`` to ``end``:
-    the value of ``{linear: [start, end]}`` in a config."""
+    r"""An SB3 schedule (of the progress remaining, 1 -> 0) linear from ``start`` to ``end``,
+    with an optional linear warm-up: the value of ``{linear: [start, end]}`` (or
+    ``{linear: [start, end], warmup: w}``) in a config.
 
-    def __init__(self, start: float, end: float):
-        self.start, self.end = start, end
+    With progress :math:`p = 1 - \text{remaining}`, clipped to [0, 1], the value is
+
+    .. math:: v(p) = \min(1, p / w)\,\bigl(s + (e - s)\,p\bigr),
+
+    the linear schedule scaled up from 0 over the first fraction ``w`` of training
+    (``w = 0``: no warm-up, the plain linear schedule). The clip matters at the end: SB3
+    reports ``1 - steps / budget``, below 0 after a last rollout that overshoots the
+    budget, where the unclipped line would go past ``end`` (below 0 for a rate decaying to
+    0: a step up the loss)."""
+
+    def __init__(self, start: float, end: float, warmup: float = 0.0):
+        if not 0.0 <= warmup < 1.0:
+            raise ValueError(f"warmup: a fraction of training in [0, 1), got {warmup!r}")
+        self.start, self.end, self.warmup = start, end, warmup
 
     def __call__(self, progress_remaining: float) -> float:
-        return self.end + (self.start - self.end) * progress_remaining
+        remaining = min(max(progress_remaining, 0.0), 1.0)
+        value = self.end + (self.start - self.end) * remaining
+        done = 1.0 - remaining
+        return value if done >= self.warmup else value * done / self.warmup
 
 
 def _schedule(key: str, value: dict) -> LinearSchedule:
-    """The schedule of a ``{linear: [start, end]}`` value of the model key ``key``."""
-    if set(value) != {"linear"} or len(value["linear"]) != 2:
-        raise ValueError(f"{key}: a number or {{linear: [start, end]}}, got {value!r}")
-    return LinearSchedule(*map(float, value["linear"]))
+    """The schedule of a ``{linear: [start, end]}`` value of the model key ``key``
+    (``warmup: w`` added: :class:`LinearSchedule`'s warm-up, for ``learning_rate``)."""
+    keys = {"linear", "warmup"} if key == "learning_rate" else {"linear"}
+    if not ({"linear"} <= set(value) <= keys) or len(value["linear"]) != 2:
+        form = "{linear: [start, end]} or {linear: [start, end], warmup: w}"
+        if key != "learning_rate":
+            form = "{linear: [start, end]}"
+        raise ValueError(f"{key}: a number or {form}, got {value!r}")
+    try:
+        return LinearSchedule(*map(float, value["linear"]), float(value.get("warmup", 0.0)))
+    except ValueError as exc:
+        raise ValueError(f"{key}: {exc}") from None
 
 
 def _resolve_policy_kwargs(kwargs: dict) -> dict:

@@ -54,6 +54,7 @@ def test_each_ppo_update_uses_the_scheduled_rate_and_the_last_one_zero(monkeypat
         ({"linear": [3e-3, 0.0], "warmup": 1.0}, r"learning_rate: warmup: .*\[0, 1\), got 1.0"),
         ({"linear": [3e-3, 0.0], "warmup": -0.1}, r"learning_rate: warmup"),
         ({"linear": [3e-3, 0.0], "warm": 0.1}, r"learning_rate: a number or"),
+        ({"linear": [3e-3, 0.0], "warmup": None}, r"learning_rate: float\(\) argument"),
         ({"linear": [3e-3]}, r"learning_rate: a number or"),
     ],
 )

@@ -72,15 +72,14 @@ class LinearSchedule:
 def _schedule(key: str, value: dict) -> LinearSchedule:
     """The schedule of a ``{linear: [start, end]}`` value of the model key ``key``
     (``warmup: w`` added: :class:`LinearSchedule`'s warm-up, for ``learning_rate``)."""
-    keys = {"linear", "warmup"} if key == "learning_rate" else {"linear"}
+    warmup = key == "learning_rate"
+    keys = {"linear", "warmup"} if warmup else {"linear"}
     if not ({"linear"} <= set(value) <= keys) or len(value["linear"]) != 2:
-        form = "{linear: [start, end]} or {linear: [start, end], warmup: w}"
-        if key != "learning_rate":
-            form = "{linear: [start, end]}"
+        form = "{linear: [start, end]}" + (" or {linear: [start, end], warmup: w}" * warmup)
         raise ValueError(f"{key}: a number or {form}, got {value!r}")
     try:
         return LinearSchedule(*map(float, value["linear"]), float(value.get("warmup", 0.0)))
-    except ValueError as exc:
+    except (TypeError, ValueError) as exc:
         raise ValueError(f"{key}: {exc}") from None
 
 

@@ -29,6 +29,7 @@ from acld_gym.physics.loads import thesis_load
 from acld_gym.physics.plant import Plant
 from acld_gym.physics.truth import MESHES
 from acld_gym.physics.truth import plant as truth_plant
+from acld_gym.util.blas import one_blas_thread
 
 __all__ = ["NominalDesign", "nominal_design", "SENSOR_NOISE_M"]
 
@@ -103,11 +104,22 @@ def nominal_design(
     """Nominal design of the ``mesh`` plant (:data:`acld_gym.physics.truth.MESHES`) sampled at
     ``dt``, with the design order :data:`acld_gym.design.pipeline.DESIGN_ORDER` and the Kalman
     filter's model-error noise ``model_std`` (cached: the env, its vector version and
-    the baselines share it)."""
+    the baselines share it).
+
+    Built on one BLAS thread (:mod:`acld_gym.util.blas`) whatever the caller's setting: on
+    some CPUs' kernels one thread and two round differently (an AMD EPYC with OpenBLAS's
+    Haswell kernels), and the design is cached, so the env's observer and scales would
+    otherwise depend on the threads of whichever call built it first."""
     if basis not in BASES:
         raise ValueError(f"basis must be one of {list(BASES)}, got {basis!r}")
     if mesh not in MESHES:
         raise ValueError(f"mesh must be one of {list(MESHES)}, got {mesh!r}")
+    with one_blas_thread():
+        return _build(dt, substeps, sensor_std, load_std, mesh, basis, model_std)
+
+
+def _build(dt, substeps, sensor_std, load_std, mesh, basis, model_std) -> NominalDesign:
+    """:func:`nominal_design`'s work, its arguments checked."""
     d = design(truth_plant(mesh, dt), order=DESIGN_ORDER[mesh], basis=basis)
     A, B, E, Cy = d.plant
     sd = discretize(A, B, E, dt, substeps)

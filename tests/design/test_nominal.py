@@ -34,3 +34,28 @@ def test_lqr_gain_stabilizes_and_follows_its_weight(nom):
     ]
     assert max(rho) < 1.0
     assert np.linalg.norm(nom.lqr_gain(THESIS_LQR_WEIGHT / 100)) < np.linalg.norm(nom.lqr_gain())
+
+
+def test_the_design_is_the_same_whatever_the_callers_blas_threads():
+    """The design is cached, so the call that builds it first sets the env's observer and
+    scales for the whole process: it is built on one BLAS thread whatever the caller's
+    setting. On an AMD EPYC with OpenBLAS's Haswell kernels, one thread and two give
+    scales one ulp apart; here the public builder under two threads must equal the same
+    build under one, bit for bit (on kernels that never differ this holds trivially)."""
+    from threadpoolctl import threadpool_limits
+
+    from acld_gym.design import nominal
+
+    build = nominal.nominal_design.__wrapped__  # the builder behind the cache
+    with threadpool_limits(limits=1, user_api="blas"):
+        one = build(mesh="thesis")
+    with threadpool_limits(limits=2, user_api="blas"):
+        two = build(mesh="thesis")
+
+    def arrays(d):
+        return [d.plant.Ad, d.reduced.Ad, d.reduced.Bd, d.kalman.Lc, d.kalman.Lp]
+
+    for a, b in zip(arrays(one), arrays(two), strict=True):
+        assert np.array_equal(a, b)
+    assert np.array_equal(one.thesis.Lp, two.thesis.Lp)  # the two that differed there
+    assert np.array_equal(one.xr_scale, two.xr_scale)

@@ -242,6 +242,27 @@ def test_runs_at_once_are_the_runs_one_after_another(restart_above, trained):
     assert r2["train_cpu_seconds"] > 0.5 * r1["train_cpu_seconds"] > 0
 
 
+def test_a_run_in_this_process_has_one_blas_thread_as_a_worker_has(monkeypatch):
+    """Whatever the caller's BLAS threads, a run trains on one, as a worker process's does:
+    on some CPUs' kernels one thread and two round differently, so a run would otherwise
+    depend on how it was called (an AMD EPYC with OpenBLAS's Haswell kernels: the test
+    above failed there by one ulp of a validation cost)."""
+    from threadpoolctl import threadpool_info, threadpool_limits
+
+    seen = []
+
+    def fake_train(cfg_, seed, env_id, timed):
+        seen.append([d["num_threads"] for d in threadpool_info() if d["user_api"] == "blas"])
+        return "policy", {"steps": cfg_.timesteps, "select": {"steps": 50, "cost": 1.0}}
+
+    monkeypatch.setattr(algos, "train_sb3", fake_train)
+    with threadpool_limits(limits=2, user_api="blas"):
+        train_algo(_cfg(restarts=1), 0, "ACLDBeam-v1")
+        after = [d["num_threads"] for d in threadpool_info() if d["user_api"] == "blas"]
+    assert seen and all(n == 1 for n in seen[0])
+    assert after == [min(2, d) for d in after]  # the caller's setting is back afterwards
+
+
 def test_runs_at_once_release_their_semaphores():
     """The worker pool's semaphores are released before ``train_algo`` returns, not when
     the garbage collector next runs: in a Ray Tune trial that is at the process's exit,

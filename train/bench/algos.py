@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import contextlib
 import gc
 import time
 from typing import Any
@@ -46,8 +45,11 @@ def _run(
     """One run: ``(policy, record, times)``, ``record["curve"]`` its learning curve (ending
     at the run's last step), ``times`` the wall and CPU time of the curve's evaluations
     (``eval_seconds``, ``eval_cpu_seconds``) and the run's whole CPU time
-    (``cpu_seconds``). ``child``: the run is a worker process's (one BLAS thread,
-    as in the command-line entry points; the policy returned without its training state)."""
+    (``cpu_seconds``). ``child``: the run is a worker process's (the policy returned
+    without its training state). Either way the run has one BLAS thread, as in the
+    command-line entry points: on some CPUs' kernels one thread and two round differently
+    (an AMD EPYC with OpenBLAS's Haswell kernels: validation costs one ulp apart, and a
+    training run amplifies that), so a run must not depend on its caller's setting."""
     times = {"eval_seconds": 0.0, "eval_cpu_seconds": 0.0}
     c0 = time.process_time()
     curve: list = []
@@ -59,7 +61,7 @@ def _run(
         times["eval_seconds"] += time.perf_counter() - w
         times["eval_cpu_seconds"] += time.process_time() - c
 
-    with one_blas_thread() if child else contextlib.nullcontext():
+    with one_blas_thread():
         policy, record = _train_once(cfg, seed, env_id, timed)
         if callback is not None and (not curve or record["steps"] > curve[-1]["steps"]):
             timed(record["steps"], policy)  # the curve reaches the run's last step

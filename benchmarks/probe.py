@@ -1,7 +1,10 @@
 """What the PPO probes of ``benchmarks/`` share (``residual_actor.py``, ``episode_noise.py``,
-``beta_actor.py``): the recipe with another policy, one run per seed (:func:`one_run`),
-trained and evaluated as the benchmark does (:func:`run_recipe`), and a command line
-printing one JSON line per seed (:func:`seeds_main`).
+``beta_actor.py``, ``time_critic.py``, ``antithetic.py``): the PPO recipe they were measured
+against, acld-gym 0.8.0-0.14.0's (:data:`BASE`; the recipe since 0.15.0 is
+``antithetic.py``'s pairs with the entropy coefficient 0.05), with another policy, one run
+per seed (:func:`one_run`), trained and evaluated as the benchmark does
+(:func:`run_recipe`), and a command line printing one JSON line per seed
+(:func:`seeds_main`).
 
 A run's line: its settings, its training wall time, its cost on 256 validation loads (the
 recipe's own check at the run's end, :func:`train.bench.evaluate.validation_cost`; LQR
@@ -20,15 +23,19 @@ from collections.abc import Callable, Iterable
 #: Env steps per episode of ACLDBeam-v1 (1 s at 1 ms).
 EPISODE_STEPS = 1000
 
+#: The config the probes change: acld-gym 0.8.0-0.14.0's PPO recipe
+#: (``train/benchmark/ablation_ppo_independent.yaml``), on which their numbers were measured.
+BASE = "ablation_ppo_independent"
+
 
 def one_run(policy, policy_kwargs: dict | None = None, drop: Iterable[str] = (), **model):
-    """``train/benchmark/ppo.yaml``'s config with ``policy`` (its ``policy_kwargs`` added to
-    the recipe's) and one run per seed, its failures reported rather than retried; the
-    keys in ``drop`` are removed from the recipe's model and policy keyword arguments, and
-    ``model`` replaces model keyword arguments."""
+    """:data:`BASE`'s config with ``policy`` (its ``policy_kwargs`` added to the base's) and
+    one run per seed, its failures reported rather than retried; the keys in ``drop`` are
+    removed from the base's model and policy keyword arguments, and ``model`` replaces model
+    keyword arguments."""
     from train.config import load_config
 
-    cfg = load_config("ppo")
+    cfg = load_config(BASE)
     drop = set(drop)
     kept = {k: v for k, v in cfg.model.items() if k not in drop}
     kwargs = {k: v for k, v in kept.get("policy_kwargs", {}).items() if k not in drop}

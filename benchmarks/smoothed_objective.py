@@ -1,18 +1,21 @@
 """The training objective as PPO sees it: smoothed by its own exploration noise.
 
-PPO's gSDE explores with noise on the actor's gains, ``a = (W_u + eps)' u`` with
-``eps ~ N(0, diag sigma^2)`` in the whitened coordinates ``u = T' z``, so what it optimizes is
-the smoothed cost :math:`J_\\sigma(W) = E_\\epsilon J(W + T \\epsilon)`, not the cost
-:math:`J(W)` of the deterministic law it is evaluated with. This script trains the PPO recipe
-(``python -m train ppo --seed S``, the same run), reads its final ``sigma`` and whitening ``T``,
-and prints :math:`J_\\sigma` of the trained law and of the shipped random-search law
-(``train/agents/vrs``) at fractions of that ``sigma``, on the same validation loads and the
-same noise draws for both (common random numbers; one gain draw per episode, where gSDE draws
-one per 64-step rollout). ``J`` is :func:`train.bench.evaluate.validation_cost`'s (the env's
-reward per load over the passive beam's). Last it prints the cost of the trained law acting
-with its stochastic policy's expected action, ``E[clip(mu + eps)]`` at the trained ``sigma``
-(:class:`_MeanActionLaw`), the other deterministic version of a clipped-Gaussian policy than
-the clipped mean the agents act with. Not a test; takes about 2 min::
+PPO's gSDE explores with noise on the actor's gains, ``a = (W_u + eps)' u`` with ``eps ~ N(0,
+diag sigma^2)`` in the whitened coordinates ``u = T' z``, so what it optimizes is the smoothed
+cost :math:`J_\\sigma(W) = E_\\epsilon J(W + T \\epsilon)`, not the cost :math:`J(W)` of the
+deterministic law it is evaluated with. This script trains a PPO recipe (``--config``: by
+default ``ablation_ppo_independent``, acld-gym 0.8.0-0.14.0's, on which its numbers in
+docs/training.md were measured, the run of ``python -m train ppo --config
+train/benchmark/ablation_ppo_independent.yaml --seed S``; ``ppo`` for today's), reads its final
+``sigma`` and whitening ``T``, and prints :math:`J_\\sigma` of the trained law and of the
+shipped random-search law (``train/agents/vrs``) at fractions of that ``sigma``, on the same
+validation loads and the same noise draws for both (common random numbers; one gain draw per
+episode, where gSDE draws one per 64-step rollout). ``J`` is
+:func:`train.bench.evaluate.validation_cost`'s (the env's reward per load over the passive
+beam's). Last it prints the cost of the trained law acting with its stochastic policy's
+expected action, ``E[clip(mu + eps)]`` at the trained ``sigma`` (:class:`_MeanActionLaw`), the
+other deterministic version of a clipped-Gaussian policy than the clipped mean the agents act
+with. Not a test; takes about 2 min::
 
     python benchmarks/smoothed_objective.py --seed 0
 """
@@ -99,6 +102,11 @@ def gain_noise_cost(W, b, dW, seeds, env_id: str = "ACLDBeam-v1") -> float:
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--seed", type=int, default=0, help="the PPO recipe's seed")
+    p.add_argument(
+        "--config",
+        default="ablation_ppo_independent",
+        help="the PPO recipe (train/benchmark/NAME.yaml; default 0.8.0-0.14.0's)",
+    )
     p.add_argument("--loads", type=int, default=256, help="validation loads")
     p.add_argument("--draws", type=int, default=4, help="noise draws per load")
     p.add_argument(
@@ -114,7 +122,7 @@ def main(argv=None) -> int:
     from train.bench.sb3_train import train_sb3
     from train.config import load_config
 
-    pol, record = train_sb3(load_config("ppo"), args.seed, "ACLDBeam-v1")
+    pol, record = train_sb3(load_config(args.config), args.seed, "ACLDBeam-v1")
     T = np.asarray(record["transform"], float)
     sigma = np.exp(pol.model.policy.log_std.detach().numpy().ravel())
     laws = {

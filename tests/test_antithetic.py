@@ -2,6 +2,8 @@
 and antithetic gain noise (each switchable), one run per seed, and its training env and
 policy pair the sub-envs as it says."""
 
+import dataclasses
+
 import numpy as np
 import torch
 
@@ -13,10 +15,21 @@ an = load_script("antithetic")
 def test_the_probe_is_the_recipe_with_pairs_and_antithetic_noise():
     from train.config import load_config
 
-    recipe, cfg = load_config("ppo"), an.config()
+    base, cfg = load_config("ablation_ppo_independent"), an.config()  # 0.8.0-0.14.0's recipe
     assert cfg.paired_loads and cfg.model["policy_kwargs"]["antithetic_noise"] is True
-    assert cfg.restarts == 1 and not recipe.paired_loads
-    assert cfg.env_kwargs == recipe.env_kwargs
+    assert cfg.restarts == 1 and not base.paired_loads
+    assert cfg.env_kwargs == base.env_kwargs and cfg.model["ent_coef"] == base.model["ent_coef"]
+    recipe, adopted = load_config("ppo"), an.config(ent_coef=0.05)  # 0.15.0's, with its critic
+    fields = {f.name for f in dataclasses.fields(recipe)} - {"model", "restarts", "restart_above"}
+    assert {f: getattr(adopted, f) for f in fields} == {f: getattr(recipe, f) for f in fields}
+    critic = {"critic_features": "negative_scaled_quadratic"}  # the recipe's other change
+    pk = {**adopted.model["policy_kwargs"], **critic}
+    assert {
+        **adopted.model,
+        "policy": "AsymmetricCriticPolicy",
+        "policy_kwargs": pk,
+    } == recipe.model
+    assert (adopted.restarts, adopted.restart_above) == (1, None)
     bench = load_config("ablation_ppo_antithetic")  # the same with the recipe's retry
     assert bench.paired_loads and bench.model["policy_kwargs"] == cfg.model["policy_kwargs"]
     off = an.config(pairs=False, antithetic=False, reward_scale="lqr", ent_coef=0.05)

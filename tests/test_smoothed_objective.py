@@ -23,8 +23,10 @@ def test_law_without_noise_is_the_agents_validation_cost(name):
     W, b = so.linear_law(agent.actor)
     seeds = validation_seeds(8)
     zero = np.zeros((len(seeds), W.size))
+    # the same law through another product order: round-off, which 1000 closed-loop steps
+    # amplify with the gains (acld-gym 0.15.0's ppo: 1.9e-9 relative; 0.14.0's within 1e-9)
     assert so.gain_noise_cost(W, b, zero, seeds) == pytest.approx(
-        validation_cost(agent, seeds=seeds), rel=1e-9
+        validation_cost(agent, seeds=seeds), rel=1e-8
     )
 
 

@@ -203,3 +203,42 @@ def test_antithetic_noise_comes_in_pairs_and_needs_gsde(tmp_path):
                 device="cpu",
                 policy_kwargs={**kw, "antithetic_noise": bad},
             )
+
+
+def test_the_negative_critic_is_never_positive_scale_invariant_and_trains_through_m():
+    """``critic_features: negative_scaled_quadratic``: V = -||M [u / sqrt(c); 1]||^2 is at
+    most 0 for every observation, up to the limit cycle's sizes; invariant to the load's
+    scale as the recipe's critic is; M takes the gradient, the fixed output layer none; it
+    takes no hidden critic layers."""
+    model = _model_with(critic_features="negative_scaled_quadratic")
+    pol = model.policy
+    rng = np.random.default_rng(0)
+    u = rng.normal(size=(64, 9)) * 10.0 ** rng.uniform(-3, 6, (64, 1))
+    obs = torch.as_tensor(np.c_[u, rng.uniform(-20, 20, 64)], dtype=torch.float32)
+    k = 5.0
+    scaled = torch.cat([obs[:, :9] * np.sqrt(k), obs[:, 9:] + np.log(k)], dim=1)
+    with torch.no_grad():
+        pol.vf_features_extractor.m.copy_(torch.randn_like(pol.vf_features_extractor.m))
+        v = pol.predict_values(obs)
+        assert torch.all(v <= 0) and torch.allclose(pol.predict_values(scaled), v, rtol=1e-4)
+    trainable = {n for n, p in pol.named_parameters() if p.requires_grad}
+    assert "vf_features_extractor.m" in trainable
+    assert not {"value_net.weight", "value_net.bias"} & trainable
+    assert float(pol.value_net.weight) == -1.0 and float(pol.value_net.bias) == 0.0
+    pol.predict_values(obs[:4]).sum().backward()
+    assert pol.vf_features_extractor.m.grad.abs().sum() > 0
+    with pytest.raises(ValueError, match="negative_scaled_quadratic.*vf: \\[\\]"):
+        _model_with(critic_features="negative_scaled_quadratic", net_arch={"pi": [], "vf": [8]})
+
+
+def test_the_negative_critic_saves_and_loads_fixed(tmp_path):
+    from stable_baselines3 import PPO
+
+    model = _model_with(critic_features="negative_scaled_quadratic")
+    model.learn(64)
+    model.save(tmp_path / "m.zip")
+    back = PPO.load(tmp_path / "m.zip", device="cpu")
+    obs = torch.as_tensor(np.random.default_rng(1).normal(size=(3, 10)), dtype=torch.float32)
+    with torch.no_grad():
+        assert torch.equal(back.policy.predict_values(obs), model.policy.predict_values(obs))
+    assert not back.policy.value_net.weight.requires_grad

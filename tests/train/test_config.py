@@ -140,8 +140,47 @@ def test_parse_load_case_names_the_choices(value):
 def test_base_applies_the_recipe_under_a_files_own_settings(tmp_path):
     """``base:`` names a recipe; the file's settings go on top, nested mappings key by key."""
     _, ppo = read_config("ppo")
-    _, one_run = read_config("ablation_ppo_one_run")  # acld-gym 0.7.0's recipe: ppo, one run
-    assert one_run == {**ppo, "restarts": 1, "restart_above": None, "select": None}
+    _, independent = read_config("ablation_ppo_independent")  # acld-gym 0.8.0-0.14.0's, whole
+    pk = {
+        k: v
+        for k, v in ppo["model"]["policy_kwargs"].items()
+        if k not in ("antithetic_noise", "critic_features")
+    }
+    assert independent == {
+        **{k: v for k, v in ppo.items() if k != "paired_loads"},
+        "model": {**ppo["model"], "ent_coef": 0.03, "policy_kwargs": pk},
+    }
+    _, paired = read_config("ablation_ppo_antithetic_ent_05")  # chained on it: two changes
+    assert paired == {
+        **independent,
+        "paired_loads": True,
+        "model": {
+            **independent["model"],
+            "ent_coef": 0.05,
+            "policy_kwargs": {**pk, "antithetic_noise": True},
+        },
+    }
+    _, negative = read_config("ablation_ppo_negative_critic")  # on it: the critic alone
+    assert negative == {
+        **independent,
+        "model": {
+            **independent["model"],
+            "policy_kwargs": {**pk, "critic_features": "negative_scaled_quadratic"},
+        },
+    }
+    # acld-gym 0.15.0's recipe: the two together
+    assert ppo == {
+        **paired,
+        "model": {
+            **paired["model"],
+            "policy_kwargs": {
+                **paired["model"]["policy_kwargs"],
+                "critic_features": "negative_scaled_quadratic",
+            },
+        },
+    }
+    _, one_run = read_config("ablation_ppo_one_run")  # acld-gym 0.7.0's recipe: one run
+    assert one_run == {**independent, "restarts": 1, "restart_above": None, "select": None}
     _, old = read_config("ablation_ppo_ent_01")  # 0.6.0's: chained on 0.7.0's, one change
     assert old == {**one_run, "model": {**one_run["model"], "ent_coef": 0.01}}
     _, ablation = read_config("ablation_ppo_lambda_095")  # chained: on 0.6.0's recipe

@@ -46,13 +46,16 @@ def test_the_default_config_is_the_benchmark_recipe():
 
 def test_overrides_of_the_command_line():
     args = build_parser().parse_args(
-        ["ppo", "--timesteps", "100", "--n-envs", "3", "--load-case", "2", "--param-noise", "0.02"]
+        ["ppo", "--timesteps", "100", "--n-envs", "4", "--load-case", "2", "--param-noise", "0.02"]
     )
     name, data = configure(args)
-    assert name == "ppo" and data["timesteps"] == 100 and data["n_envs"] == 3
+    assert name == "ppo" and data["timesteps"] == 100 and data["n_envs"] == 4
     assert data["loads"] == {2: 1}
     assert data["env_kwargs"]["param_noise"] == 0.02
     assert data["env_kwargs"]["reward_scale"] == "passive"  # the recipe's options stay
+    odd = build_parser().parse_args(["ppo", "--n-envs", "3"])  # the recipe pairs its sub-envs
+    with pytest.raises(ValueError, match="overrides: paired_loads needs an even number"):
+        configure(odd)
 
 
 @pytest.mark.parametrize("algo", ["ppo", "sac"])

@@ -1,7 +1,5 @@
 """train.vec: the action map, the shaping potential and the wrapped training env."""
 
-from dataclasses import replace
-
 import numpy as np
 import pytest
 import scipy.linalg as sla
@@ -136,7 +134,10 @@ def test_make_vec_env_is_seeded_and_normalized():
 def test_make_vec_env_splits_the_loads_and_passes_env_options():
     """Sub-envs per load in proportion to the weights, each with the config's env options
     (here the recipe's reward scale, observed as the last entry)."""
-    cfg = load_config("ppo").with_overrides(n_envs=4, loads={1: 1, "random": 3})
+    # acld-gym 0.8.0-0.14.0's PPO recipe: the sub-envs on their own seeds, any split
+    cfg = load_config("ablation_ppo_independent").with_overrides(
+        n_envs=4, loads={1: 1, "random": 3}
+    )
     venv = make_vec_env(cfg, seed=0)
     obs = venv.reset()
     assert obs.shape == (4, 10)  # 9 + log c (observe_reward_scale)
@@ -149,7 +150,7 @@ def test_make_vec_env_splits_the_loads_and_passes_env_options():
 
 
 def test_subproc_backend_is_the_same_env():
-    cfg = load_config("ppo").with_overrides(n_envs=2, loads={1: 1})
+    cfg = load_config("ablation_ppo_independent").with_overrides(n_envs=2, loads={1: 1})
     native, sub = make_vec_env(cfg, seed=4), make_vec_env(cfg, seed=4, backend="subproc")
     try:
         on, os_ = native.reset(), sub.reset()
@@ -168,7 +169,7 @@ def test_make_vec_env_pairs_the_sub_envs_with_paired_loads():
     """``paired_loads``: sub-envs 2i and 2i+1 of each load case run the same episodes under
     the same actions; with the subprocess backend it is refused."""
     cfg = load_config("ppo").with_overrides(n_envs=6, loads={1: 1, "random": 2})
-    cfg = replace(cfg, paired_loads=True)
+    assert cfg.paired_loads  # the recipe's, since acld-gym 0.15.0
     venv = make_vec_env(cfg, seed=3)
     obs = venv.reset()
     assert obs.shape == (6, 10)

@@ -37,6 +37,7 @@ __all__ = [
     "ScaledQuadraticCritic",
     "DropLast",
     "ScaledQuadraticFeatures",
+    "NegativeScaledQuadraticFeature",
     "EpisodeScaledRolloutBuffer",
     "SB3Policy",
 ]
@@ -90,8 +91,44 @@ class ScaledQuadraticFeatures(QuadraticFeatures):
         self._observation_space = observation_space
 
     def forward(self, observations: torch.Tensor) -> torch.Tensor:
-        u = observations[:, :-1] * torch.exp(-0.5 * observations[:, -1:])
-        return super().forward(u)
+        return super().forward(scaled_state(observations))
+
+
+def scaled_state(observations: torch.Tensor) -> torch.Tensor:
+    r""":math:`w = u/\sqrt{c}` of observations :math:`[u, \log c]` (``observe_reward_scale``:
+    log c last), the state the scaled critics are quadratic in."""
+    return observations[:, :-1] * torch.exp(-0.5 * observations[:, -1:])
+
+
+class NegativeScaledQuadraticFeature(BaseFeaturesExtractor):
+    r"""The one feature :math:`q = \|M [w; 1]\|^2 \ge 0` of the observation
+    :math:`[u, \log c]`, :math:`w = u/\sqrt{c}` (as :class:`ScaledQuadraticFeatures`), M a
+    learned square matrix of size d + 1, started at 0.1 times a standard normal draw over
+    :math:`\sqrt{d + 1}`. The critic on it is :math:`V = -q` (:attr:`output_weight`; its
+    output layer is fixed, no bias): a quadratic form, a linear term and a constant that
+    sum to at most 0 for every observation.
+
+    Why: every reward of the env is a cost's negative, so every value is at most 0, and so
+    is the value of a linear policy on a linear plant with noise, :math:`-(w^T P w + k)`
+    with :math:`P \succeq 0`, :math:`k \ge 0`. A general quadratic form
+    (:class:`ScaledQuadraticFeatures` with a linear output) can curve upwards, and in the
+    PPO recipe's runs that ended in the +/-120 V limit cycle it did: on seed 8 its values
+    reached +6e5 within the first rollouts after the whitening, the returns it bootstraps
+    at each rollout's end turned positive, and the actor followed the critic's
+    divergence (docs/training.md, "A critic that cannot be positive")."""
+
+    #: The critic's value is this times the feature (the output layer fixed, no bias).
+    output_weight = -1.0
+
+    def __init__(self, observation_space: spaces.Box, init: float = 0.1):
+        super().__init__(observation_space, features_dim=1)
+        n = int(observation_space.shape[0])  # d + 1: u and log c
+        self.m = nn.Parameter(torch.randn(n, n) * init / np.sqrt(n))
+
+    def forward(self, observations: torch.Tensor) -> torch.Tensor:
+        w = scaled_state(observations)
+        z = torch.cat([w, torch.ones_like(w[:, :1])], dim=-1)
+        return (z @ self.m.T).square().sum(dim=-1, keepdim=True)
 
 
 #: ``critic_features`` of :class:`train.bench.sb3_policies.SplitCriticPolicy` and their extractor
@@ -99,6 +136,7 @@ class ScaledQuadraticFeatures(QuadraticFeatures):
 CRITIC_FEATURES = {
     "quadratic": QuadraticFeatures,
     "scaled_quadratic": ScaledQuadraticFeatures,
+    "negative_scaled_quadratic": NegativeScaledQuadraticFeature,
     "direction": DirectionFeatures,
     "flatten": FlattenExtractor,
 }
@@ -129,7 +167,10 @@ class SplitCriticPolicy(ActorCriticPolicy):
     """PPO's ``ActorCriticPolicy`` whose critic has features of its own,
     ``critic_features`` (a ``policy_kwargs`` key): ``"quadratic"``
     (:class:`QuadraticFeatures`; with ``net_arch: {vf: []}`` the value is a quadratic
-    form of the observation, suited to a linear-quadratic problem), ``"direction"``
+    form of the observation, suited to a linear-quadratic problem),
+    ``"scaled_quadratic"`` (:class:`ScaledQuadraticFeatures`), ``"negative_scaled_quadratic"``
+    (:class:`NegativeScaledQuadraticFeature`: the value itself, never positive; its output
+    layer fixed, with ``net_arch: {vf: []}`` only), ``"direction"``
     (:class:`train.features.DirectionFeatures`) or ``"flatten"``. The actor sees the
     (flattened) observation, e.g. linear with ``net_arch: {pi: []}``.
     ``antithetic_noise`` (a ``policy_kwargs`` key, with ``use_sde``): gSDE's noise in
@@ -151,6 +192,17 @@ class SplitCriticPolicy(ActorCriticPolicy):
         self.antithetic_noise = antithetic_noise
         kwargs["share_features_extractor"] = False
         super().__init__(*args, **kwargs)
+        weight = getattr(self.vf_features_extractor, "output_weight", None)
+        if weight is not None:  # the critic's sign is its features': output layer fixed
+            if self.mlp_extractor.latent_dim_vf != 1:
+                raise ValueError(
+                    f"critic_features {critic_features!r} is the value itself: it takes "
+                    f"net_arch vf: [], got a critic of {self.mlp_extractor.latent_dim_vf} outputs"
+                )
+            with torch.no_grad():
+                self.value_net.weight.fill_(weight)
+                self.value_net.bias.zero_()
+            self.value_net.requires_grad_(False)
 
     def reset_noise(self, n_envs: int = 1) -> None:
         """gSDE's new noise on the actor's gains, one matrix E per sub-env; with

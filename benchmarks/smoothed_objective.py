@@ -26,6 +26,7 @@ import argparse
 import sys
 
 import numpy as np
+from probe import BASE  # benchmarks/probe.py: the recipe the probes were measured on
 
 
 def linear_law(actor) -> tuple[np.ndarray, float]:
@@ -104,7 +105,7 @@ def main(argv=None) -> int:
     p.add_argument("--seed", type=int, default=0, help="the PPO recipe's seed")
     p.add_argument(
         "--config",
-        default="ablation_ppo_independent",
+        default=BASE,
         help="the PPO recipe (train/benchmark/NAME.yaml; default 0.8.0-0.14.0's)",
     )
     p.add_argument("--loads", type=int, default=256, help="validation loads")

@@ -2,26 +2,20 @@
 takes no step in the updates of the first ``frozen_rollouts`` rollouts while the critic
 trains, then trains as in the recipe; a bad count is named."""
 
-import dataclasses
-
 import pytest
 import torch
 from stable_baselines3 import PPO
 
 from tests.benchmark_scripts import load_script
+from tests.train.tiny_sb3 import shrink_ppo
 
 cf = load_script("critic_first")
 
 
 def tiny(cfg):
-    """``cfg`` shrunk as ``tests.train.tiny_sb3.tiny_ppo`` shrinks the recipe: 256 env steps
-    of whitening, then three rollouts of 512 on 4 sub-envs, one epoch each, at a constant
-    learning rate (the recipe's decays to 0, which the third update, past the budget, gets)."""
-    model = {**cfg.model, "n_steps": 128, "batch_size": 256, "n_epochs": 1}
-    model["learning_rate"] = 1e-3
-    return dataclasses.replace(
-        cfg, timesteps=1536, n_envs=4, eval_points=1, whiten_steps=256, model=model
-    )
+    """``cfg`` shrunk by ``tests.train.tiny_sb3.shrink_ppo``, at a constant learning rate
+    (the recipe's decays to 0, which the third update, past the budget, gets)."""
+    return shrink_ppo(cfg, {"learning_rate": 1e-3})
 
 
 @pytest.mark.parametrize(("frozen", "candidate"), [(2, False), (0, False), (1, True)])

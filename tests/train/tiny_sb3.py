@@ -2,6 +2,8 @@
 stand-in for an SB3 model (``Averaging``, ``Selection`` and ``train_algo`` read only
 ``model.policy``)."""
 
+import dataclasses
+
 import torch
 import yaml
 
@@ -21,20 +23,20 @@ def tiny_sac(timesteps: int = 10, **fields) -> TrainConfig:
     )
 
 
+def shrink_ppo(cfg: TrainConfig, model: dict | None = None, **fields) -> TrainConfig:
+    """A PPO config ``cfg`` shrunk to 1536 env steps on 4 sub-envs: 256 of whitening, then
+    rollouts of 512 starting at 256, 768 and 1280 env steps, one epoch each; ``model`` keys
+    and ``fields`` changed on top."""
+    small = {"n_steps": 128, "batch_size": 256, "n_epochs": 1, **(model or {})}
+    shrunk = {"timesteps": 1536, "n_envs": 4, "eval_points": 1, "whiten_steps": 256, **fields}
+    return dataclasses.replace(cfg, model={**cfg.model, **small}, **shrunk)
+
+
 def tiny_ppo(model: dict | None = None, **fields) -> TrainConfig:
-    """The PPO recipe (train/benchmark/ppo.yaml) shrunk to 1536 env steps on 4 sub-envs: 256
-    of whitening, then rollouts of 512 starting at 256, 768 and 1280 env steps, one epoch
-    each; ``model`` keys and ``fields`` changed on top."""
-    data = yaml.safe_load(open("train/benchmark/ppo.yaml"))
-    data.update(timesteps=1536, n_envs=4, eval_points=1, whiten_steps=256, **fields)
-    data["model"] = {
-        **data["model"],
-        "n_steps": 128,
-        "batch_size": 256,
-        "n_epochs": 1,
-        **(model or {}),
-    }
-    return TrainConfig(**data)
+    """The PPO recipe (train/benchmark/ppo.yaml) shrunk by :func:`shrink_ppo`."""
+    return shrink_ppo(
+        TrainConfig(**yaml.safe_load(open("train/benchmark/ppo.yaml"))), model, **fields
+    )
 
 
 def tiny_sac_recipe(timesteps: int, **fields) -> TrainConfig:

@@ -72,11 +72,13 @@ class LinearSchedule:
 def _schedule(key: str, value: dict) -> LinearSchedule:
     """The schedule of a ``{linear: [start, end]}`` value of the model key ``key``
     (``warmup: w`` added: :class:`LinearSchedule`'s warm-up, for ``learning_rate``)."""
-    warmup = key == "learning_rate"
-    keys = {"linear", "warmup"} if warmup else {"linear"}
+    forms = ["{linear: [start, end]}"]
+    keys = {"linear"}
+    if key == "learning_rate":
+        forms.append("{linear: [start, end], warmup: w}")
+        keys.add("warmup")
     if not ({"linear"} <= set(value) <= keys) or len(value["linear"]) != 2:
-        form = "{linear: [start, end]}" + (" or {linear: [start, end], warmup: w}" * warmup)
-        raise ValueError(f"{key}: a number or {form}, got {value!r}")
+        raise ValueError(f"{key}: a number or {' or '.join(forms)}, got {value!r}")
     try:
         return LinearSchedule(*map(float, value["linear"]), float(value.get("warmup", 0.0)))
     except (TypeError, ValueError) as exc:

@@ -242,3 +242,50 @@ def test_the_negative_critic_saves_and_loads_fixed(tmp_path):
     with torch.no_grad():
         assert torch.equal(back.policy.predict_values(obs), model.policy.predict_values(obs))
     assert not back.policy.value_net.weight.requires_grad
+
+
+def test_the_sac_negative_critic_is_never_positive_and_saves(tmp_path):
+    """``negative_critic`` (SAC): each twin critic is Q = -||M [w; s]||^2, w = [u, clip(3 a)]
+    / sqrt(c), s the offset scale (100), computed here by hand: at most 0 for every
+    observation and action, trained through M alone; it takes no hidden layers; SAC.load
+    gives the same critic back."""
+    from stable_baselines3 import SAC
+
+    from train.bench.sb3_policies import NegativeSquareForm
+    from train.bench.sb3_train import make_model, make_vec_env
+
+    cfg = _sac_config(negative_critic=True)
+    venv = make_vec_env(cfg, 0, "ACLDBeam-v1")
+    try:
+        model = make_model(cfg, venv, 0)
+        critic = model.critic
+        assert all(isinstance(q, NegativeSquareForm) for q in critic.q_networks)
+        assert {n for n, _ in critic.named_parameters()} == {"qf0.m", "qf1.m"}
+        rng = np.random.default_rng(0)
+        u = rng.normal(size=(64, 9)) * 10.0 ** rng.uniform(-3, 6, (64, 1))
+        log_c = rng.uniform(-20, 20, (64, 1))
+        a = rng.uniform(-1, 1, (64, 1))
+        obs = torch.as_tensor(np.c_[u, log_c], dtype=torch.float32)
+        act = torch.as_tensor(a, dtype=torch.float32)
+        z = np.c_[u, np.clip(3.0 * a, -1, 1)] * np.exp(-0.5 * log_c)
+        z = np.c_[z, np.full(64, 100.0)]
+        with torch.no_grad():
+            for q in critic.q_networks:
+                q.m.copy_(torch.randn_like(q.m))
+            q1, q2 = critic(obs, act)
+            assert torch.all(q1 <= 0) and torch.all(q2 <= 0) and not torch.equal(q1, q2)
+            m = critic.q_networks[0].m.double().numpy()
+            by_hand = -(((z @ m.T) ** 2).sum(axis=1))
+            np.testing.assert_allclose(q1.double().numpy()[:, 0], by_hand, rtol=1e-4)
+        critic.q1_forward(obs[:4], act[:4]).sum().backward()
+        assert critic.q_networks[0].m.grad.abs().sum() > 0
+        model.learn(200)
+        model.save(tmp_path / "sac.zip")
+        back = SAC.load(tmp_path / "sac.zip", device="cpu")
+        with torch.no_grad():
+            assert torch.equal(back.critic(obs, act)[0], model.critic(obs, act)[0])
+        assert back.policy.negative_critic is True
+        with pytest.raises(ValueError, match="negative must be true or false, and true with"):
+            make_model(_sac_config(negative_critic=True, net_arch={"pi": [], "qf": [8]}), venv, 0)
+    finally:
+        venv.close()

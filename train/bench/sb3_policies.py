@@ -122,13 +122,36 @@ class NegativeScaledQuadraticFeature(BaseFeaturesExtractor):
 
     def __init__(self, observation_space: spaces.Box, init: float = 0.1):
         super().__init__(observation_space, features_dim=1)
-        n = int(observation_space.shape[0])  # d + 1: u and log c
-        self.m = nn.Parameter(torch.randn(n, n) * init / np.sqrt(n))
+        self.m = square_form_matrix(int(observation_space.shape[0]), init)  # d + 1: u, log c
 
     def forward(self, observations: torch.Tensor) -> torch.Tensor:
         w = scaled_state(observations)
-        z = torch.cat([w, torch.ones_like(w[:, :1])], dim=-1)
-        return (z @ self.m.T).square().sum(dim=-1, keepdim=True)
+        return square_norm(torch.cat([w, torch.ones_like(w[:, :1])], dim=-1), self.m)
+
+
+def square_form_matrix(n: int, init: float = 0.1) -> nn.Parameter:
+    r"""The learned n x n matrix M of a form :math:`\|M z\|^2`, started at ``init`` times a
+    standard normal draw over :math:`\sqrt{n}`."""
+    return nn.Parameter(torch.randn(n, n) * init / np.sqrt(n))
+
+
+def square_norm(z: torch.Tensor, m: torch.Tensor) -> torch.Tensor:
+    r""":math:`\|M z\|^2` of each row z of ``z``, as a column."""
+    return (z @ m.T).square().sum(dim=-1, keepdim=True)
+
+
+class NegativeSquareForm(nn.Module):
+    r"""A critic head :math:`Q = -\|M z\|^2 \le 0` on features z (:func:`square_norm`,
+    M from :func:`square_form_matrix`): SAC's never-positive twin of
+    :class:`NegativeScaledQuadraticFeature` (:class:`ScaledQuadraticCritic` with
+    ``negative=True``)."""
+
+    def __init__(self, n: int, init: float = 0.1):
+        super().__init__()
+        self.m = square_form_matrix(n, init)
+
+    def forward(self, z: torch.Tensor) -> torch.Tensor:
+        return -square_norm(z, self.m)
 
 
 #: ``critic_features`` of :class:`train.bench.sb3_policies.SplitCriticPolicy` and their extractor
@@ -380,7 +403,13 @@ class ScaledQuadraticCritic(ContinuousCritic):
     fitted by least squares on the random search's data, against quadratic coefficients of
     0.003-3): with Adam's steps of about 1e-3 a bias takes some 70,000 updates to get
     there, and meanwhile the quadratic terms make up for it; a feature of 100 brings it
-    within 700."""
+    within 700.
+
+    ``negative``: each critic is :math:`Q = -\|M [w; s]\|^2` instead
+    (:class:`NegativeSquareForm`; s the ``offset_scale``, or 1), a quadratic form, a linear
+    term and a constant that sum to at most 0, as every value of the env's costs is: the
+    PPO recipe's never-positive critic (:class:`NegativeScaledQuadraticFeature`) for SAC.
+    It takes ``net_arch: []`` only."""
 
     def __init__(
         self,
@@ -392,6 +421,7 @@ class ScaledQuadraticCritic(ContinuousCritic):
         activation_fn=nn.ReLU,
         action_headroom: float = 1.0,
         offset_scale: float | None = None,
+        negative: bool = False,
         **kwargs,
     ):
         super().__init__(
@@ -413,19 +443,30 @@ class ScaledQuadraticCritic(ContinuousCritic):
             if offset_scale is None
             else check_real("offset_scale", offset_scale, 0.0, low_open=True)
         )
+        if not isinstance(negative, bool) or (negative and list(net_arch)):
+            raise ValueError(
+                f"negative must be true or false, and true with net_arch qf: [] only; got "
+                f"negative={negative!r} with qf: {list(net_arch)!r}"
+            )
+        self.negative = negative
         d = int(observation_space.shape[0]) - 1 + int(np.prod(action_space.shape))
         self.quadratic = QuadraticFeatures(spaces.Box(-np.inf, np.inf, (d,), np.float32))
-        # and the constant feature offset_scale, if any
-        n_feat = self.quadratic.features_dim + (self.offset_scale is not None)
         self.q_networks = []
         for idx in range(n_critics):
-            q_net = nn.Sequential(*create_mlp(n_feat, 1, list(net_arch), activation_fn))
+            if negative:  # on [w, s]
+                q_net = NegativeSquareForm(d + 1)
+            else:  # on the quadratic features of w and the constant offset_scale, if any
+                n_feat = self.quadratic.features_dim + (self.offset_scale is not None)
+                q_net = nn.Sequential(*create_mlp(n_feat, 1, list(net_arch), activation_fn))
             self.add_module(f"qf{idx}", q_net)  # replaces the MLP of the same name
             self.q_networks.append(q_net)
 
     def _features(self, obs: torch.Tensor, actions: torch.Tensor) -> torch.Tensor:
         applied = torch.clamp(self.action_headroom * actions, -1.0, 1.0)
         w = torch.cat([obs[:, :-1], applied], dim=1) * torch.exp(-0.5 * obs[:, -1:])
+        if self.negative:
+            s = 1.0 if self.offset_scale is None else self.offset_scale
+            return torch.cat([w, torch.full_like(w[:, :1], s)], dim=1)
         f = self.quadratic(w)
         if self.offset_scale is None:
             return f
@@ -444,7 +485,8 @@ class AsymmetricSACPolicy(SACPolicy):
     only (:class:`DropLast`; ``net_arch: {pi: []}`` a linear law, deployable on the plain
     env), the twin critic is :class:`ScaledQuadraticCritic` of the applied action, for the
     ``action_headroom`` of the env's action map (:func:`train.bench.sb3_train.make_model`
-    passes the config's), with its ``offset_scale``.
+    passes the config's), with its ``offset_scale``, never positive with ``negative_critic``
+    (:class:`NegativeSquareForm`).
 
     Two bounds on the actor, for an exploration floor: ``mean_clip`` m limits the
     pre-tanh mean to [-m, m] (a ``Hardtanh``, exported as a ``clip``; with m = 1 and
@@ -466,6 +508,7 @@ class AsymmetricSACPolicy(SACPolicy):
         offset_scale: float | None = None,
         mean_clip: float | None = None,
         log_std_min: float | None = None,
+        negative_critic: bool = False,
         **kwargs,
     ):
         from acld_gym.wrappers import check_headroom
@@ -478,6 +521,7 @@ class AsymmetricSACPolicy(SACPolicy):
                 f"log_std_min must be in [-20, 2) (SAC's log std range), got {log_std_min!r}"
             )
         self.offset_scale = offset_scale
+        self.negative_critic = negative_critic
         self.mean_clip = mean_clip
         self.log_std_min = log_std_min
         kwargs.setdefault("features_extractor_class", DropLast)
@@ -495,7 +539,10 @@ class AsymmetricSACPolicy(SACPolicy):
     def make_critic(self, features_extractor=None) -> ScaledQuadraticCritic:
         critic_kwargs = self._update_features_extractor(self.critic_kwargs, features_extractor)
         return ScaledQuadraticCritic(
-            **critic_kwargs, action_headroom=self.action_headroom, offset_scale=self.offset_scale
+            **critic_kwargs,
+            action_headroom=self.action_headroom,
+            offset_scale=self.offset_scale,
+            negative=self.negative_critic,
         ).to(self.device)
 
     def _get_constructor_parameters(self) -> dict:
@@ -503,6 +550,7 @@ class AsymmetricSACPolicy(SACPolicy):
         data.update(
             action_headroom=self.action_headroom,
             offset_scale=self.offset_scale,
+            negative_critic=self.negative_critic,
             mean_clip=self.mean_clip,
             log_std_min=self.log_std_min,
         )

@@ -16,6 +16,7 @@ on one core::
 
     python benchmarks/episode_noise.py --seeds 0 1 2 3 4
     python benchmarks/episode_noise.py --seeds 0 1 2 3 4 --hold 128
+    python benchmarks/episode_noise.py --seeds 0 1 2 3 4 --recipe ppo   # on 0.15.0's recipe
 
 Its numbers are in docs/training.md ("Reinforcement learning from scratch", the probes
 table).
@@ -26,7 +27,7 @@ from __future__ import annotations
 import sys
 
 import torch
-from probe import EPISODE_STEPS, one_run, run_recipe, seeds_main  # benchmarks/probe.py
+from probe import BASE, EPISODE_STEPS, one_run, run_recipe, seeds_main  # benchmarks/probe.py
 from torch.distributions import Normal
 
 from train.bench.sb3_policies import AsymmetricCriticPolicy
@@ -53,16 +54,24 @@ class EpisodeNoisePolicy(AsymmetricCriticPolicy):
         dist.exploration_mat = dist.weights_dist.rsample()
         dist.exploration_matrices = self.eps * std
 
+    def _draw(self, shape) -> torch.Tensor:
+        """A standard-normal draw per sub-env; with ``antithetic_noise`` sub-env ``2i + 1``
+        gets the negative of ``2i``'s, as the recipe's gSDE noise (0.15.0)."""
+        eps = torch.randn(shape)
+        if self.antithetic_noise and shape[0] > 1:
+            eps[1::2] = -eps[0::2]
+        return eps
+
     def reset_noise(self, n_envs: int = 1) -> None:
         std = self.action_dist.get_std(self.log_std)
         if self.eps is None or self.eps.shape[0] != n_envs:
-            self.eps = torch.randn((n_envs, *std.shape))
+            self.eps = self._draw((n_envs, *std.shape))
             self.steps = 0
         self._act_with_eps()
 
     def forward(self, obs: torch.Tensor, deterministic: bool = False):
         if self.eps is not None and self.steps and self.steps % self.hold == 0:
-            self.eps = torch.randn_like(self.eps)  # e.g. the sub-envs' next episodes
+            self.eps = self._draw(self.eps.shape)  # e.g. the sub-envs' next episodes
             self._act_with_eps()
         self.steps += 1
         return super().forward(obs, deterministic)
@@ -71,21 +80,28 @@ class EpisodeNoisePolicy(AsymmetricCriticPolicy):
         return {**super()._get_constructor_parameters(), "hold": self.hold}
 
 
-def config(hold: int = EPISODE_STEPS):
-    """``train/benchmark/ppo.yaml``'s config with :class:`EpisodeNoisePolicy`, one run."""
-    return one_run(EpisodeNoisePolicy, {"hold": hold})
+def config(hold: int = EPISODE_STEPS, recipe: str = BASE):
+    """The PPO config ``recipe`` (:data:`probe.BASE`, or ``"ppo"``: acld-gym 0.15.0's
+    recipe, its sub-envs in pairs with antithetic draws) with :class:`EpisodeNoisePolicy`,
+    one run."""
+    return one_run(EpisodeNoisePolicy, {"hold": hold}, base=recipe)
 
 
-def run(seed: int, hold: int = EPISODE_STEPS, env_id: str = "ACLDBeam-v1") -> dict:
+def run(
+    seed: int, hold: int = EPISODE_STEPS, env_id: str = "ACLDBeam-v1", recipe: str = BASE
+) -> dict:
     """Train one run of seed ``seed`` and evaluate it."""
-    return run_recipe(config(hold), seed, env_id, hold=hold)
+    return run_recipe(config(hold, recipe), seed, env_id, hold=hold, recipe=recipe)
 
 
 def main(argv: list[str] | None = None) -> int:
     def add_arguments(p):
         p.add_argument("--hold", type=int, default=EPISODE_STEPS, help="steps per noise draw")
+        p.add_argument("--recipe", default=BASE, choices=(BASE, "ppo"), help="config changed")
 
-    return seeds_main(__doc__, lambda seed, a: run(seed, a.hold), argv, add_arguments)
+    return seeds_main(
+        __doc__, lambda seed, a: run(seed, a.hold, recipe=a.recipe), argv, add_arguments
+    )
 
 
 if __name__ == "__main__":

@@ -28,14 +28,20 @@ EPISODE_STEPS = 1000
 BASE = "ablation_ppo_independent"
 
 
-def one_run(policy, policy_kwargs: dict | None = None, drop: Iterable[str] = (), **model):
-    """:data:`BASE`'s config with ``policy`` (its ``policy_kwargs`` added to the base's) and
-    one run per seed, its failures reported rather than retried; the keys in ``drop`` are
-    removed from the base's model and policy keyword arguments, and ``model`` replaces model
-    keyword arguments."""
+def one_run(
+    policy,
+    policy_kwargs: dict | None = None,
+    drop: Iterable[str] = (),
+    base: str = BASE,
+    **model,
+):
+    """The config ``base`` (:data:`BASE` unless given) with ``policy`` (its
+    ``policy_kwargs`` added to the base's) and one run per seed, its failures reported
+    rather than retried; the keys in ``drop`` are removed from the base's model and policy
+    keyword arguments, and ``model`` replaces model keyword arguments."""
     from train.config import load_config
 
-    cfg = load_config(BASE)
+    cfg = load_config(base)
     drop = set(drop)
     kept = {k: v for k, v in cfg.model.items() if k not in drop}
     kwargs = {k: v for k, v in kept.get("policy_kwargs", {}).items() if k not in drop}

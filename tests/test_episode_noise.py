@@ -43,3 +43,21 @@ def test_the_draw_is_renewed_after_an_episode_of_steps():
     assert not torch.equal(policy.eps, eps)
     std = policy.action_dist.get_std(policy.log_std).detach()
     torch.testing.assert_close(policy.action_dist.exploration_matrices.detach(), policy.eps * std)
+
+
+def test_on_the_0_15_recipe_the_draws_come_in_antithetic_pairs():
+    """``--recipe ppo``: acld-gym 0.15.0's recipe (sub-envs in pairs), and each draw, the
+    first and every renewed one, gives sub-env 2i + 1 the negative of 2i's."""
+    cfg = en.config(hold=3, recipe="ppo")
+    assert cfg.paired_loads and cfg.restarts == 1
+    assert cfg.model["policy_kwargs"]["critic_features"] == "negative_scaled_quadratic"
+    model, width = tiny_model(cfg)
+    policy = model.policy
+    policy.reset_noise(4)
+    first = policy.eps.clone()
+    with torch.no_grad():
+        for _ in range(4):  # past the 3-step hold: a renewed draw
+            policy(torch.zeros((4, width)))
+    for eps in (first, policy.eps):
+        assert torch.equal(eps[1::2], -eps[0::2]) and not torch.equal(eps[0], eps[2])
+    assert not torch.equal(policy.eps, first)

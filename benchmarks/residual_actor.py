@@ -15,6 +15,7 @@ on one core::
 
     python benchmarks/residual_actor.py --seeds 0 1 2 3 4
     python benchmarks/residual_actor.py --seeds 0 1 2 3 4 --noise linear
+    python benchmarks/residual_actor.py --seeds 0 1 2 3 4 --recipe ppo   # on 0.15.0's recipe
 
 Its numbers are in docs/training.md ("Reinforcement learning from scratch", the probes
 table). The actor is not exported as an agent (:class:`train.agent.ActorProgram` has no
@@ -29,7 +30,7 @@ import sys
 import numpy as np
 import torch
 import torch.nn as nn
-from probe import one_run, run_recipe, seeds_main  # benchmarks/probe.py, beside this script
+from probe import BASE, one_run, run_recipe, seeds_main  # benchmarks/probe.py, beside this script
 from stable_baselines3.common.distributions import StateDependentNoiseDistribution
 
 from train.bench.sb3_policies import AsymmetricCriticPolicy
@@ -101,14 +102,23 @@ class ResidualActorPolicy(AsymmetricCriticPolicy):
         return {**super()._get_constructor_parameters(), "hidden": self.hidden, "noise": self.noise}
 
 
-def config(hidden: list[int], noise: str = "latent"):
-    """``train/benchmark/ppo.yaml``'s config with the residual actor, one run."""
-    return one_run(ResidualActorPolicy, {"hidden": list(hidden), "noise": noise})
+def config(hidden: list[int], noise: str = "latent", recipe: str = BASE):
+    """The PPO config ``recipe`` (:data:`probe.BASE`, or ``"ppo"``: acld-gym 0.15.0's
+    recipe, whose critic cannot be positive and whose gSDE draws come in antithetic pairs
+    of paired sub-envs) with the residual actor, one run."""
+    return one_run(ResidualActorPolicy, {"hidden": list(hidden), "noise": noise}, base=recipe)
 
 
-def run(seed: int, hidden: list[int], noise: str = "latent", env_id: str = "ACLDBeam-v1") -> dict:
+def run(
+    seed: int,
+    hidden: list[int],
+    noise: str = "latent",
+    env_id: str = "ACLDBeam-v1",
+    recipe: str = BASE,
+) -> dict:
     """Train one run of seed ``seed`` and evaluate it."""
-    return run_recipe(config(hidden, noise), seed, env_id, hidden=hidden, noise=noise)
+    cfg = config(hidden, noise, recipe)
+    return run_recipe(cfg, seed, env_id, hidden=hidden, noise=noise, recipe=recipe)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -117,8 +127,12 @@ def main(argv: list[str] | None = None) -> int:
         p.add_argument(
             "--noise", choices=NOISES, default="latent", help="what gSDE's noise acts on"
         )
+        p.add_argument("--recipe", default=BASE, choices=(BASE, "ppo"), help="config changed")
 
-    return seeds_main(__doc__, lambda seed, a: run(seed, a.hidden, a.noise), argv, add_arguments)
+    def one(seed, a):
+        return run(seed, a.hidden, a.noise, recipe=a.recipe)
+
+    return seeds_main(__doc__, one, argv, add_arguments)
 
 
 if __name__ == "__main__":

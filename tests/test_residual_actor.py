@@ -101,3 +101,15 @@ def test_bad_noise_is_refused_by_name():
         ra.ResidualActorPolicy(
             gym.spaces.Box(-1, 1, (3,)), gym.spaces.Box(-1, 1, (1,)), lambda _: 1e-3, noise="h"
         )
+
+
+def test_on_the_0_15_recipe_the_noise_comes_in_antithetic_pairs():
+    """``--recipe ppo``: acld-gym 0.15.0's recipe (paired sub-envs, the never-positive
+    critic) with the residual actor, whose gSDE matrices come in pairs E, -E."""
+    cfg = ra.config([8], recipe="ppo")
+    assert cfg.paired_loads and cfg.restarts == 1
+    assert cfg.model["policy_kwargs"]["critic_features"] == "negative_scaled_quadratic"
+    policy = tiny_model(cfg)[0].policy
+    policy.reset_noise(4)
+    e = policy.action_dist.exploration_matrices
+    assert torch.equal(e[1::2], -e[0::2]) and not torch.equal(e[0], e[2])

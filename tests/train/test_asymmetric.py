@@ -285,7 +285,12 @@ def test_the_sac_negative_critic_is_never_positive_and_saves(tmp_path):
         with torch.no_grad():
             assert torch.equal(back.critic(obs, act)[0], model.critic(obs, act)[0])
         assert back.policy.negative_critic is True
-        with pytest.raises(ValueError, match="negative must be true or false, and true with"):
+        with pytest.raises(
+            ValueError,
+            match=r"negative \(SAC's policy_kwargs negative_critic\) must be .* qf: \[8\]",
+        ):
             make_model(_sac_config(negative_critic=True, net_arch={"pi": [], "qf": [8]}), venv, 0)
+        with pytest.raises(ValueError, match="negative_critic\\) must be true or false.*'yes'"):
+            make_model(_sac_config(negative_critic="yes"), venv, 0)
     finally:
         venv.close()

@@ -445,8 +445,8 @@ class ScaledQuadraticCritic(ContinuousCritic):
         )
         if not isinstance(negative, bool) or (negative and list(net_arch)):
             raise ValueError(
-                f"negative must be true or false, and true with net_arch qf: [] only; got "
-                f"negative={negative!r} with qf: {list(net_arch)!r}"
+                f"negative (SAC's policy_kwargs negative_critic) must be true or false, and "
+                f"true with net_arch qf: [] only; got {negative!r} with qf: {list(net_arch)!r}"
             )
         self.negative = negative
         d = int(observation_space.shape[0]) - 1 + int(np.prod(action_space.shape))

@@ -27,7 +27,14 @@ from __future__ import annotations
 import sys
 
 import torch
-from probe import BASE, EPISODE_STEPS, one_run, run_recipe, seeds_main  # benchmarks/probe.py
+from probe import (  # benchmarks/probe.py
+    BASE,
+    EPISODE_STEPS,
+    RECIPES,
+    one_run,
+    run_recipe,
+    seeds_main,
+)
 from torch.distributions import Normal
 
 from train.bench.sb3_policies import AsymmetricCriticPolicy
@@ -97,7 +104,7 @@ def run(
 def main(argv: list[str] | None = None) -> int:
     def add_arguments(p):
         p.add_argument("--hold", type=int, default=EPISODE_STEPS, help="steps per noise draw")
-        p.add_argument("--recipe", default=BASE, choices=(BASE, "ppo"), help="config changed")
+        p.add_argument("--recipe", default=BASE, choices=RECIPES, help="config changed")
 
     return seeds_main(
         __doc__, lambda seed, a: run(seed, a.hold, recipe=a.recipe), argv, add_arguments

@@ -1,10 +1,10 @@
 """What the PPO probes of ``benchmarks/`` share (``residual_actor.py``, ``episode_noise.py``,
-``beta_actor.py``, ``time_critic.py``, ``antithetic.py``): the PPO recipe they were measured
-against, acld-gym 0.8.0-0.14.0's (:data:`BASE`; the recipe since 0.15.0 is
-``antithetic.py``'s pairs with the entropy coefficient 0.05), with another policy, one run
-per seed (:func:`one_run`), trained and evaluated as the benchmark does
-(:func:`run_recipe`), and a command line printing one JSON line per seed
-(:func:`seeds_main`).
+``beta_actor.py``, ``time_critic.py``, ``antithetic.py``, ``paired_minibatches.py``): the
+PPO recipe they were measured against, acld-gym 0.8.0-0.14.0's (:data:`BASE`; the recipe
+since 0.15.0 is ``antithetic.py``'s pairs with the entropy coefficient 0.05, and the
+``--recipe ppo`` of two probes, :data:`RECIPES`), with another policy, one run per seed
+(:func:`one_run`), trained and evaluated as the benchmark does (:func:`run_recipe`), and
+a command line printing one JSON line per seed (:func:`seeds_main`).
 
 A run's line: its settings, its training wall time, its cost on 256 validation loads (the
 recipe's own check at the run's end, :func:`train.bench.evaluate.validation_cost`; LQR
@@ -26,6 +26,10 @@ EPISODE_STEPS = 1000
 #: The config the probes change: acld-gym 0.8.0-0.14.0's PPO recipe
 #: (``train/benchmark/ablation_ppo_independent.yaml``), on which their numbers were measured.
 BASE = "ablation_ppo_independent"
+
+#: The configs a probe's ``--recipe`` may change: :data:`BASE`, or ``"ppo"``, acld-gym
+#: 0.15.0's recipe (``train/benchmark/ppo.yaml``).
+RECIPES = (BASE, "ppo")
 
 
 def one_run(

@@ -30,7 +30,13 @@ import sys
 import numpy as np
 import torch
 import torch.nn as nn
-from probe import BASE, one_run, run_recipe, seeds_main  # benchmarks/probe.py, beside this script
+from probe import (  # benchmarks/probe.py, beside this script
+    BASE,
+    RECIPES,
+    one_run,
+    run_recipe,
+    seeds_main,
+)
 from stable_baselines3.common.distributions import StateDependentNoiseDistribution
 
 from train.bench.sb3_policies import AsymmetricCriticPolicy
@@ -127,7 +133,7 @@ def main(argv: list[str] | None = None) -> int:
         p.add_argument(
             "--noise", choices=NOISES, default="latent", help="what gSDE's noise acts on"
         )
-        p.add_argument("--recipe", default=BASE, choices=(BASE, "ppo"), help="config changed")
+        p.add_argument("--recipe", default=BASE, choices=RECIPES, help="config changed")
 
     def one(seed, a):
         return run(seed, a.hidden, a.noise, recipe=a.recipe)

@@ -37,7 +37,7 @@ from probe import (  # benchmarks/probe.py
 )
 from torch.distributions import Normal
 
-from train.bench.sb3_policies import AsymmetricCriticPolicy
+from train.bench.sb3_policies import AsymmetricCriticPolicy, antithetic_pairs
 
 
 class EpisodeNoisePolicy(AsymmetricCriticPolicy):
@@ -65,9 +65,7 @@ class EpisodeNoisePolicy(AsymmetricCriticPolicy):
         """A standard-normal draw per sub-env; with ``antithetic_noise`` sub-env ``2i + 1``
         gets the negative of ``2i``'s, as the recipe's gSDE noise (0.15.0)."""
         eps = torch.randn(shape)
-        if self.antithetic_noise and shape[0] > 1:
-            eps[1::2] = -eps[0::2]
-        return eps
+        return antithetic_pairs(eps) if self.antithetic_noise and shape[0] > 1 else eps
 
     def reset_noise(self, n_envs: int = 1) -> None:
         std = self.action_dist.get_std(self.log_std)

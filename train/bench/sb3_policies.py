@@ -186,6 +186,14 @@ class _SplitMlp(nn.Module):
         return self.value_net(features)
 
 
+def antithetic_pairs(draws: torch.Tensor) -> torch.Tensor:
+    """A copy of ``draws`` (one per sub-env, first axis) with sub-env ``2i + 1``'s the
+    negative of ``2i``'s: the pair layout of ``paired_loads`` and ``antithetic_noise``."""
+    out = draws.clone()
+    out[1::2] = -out[0::2]
+    return out
+
+
 class SplitCriticPolicy(ActorCriticPolicy):
     """PPO's ``ActorCriticPolicy`` whose critic has features of its own,
     ``critic_features`` (a ``policy_kwargs`` key): ``"quadratic"``
@@ -245,9 +253,7 @@ class SplitCriticPolicy(ActorCriticPolicy):
         if not self.antithetic_noise or n_envs == 1:
             return
         dist = self.action_dist
-        e = dist.exploration_matrices.detach().clone()
-        e[1::2] = -e[0::2]
-        dist.exploration_matrices = e
+        dist.exploration_matrices = antithetic_pairs(dist.exploration_matrices.detach())
 
     def make_critic_extractor(self) -> BaseFeaturesExtractor:
         """The critic's features extractor on the observation space: ``critic_features``'
@@ -450,13 +456,17 @@ class ScaledQuadraticCritic(ContinuousCritic):
             )
         self.negative = negative
         d = int(observation_space.shape[0]) - 1 + int(np.prod(action_space.shape))
-        self.quadratic = QuadraticFeatures(spaces.Box(-np.inf, np.inf, (d,), np.float32))
+        # negative: each critic on [w, s]; else on the quadratic features of w and the
+        # constant offset_scale, if any
+        self.quadratic = (
+            None if negative else QuadraticFeatures(spaces.Box(-np.inf, np.inf, (d,), np.float32))
+        )
+        n_feat = None if negative else self.quadratic.features_dim + (offset_scale is not None)
         self.q_networks = []
         for idx in range(n_critics):
-            if negative:  # on [w, s]
+            if negative:
                 q_net = NegativeSquareForm(d + 1)
-            else:  # on the quadratic features of w and the constant offset_scale, if any
-                n_feat = self.quadratic.features_dim + (self.offset_scale is not None)
+            else:
                 q_net = nn.Sequential(*create_mlp(n_feat, 1, list(net_arch), activation_fn))
             self.add_module(f"qf{idx}", q_net)  # replaces the MLP of the same name
             self.q_networks.append(q_net)

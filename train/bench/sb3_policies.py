@@ -94,10 +94,12 @@ class ScaledQuadraticFeatures(QuadraticFeatures):
         return super().forward(scaled_state(observations))
 
 
-def scaled_state(observations: torch.Tensor) -> torch.Tensor:
-    r""":math:`w = u/\sqrt{c}` of observations :math:`[u, \log c]` (``observe_reward_scale``:
-    log c last), the state the scaled critics are quadratic in."""
-    return observations[:, :-1] * torch.exp(-0.5 * observations[:, -1:])
+def scaled_state(observations: torch.Tensor, *extra: torch.Tensor) -> torch.Tensor:
+    r""":math:`w = [u, \ldots] / \sqrt{c}` of observations :math:`[u, \log c]`
+    (``observe_reward_scale``: log c last), the state the scaled critics are quadratic in;
+    ``extra`` columns (SAC's applied action) join u before the scaling."""
+    x = torch.cat([observations[:, :-1], *extra], dim=1) if extra else observations[:, :-1]
+    return x * torch.exp(-0.5 * observations[:, -1:])
 
 
 class NegativeScaledQuadraticFeature(BaseFeaturesExtractor):
@@ -473,7 +475,7 @@ class ScaledQuadraticCritic(ContinuousCritic):
 
     def _features(self, obs: torch.Tensor, actions: torch.Tensor) -> torch.Tensor:
         applied = torch.clamp(self.action_headroom * actions, -1.0, 1.0)
-        w = torch.cat([obs[:, :-1], applied], dim=1) * torch.exp(-0.5 * obs[:, -1:])
+        w = scaled_state(obs, applied)
         if self.negative:
             s = 1.0 if self.offset_scale is None else self.offset_scale
             return torch.cat([w, torch.full_like(w[:, :1], s)], dim=1)

@@ -28,9 +28,9 @@ from pathlib import Path
 import acld_gym
 from acld_gym.benchmark import TEST_SETS
 from acld_gym.util.atomic import check_directory, check_writable, write_json, write_text
-from acld_gym.util.validate import arg_type
 
 from .analysis.control import Analysis, analyze
+from .evaluate import add_score_episodes_argument, check_score_episodes
 
 __all__ = ["analyze", "Analysis", "BASELINES", "resolve_policy", "main"]
 
@@ -96,12 +96,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", metavar="PATH", help="write the record as JSON")
     p.add_argument("--plots", metavar="DIR", help="write the compliance figures to DIR")
     p.add_argument("--markdown", metavar="PATH", help="write the comparison tables as markdown")
-    p.add_argument(
-        "--score-episodes",
-        type=arg_type(int, 0, 100_000),
-        default=None,
-        help="score on the first N test episodes only (0: no score; default: the whole test set)",
-    )
+    add_score_episodes_argument(p)
     p.add_argument("--quiet", action="store_true", help="no progress line")
     return p
 
@@ -115,11 +110,7 @@ def main(argv: list[str] | None = None) -> int:
                 check_writable(path, flag)
         if args.plots:
             check_directory(args.plots, "--plots")
-        n = len(TEST_SETS[args.env_id].seeds)
-        if args.score_episodes is not None and args.score_episodes > n:
-            raise ValueError(
-                f"--score-episodes: the test set has {n} episodes, got {args.score_episodes}"
-            )
+        check_score_episodes(args.score_episodes, args.env_id)
         policies = [resolve_policy(spec, args.env_id) for spec in args.policy]
     except (OSError, ValueError) as exc:
         parser.error(str(exc))

@@ -29,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
+from acld_gym.benchmark import TEST_SETS
 from acld_gym.envs.beam_env import ACLDBeamEnv
 from acld_gym.envs.fingerprint import fingerprint_differences, observation_fingerprint
 from acld_gym.envs.presets import PRESETS, preset
@@ -58,6 +59,8 @@ __all__ = [
     "format_effort",
     "format_thesis_comparison",
     "add_scores",
+    "add_score_episodes_argument",
+    "check_score_episodes",
     "plot_episodes",
 ]
 
@@ -336,6 +339,28 @@ def format_thesis_comparison(rows: list[EvalRow]) -> str:
     return "\n".join(out)
 
 
+def add_score_episodes_argument(p: argparse.ArgumentParser) -> None:
+    """The ``--score-episodes N`` option of the CLIs that score policies on a test set
+    (``baselines.evaluate``, ``baselines.analyze``, ``train.compare``); checked against the
+    set's size by :func:`check_score_episodes`."""
+    p.add_argument(
+        "--score-episodes",
+        type=arg_type(int, 0, 100_000),
+        default=None,
+        help="score on the first N episodes of the test set (0: no score; default: all of it)",
+    )
+
+
+def check_score_episodes(n_episodes: int | None, env_id: str = "ACLDBeam-v1") -> None:
+    """``ValueError`` naming ``--score-episodes`` unless ``n_episodes`` (None: the whole
+    set) fits the test set of ``env_id``: a CLI checks it before any computing."""
+    size = len(TEST_SETS[env_id].seeds)
+    if n_episodes is not None and n_episodes > size:
+        raise ValueError(
+            f"--score-episodes: the test set of {env_id} has {size} episodes, got {n_episodes}"
+        )
+
+
 def add_scores(
     policies: dict,
     n_episodes: int | None,
@@ -411,19 +436,15 @@ def main(argv: list[str] | None = None) -> int:
         help="truth plant: the mesh-converged beam or the thesis mesh (default: "
         "the configuration's)",
     )
-    p.add_argument(
-        "--score-episodes",
-        type=arg_type(int, 0, 100_000),
-        default=None,
-        help="score on the first N episodes of the test set (0: no score; default: all of it)",
-    )
+    add_score_episodes_argument(p)
     p.add_argument("--quiet", action="store_true", help="no progress line")
     args = p.parse_args(argv)
-    try:  # unusable output paths fail now, before any computing
+    try:  # unusable output paths and a bad --score-episodes fail now, before any computing
         if args.json:
             check_writable(args.json, "--json")
         if args.plots:
             check_directory(args.plots, "--plots")
+        check_score_episodes(args.score_episodes, args.env_id)
     except ValueError as exc:
         p.error(str(exc))
     config = preset(args.env_id, **({} if args.mesh is None else {"mesh": args.mesh}))

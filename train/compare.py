@@ -39,7 +39,9 @@ from acld_gym.util.progress import Progress
 from acld_gym.util.validate import arg_type
 from baselines.evaluate import (
     EvalRow,
+    add_score_episodes_argument,
     add_scores,
+    check_score_episodes,
     default_policies,
     episode_rows,
     format_tables,
@@ -320,12 +322,7 @@ def build_parser() -> argparse.ArgumentParser:
         default="converged",
         help="truth plant (default: the converged beam); the agents trained on it",
     )
-    p.add_argument(
-        "--score-episodes",
-        type=arg_type(int, 0, 100_000),
-        default=None,
-        help="score on the first N episodes of the test set (0: no score; default: all of it)",
-    )
+    add_score_episodes_argument(p)
     p.add_argument("--quiet", action="store_true", help="no progress line")
     return p
 
@@ -333,12 +330,13 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    try:  # unusable output paths fail now, before any computing
+    try:  # unusable output paths and a bad --score-episodes fail now, before any computing
         for flag, path in (("--json", args.json), ("--markdown", args.markdown)):
             if path:
                 check_writable(path, flag)
         if args.plots:
             check_directory(args.plots, "--plots")
+        check_score_episodes(args.score_episodes)
     except ValueError as exc:
         parser.error(str(exc))
     try:

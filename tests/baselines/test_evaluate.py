@@ -49,11 +49,28 @@ def test_cli_writes_json_with_issue_keys(tmp_path, capsys):
     assert "score on ACLDBeam-v1/test-v1 (3 random loads" in out and "TV [kV/s]" in out
 
 
-def test_cli_bad_argument_exits_2(capsys):
+@pytest.mark.parametrize(
+    "argv, word",
+    [
+        (["--seed", "abc"], "--seed"),
+        # beyond the test set's 100 episodes: refused before any episode is run (it used
+        # to fail after evaluating every policy, naming the test set's argument n)
+        (["--score-episodes", "101"], "--score-episodes: the test set of ACLDBeam-v1 has 100"),
+        (["--env-id", "ACLDBeamHard-v1", "--score-episodes", "101"], "ACLDBeamHard-v1 has"),
+    ],
+)
+def test_cli_bad_argument_exits_2(argv, word, capsys, monkeypatch):
+    import baselines.evaluate as ev
+
+    def no_computing(*args, **kwargs):
+        raise AssertionError("computed before the arguments were checked")
+
+    monkeypatch.setattr(ev, "evaluate", no_computing)
+    monkeypatch.setattr(ev, "ACLDBeamEnv", no_computing)
     with pytest.raises(SystemExit) as e:
-        main(["--seed", "abc"])
+        main(argv)
     assert e.value.code == 2
-    assert "--seed" in capsys.readouterr().err
+    assert word in capsys.readouterr().err
 
 
 def test_thesis_comparison_lists_saturated_lqr_smc_rows_only():

@@ -76,8 +76,23 @@ def test_the_markdown_has_the_effort_and_the_score(tmp_path, capsys):
     assert "score on ACLDBeam-v1/test-v1 (2 random loads" in capsys.readouterr().out
 
 
-@pytest.mark.parametrize("argv, word", [(["--score-episodes", "-1"], "--score-episodes")])
-def test_bad_score_episodes_exit_2(argv, word, capsys):
+@pytest.mark.parametrize(
+    "argv, word",
+    [
+        (["--score-episodes", "-1"], "--score-episodes"),
+        # beyond the test set: refused before the agents are evaluated (it used to fail
+        # after minutes of evaluation, naming the test set's argument n)
+        (["--score-episodes", "101"], "--score-episodes: the test set of ACLDBeam-v1 has 100"),
+    ],
+)
+def test_bad_score_episodes_exit_2(argv, word, capsys, monkeypatch):
+    import train.compare as cmp
+
+    def no_computing(*args, **kwargs):
+        raise AssertionError("computed before the arguments were checked")
+
+    monkeypatch.setattr(cmp, "load_agents", no_computing)
+    monkeypatch.setattr(cmp, "compare", no_computing)
     with pytest.raises(SystemExit) as e:
         main(argv)
     assert e.value.code == 2 and word in capsys.readouterr().err

@@ -249,12 +249,14 @@ class TrainConfig:
         :class:`train.bench.sb3_policies.SplitCriticPolicy`). Needs an even number of
         sub-envs per load case. Default false: sub-env i gets ``seed + i``.
     env_kwargs : dict
-        SB3 algorithms: options of the *training* env (fields of
-        :class:`acld_gym.envs.config.EnvConfig`, e.g. ``reward_scale: passive``,
-        ``observe_reward_scale: true``, ``param_noise: 0.05``); the evaluation is always on
-        the env id as registered. With ``observe_reward_scale`` the whitening leaves the
-        last entry (log c) alone and the policy must drop it from its actor
-        (:class:`train.bench.sb3_policies.AsymmetricCriticPolicy`).
+        Options of the *training* env (fields of :class:`acld_gym.envs.config.EnvConfig`,
+        e.g. ``reward_scale: passive``, ``observe_reward_scale: true``, ``param_noise:
+        0.05``); the evaluation is always on the env id as registered. With
+        ``observe_reward_scale`` (SB3 algorithms only: vrs's actor reads the whole
+        observation) the whitening leaves the last entry (log c) alone and the policy must
+        drop it from its actor (:class:`train.bench.sb3_policies.AsymmetricCriticPolicy`).
+        vrs: its candidates' episodes run on them (with ``reward_scale`` and ``objective:
+        return`` an episode's score is its scaled return).
     residual : str or None
         SB3 algorithms: ``"lqr"``: the action a in [-1, 1] is added to the discrete LQR
         voltage, ``V = 120 clip(u_lqr / 120 + 2 a, -1, 1)`` [V]
@@ -408,8 +410,11 @@ class TrainConfig:
                 f"env_kwargs must be a mapping of env options, got {self.env_kwargs!r}"
             )
         if self.env_kwargs:
-            if not sb3:
-                raise ValueError("env_kwargs are for the SB3 algorithms (vrs has its own env)")
+            if not sb3 and self.env_kwargs.get("observe_reward_scale"):
+                raise ValueError(
+                    "env_kwargs: observe_reward_scale is for the SB3 algorithms (vrs's "
+                    "actor reads the whole observation, log c included)"
+                )
             if "load_case" in self.env_kwargs:
                 raise ValueError(
                     "env_kwargs: the training loads are the loads: field, not load_case"

@@ -292,6 +292,25 @@ def test_whitening_and_actor():
     assert np.allclose(v[:, 0], expect, atol=1e-4)
 
 
+def test_random_search_episodes_take_the_training_env_options():
+    """vrs's candidates run on ``env_kwargs``: with ``reward_scale: passive`` the passive
+    law (all gains 0) returns exactly -T on every load (acld_gym.envs.scale), where the
+    env's own rewards do not."""
+    from train.bench.search import _CandidateEnvs
+
+    returns = {}
+    for kwargs in ({}, {"reward_scale": "passive"}):
+        envs = _CandidateEnvs("ACLDBeam-v1", {"random": 3}, 2, None, kwargs)
+        try:
+            returns[bool(kwargs)] = envs.returns(np.zeros((2, envs.n_obs + 1)), seed=5)
+            horizon = envs.horizon
+        finally:
+            envs.close()
+    assert returns[True].shape == (2, 3)
+    assert np.allclose(returns[True], -horizon, rtol=1e-9, atol=0)
+    assert not np.allclose(returns[False], -horizon, rtol=1e-3)
+
+
 def test_benchmark_rejects_bad_arguments(tmp_path):
     from train.benchmark import main
 

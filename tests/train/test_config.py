@@ -89,8 +89,14 @@ def test_bad_values_name_the_field(change, word):
 def test_vrs_takes_no_sb3_options():
     with pytest.raises(ValueError, match="SB3"):
         TrainConfig(algo="vrs", timesteps=10, shaping=0.1)
-    with pytest.raises(ValueError, match="env_kwargs"):
-        TrainConfig(algo="vrs", timesteps=10, env_kwargs={"reward_scale": "passive"})
+    # its candidates' episodes take the env's options, but not log c in its observation
+    TrainConfig(algo="vrs", timesteps=10, env_kwargs={"reward_scale": "passive"})
+    with pytest.raises(ValueError, match="env_kwargs: observe_reward_scale is for the SB3"):
+        TrainConfig(
+            algo="vrs",
+            timesteps=10,
+            env_kwargs={"reward_scale": "passive", "observe_reward_scale": True},
+        )
     with pytest.raises(ValueError, match="action_headroom is for the SB3"):
         TrainConfig(algo="vrs", timesteps=10, action_headroom=2.0)
     with pytest.raises(ValueError, match="select and average are for the SB3"):

@@ -136,17 +136,25 @@ class RandomSearch:
 
 class _CandidateEnvs:
     """One native vector env per training load case, with ``per_candidate`` episodes of
-    that case for each of ``n_candidates`` parameter rows (candidate-major)."""
+    that case for each of ``n_candidates`` parameter rows (candidate-major), with the training
+    env options ``env_kwargs``."""
 
     def __init__(
-        self, env_id: str, loads: dict, n_candidates: int, features: str | None = "direction"
+        self,
+        env_id: str,
+        loads: dict,
+        n_candidates: int,
+        features: str | None = "direction",
+        env_kwargs: dict | None = None,
     ):
         self.envs = {}
         self.features = features
         self.n_candidates = n_candidates
         for case, n in loads.items():
             n = int(n)
-            venv = gym.make_vec(env_id, num_envs=n_candidates * n, load_case=case).unwrapped
+            venv = gym.make_vec(
+                env_id, num_envs=n_candidates * n, load_case=case, **(env_kwargs or {})
+            ).unwrapped
             self.envs[case] = (venv, n)
         first = next(iter(self.envs.values()))[0]
         self.v_max = float(first.single_action_space.high[0])
@@ -211,7 +219,9 @@ def train_random_search(
     Returns the final actor and a record (iterations, steps, |theta|)."""
     rs = RandomSearch(**cfg.model)
     rng = np.random.default_rng(seed)
-    envs = _CandidateEnvs(env_id, cfg.load_weights, 2 * rs.n_directions, cfg.features)
+    envs = _CandidateEnvs(
+        env_id, cfg.load_weights, 2 * rs.n_directions, cfg.features, cfg.env_kwargs
+    )
     n_obs = envs.n_obs
     dim = n_obs + 1 + (1 if cfg.features == "direction" else 0)  # features and a bias
     theta = rng.normal(0.0, rs.init_std, dim)

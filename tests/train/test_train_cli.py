@@ -30,7 +30,6 @@ def _exit2(fn, argv, capsys, word):
         (["ppo", "--param-noise", "-0.1"], "--param-noise"),
         (["ppo", "--config", "/nonexistent/ppo.yaml"], "does not exist"),
         (["sac", "--config", "ppo_dagger"], "not 'sac'"),
-        (["vrs", "--param-noise", "0.01"], "env_kwargs"),
         (["ppo", "--random-episodes", "0"], "--random-episodes"),
         (["ppo", "--env-id", "ACLDBeam-v9"], "--env-id"),
         (["ppo", "--backend", "ray"], "--backend"),

@@ -21,11 +21,10 @@ table).
 
 from __future__ import annotations
 
-import dataclasses
 import sys
 
 import numpy as np
-from probe import run_recipe, seeds_main  # benchmarks/probe.py, beside this script
+from probe import one_run, run_recipe, seeds_main  # benchmarks/probe.py, beside this script
 from stable_baselines3.common.buffers import RolloutBuffer
 
 #: The recipe's rollout fields, flattened to (sub-env, step) order before the minibatches.
@@ -65,11 +64,7 @@ class PairedRolloutBuffer(RolloutBuffer):
 
 def config():
     """``train/benchmark/ppo.yaml``'s config, one run, with :class:`PairedRolloutBuffer`."""
-    from train.config import load_config
-
-    cfg = load_config("ppo")
-    model = {**cfg.model, "rollout_buffer_class": PairedRolloutBuffer}
-    return dataclasses.replace(cfg, model=model, restarts=1, restart_above=None)
+    return one_run(None, base="ppo", rollout_buffer_class=PairedRolloutBuffer)
 
 
 def main(argv: list[str] | None = None) -> int:

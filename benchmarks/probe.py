@@ -40,7 +40,7 @@ def one_run(
     base: str = BASE,
     **model,
 ):
-    """The config ``base`` (:data:`BASE` unless given) with ``policy`` (its
+    """The config ``base`` (:data:`BASE` unless given) with ``policy`` (None: the base's; its
     ``policy_kwargs`` added to the base's) and one run per seed, its failures reported
     rather than retried; the keys in ``drop`` are removed from the base's model and policy
     keyword arguments, and ``model`` replaces model keyword arguments."""
@@ -51,6 +51,7 @@ def one_run(
     kept = {k: v for k, v in cfg.model.items() if k not in drop}
     kwargs = {k: v for k, v in kept.get("policy_kwargs", {}).items() if k not in drop}
     kwargs.update(policy_kwargs or {})
+    policy = kept["policy"] if policy is None else policy
     new = {**kept, **model, "policy": policy, "policy_kwargs": kwargs}
     return dataclasses.replace(cfg, model=new, restarts=1, restart_above=None)
 

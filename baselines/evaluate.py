@@ -29,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
+from acld_gym import ENV_ID
 from acld_gym.benchmark import TEST_SETS
 from acld_gym.envs.beam_env import ACLDBeamEnv
 from acld_gym.envs.fingerprint import fingerprint_differences, observation_fingerprint
@@ -351,7 +352,7 @@ def add_score_episodes_argument(p: argparse.ArgumentParser) -> None:
     )
 
 
-def check_score_episodes(n_episodes: int | None, env_id: str = "ACLDBeam-v1") -> None:
+def check_score_episodes(n_episodes: int | None, env_id: str = ENV_ID) -> None:
     """``ValueError`` naming ``--score-episodes`` unless ``n_episodes`` (None: the whole
     set) fits the test set of ``env_id``: a CLI checks it before any computing."""
     size = len(TEST_SETS[env_id].seeds)
@@ -367,7 +368,7 @@ def add_scores(
     env_kwargs: dict,
     quiet: bool = True,
     labels: dict | None = None,
-    env_id: str = "ACLDBeam-v1",
+    env_id: str = ENV_ID,
 ) -> dict:
     """Score ``policies`` on the test set of ``env_id`` (the first ``n_episodes``; 0:
     none), print the score table, and return ``{policy: score dict}`` for the JSON rows."""
@@ -426,8 +427,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument(
         "--env-id",
         choices=list(PRESETS),
-        default="ACLDBeam-v1",
-        help="the registered configuration (default ACLDBeam-v1)",
+        default=ENV_ID,
+        help=f"the registered configuration (default {ENV_ID})",
     )
     p.add_argument(
         "--mesh",

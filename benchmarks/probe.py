@@ -1,11 +1,12 @@
 """What the PPO probes of ``benchmarks/`` share (``residual_actor.py``, ``episode_noise.py``,
 ``beta_actor.py``, ``time_critic.py``, ``antithetic.py``, ``paired_minibatches.py``,
-``actor_steps.py``): the PPO recipe they were measured against, acld-gym 0.8.0-0.14.0's
-(:data:`BASE`; the recipe since 0.15.0 is ``antithetic.py``'s pairs with the entropy
-coefficient 0.05, the ``--recipe ppo`` of two probes, :data:`RECIPES`, and the ``base`` of
-``actor_steps.py``), with another policy, one run per seed
-(:func:`one_run`), trained and evaluated as the benchmark does (:func:`run_recipe`), and
-a command line printing one JSON line per seed (:func:`seeds_main`).
+``actor_steps.py``, ``phase_weights.py``): the PPO recipe they were measured against,
+acld-gym 0.8.0-0.14.0's (:data:`BASE`; the recipe since 0.15.0 is ``antithetic.py``'s
+pairs with the entropy coefficient 0.05, the ``--recipe ppo`` of two probes,
+:data:`RECIPES`, and the ``base`` of ``actor_steps.py``, ``paired_minibatches.py`` and
+``phase_weights.py``), with another policy, one run per seed (:func:`one_run`), trained
+and evaluated as the benchmark does (:func:`run_recipe`), and a command line printing one
+JSON line per seed (:func:`seeds_main`).
 
 A run's line: its settings, its training wall time, its cost on 256 validation loads (the
 recipe's own check at the run's end, :func:`train.bench.evaluate.validation_cost`; LQR

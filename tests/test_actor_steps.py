@@ -1,6 +1,7 @@
 """``benchmarks/actor_steps.py``: the linear law's parameters are a param group of their own
-with the probe's eps and step scale, whose steps are Adam's with the learning rate times
-that scale; every other parameter keeps the recipe's Adam; bad values are named."""
+with the probe's eps, step scale and decoupled weight decay, whose steps are Adam's (AdamW's
+with a decay) with the learning rate times that scale; every other parameter keeps the
+recipe's Adam; bad values are named."""
 
 import pytest
 import torch
@@ -29,12 +30,30 @@ def test_scaled_adam_steps_a_group_as_adam_with_its_learning_rate_scaled():
     assert [g["lr"] for g in opt.param_groups] == [1e-2, 1e-2]  # the schedule's, restored
 
 
+def test_a_decayed_group_steps_as_adamw():
+    torch.manual_seed(1)
+    a = torch.nn.Parameter(torch.randn(4))
+    a2 = torch.nn.Parameter(a.detach().clone())
+    group = {"params": [a], "weight_decay": 0.3, "decoupled_weight_decay": True, "lr_scale": 2.0}
+    opt = acs.ScaledAdam([group], lr=1e-2)
+    ref = torch.optim.AdamW([a2], lr=2e-2, weight_decay=0.3)
+    for _ in range(4):
+        for o, p in ((opt, a), (ref, a2)):
+            o.zero_grad()
+            (p * torch.arange(4.0)).sum().backward()
+            o.step()
+    assert torch.allclose(a, a2, rtol=0, atol=1e-7)
+    assert not torch.allclose(a, a2 + 1e-5)  # the comparison can fail
+
+
 def test_the_law_is_its_own_group_and_the_rest_keeps_the_recipe():
-    model, _ = tiny_model(acs.config(eps=0.2, lr_scale=5.0))
+    model, _ = tiny_model(acs.config(eps=0.2, lr_scale=5.0, weight_decay=0.01))
     pol = model.policy
     rest, law = pol.optimizer.param_groups
     assert [id(p) for p in law["params"]] == [id(p) for p in pol.action_net.parameters()]
     assert law["eps"] == 0.2 and law["lr_scale"] == 5.0
+    assert law["weight_decay"] == 0.01 and law["decoupled_weight_decay"]
+    assert rest["weight_decay"] == 0 and not rest["decoupled_weight_decay"]
     assert "lr_scale" not in rest and rest["eps"] == pol.optimizer_kwargs["eps"] == 1e-5  # SB3's
     every = {id(p) for p in pol.parameters()}
     assert {id(p) for g in (rest, law) for p in g["params"]} == every
@@ -42,7 +61,12 @@ def test_the_law_is_its_own_group_and_the_rest_keeps_the_recipe():
 
 
 @pytest.mark.parametrize(
-    ("kwargs", "name"), [({"eps": 0.0}, "actor_eps"), ({"lr_scale": -1.0}, "actor_lr_scale")]
+    ("kwargs", "name"),
+    [
+        ({"eps": 0.0}, "actor_eps"),
+        ({"lr_scale": -1.0}, "actor_lr_scale"),
+        ({"weight_decay": -0.1}, "actor_weight_decay"),
+    ],
 )
 def test_bad_values_are_named(kwargs, name):
     with pytest.raises(ValueError, match=name):

@@ -24,6 +24,7 @@ import shlex
 import sys
 from pathlib import Path
 
+from acld_gym import ENV_ID
 from acld_gym.util.atomic import check_writable, write_text
 from acld_gym.util.validate import arg_type
 
@@ -91,7 +92,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="per-episode parameter randomization of the training env (an env "
         "option; default: the config's, else none)",
     )
-    p.add_argument("--env-id", default="ACLDBeam-v1", help="(default ACLDBeam-v1)")
+    p.add_argument("--env-id", default=ENV_ID, help=f"(default {ENV_ID})")
     p.add_argument(
         "--random-episodes",
         type=_episodes,

@@ -58,8 +58,8 @@ class ScaledAdam(torch.optim.Adam):
 
 class IsotropicActorPolicy(AsymmetricCriticPolicy):
     """The recipe's policy whose law (``action_net``) is a :class:`ScaledAdam` param group
-    with ``actor_eps`` and ``actor_lr_scale``; every other parameter keeps the recipe's
-    Adam."""
+    with ``actor_eps``, ``actor_lr_scale`` and a decoupled ``actor_weight_decay`` (AdamW's;
+    0: none); every other parameter keeps the recipe's Adam."""
 
     def __init__(
         self,

@@ -3,9 +3,12 @@ RMS of the last episode's rollouts' standard deviations, so rollouts keep their 
 SB3's per-minibatch normalization is off and everything else is the recipe's."""
 
 import numpy as np
+import torch
+from stable_baselines3.common.buffers import RolloutBuffer
 
 from tests.benchmark_scripts import load_script, tiny_model
 from tests.train.tiny_sb3 import shrink_ppo
+from train.config import load_config
 
 pw = load_script("phase_weights")
 
@@ -20,25 +23,16 @@ def rollouts(buf, scales, rng):
         buf.values[:] = 0.0
         buf.episode_starts[:] = 0.0
         buf.pos, buf.full = buf.buffer_size, True
-        last = np.zeros(buf.n_envs, dtype=np.float32)
-        pw.RolloutBuffer.compute_returns_and_advantage(buf, _tensor(last), np.zeros(buf.n_envs))
+        last, dones = torch.zeros(buf.n_envs), np.zeros(buf.n_envs)
+        RolloutBuffer.compute_returns_and_advantage(buf, last, dones)  # SB3's own
         before.append(buf.advantages.copy())
-        buf.compute_returns_and_advantage(_tensor(last), np.zeros(buf.n_envs))
+        buf.compute_returns_and_advantage(last, dones)
         after.append(buf.advantages.copy())
     return after, before
 
 
-def _tensor(x):
-    import torch
-
-    return torch.as_tensor(x)
-
-
 def test_the_config_is_the_recipe_with_the_buffer_and_without_sb3s_normalization():
-    cfg = pw.config()
-    from train.config import load_config
-
-    recipe = load_config("ppo")
+    cfg, recipe = pw.config(), load_config("ppo")
     assert cfg.model["rollout_buffer_class"] is pw.PhaseScaledRolloutBuffer
     assert cfg.model["normalize_advantage"] is False
     rest = {

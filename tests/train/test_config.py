@@ -145,7 +145,7 @@ def test_parse_load_case_names_the_choices(value):
 
 def test_base_applies_the_recipe_under_a_files_own_settings(tmp_path):
     """``base:`` names a recipe; the file's settings go on top, nested mappings key by key."""
-    _, ppo = read_config("ppo")
+    _, ppo = read_config("ablation_ppo_v015")  # acld-gym 0.15.0-0.17.1's recipe, whole
     _, independent = read_config("ablation_ppo_independent")  # acld-gym 0.8.0-0.14.0's, whole
     pk = {
         k: v
@@ -184,6 +184,15 @@ def test_base_applies_the_recipe_under_a_files_own_settings(tmp_path):
                 "critic_features": "negative_scaled_quadratic",
             },
         },
+    }
+    # today's (0.18.0): a run retried above 0.520 on validation, not above LQR's cost
+    _, today = read_config("ppo")
+    assert today == {**ppo, "restart_above": 0.52}
+    assert read_config("ablation_ppo_retry_above_0520")[1] == today
+    assert read_config("ablation_ppo_lowest_of_5")[1] == {
+        **ppo,
+        "restarts": 5,
+        "restart_above": None,
     }
     _, one_run = read_config("ablation_ppo_one_run")  # acld-gym 0.7.0's recipe: one run
     assert one_run == {**independent, "restarts": 1, "restart_above": None, "select": None}

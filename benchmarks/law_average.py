@@ -8,9 +8,10 @@ points of a flat valley of near-optimal laws and differ on the thesis's single l
 the cost is convex near the laws, it is at least as good as the k laws' mean cost. This
 script evaluates, for each of the n agents of benchmarks' output directories in seed order,
 the mean law of it and its k - 1 successors (cyclically), and prints the IQM over the n
-groups next to the single agents' IQM (ISE / LQR on cases 1 / 2 / 3 / random, the
-benchmark's evaluation: :func:`train.bench.evaluate.batched_ise`). Not a test, and not a
-training recipe: an analysis of runs already made; a few seconds::
+groups next to the single agents' IQM (ISE / LQR on cases 1 / 2 / 3 / random on the env
+the agents were trained on, the benchmark's evaluation:
+:func:`train.bench.evaluate.batched_ise`). Not a test, and not a training recipe: an
+analysis of runs already made; a few seconds::
 
     python benchmarks/law_average.py DIR [DIR ...] [--algo ppo] --k 10
 
@@ -95,15 +96,15 @@ def main(argv: list[str] | None = None) -> int:
     )
     ap.add_argument("--algo", help="the agents' algorithm (default: the only one there)")
     ap.add_argument("--k", type=int, default=1, help="laws per mean (default 1: each alone)")
-    ap.add_argument("--env-id", default="ACLDBeam-v1")
     args = ap.parse_args(argv)
     agents = load_agents(args.directories, args.algo)
     groups = cyclic_groups(len(agents), args.k)
+    env_id = agents[0].metadata["env"]["id"]  # the one env of all (mean_law checks "env")
     episodes = eval_episodes()
-    lqr = lqr_ise(args.env_id, episodes)
+    lqr = lqr_ise(env_id, episodes)
 
     def rel(agent) -> list[float]:
-        ise = batched_ise(agent, args.env_id, episodes)
+        ise = batched_ise(agent, env_id, episodes)
         return [ise[c] / lqr[c] for c in CASES]
 
     single = [rel(ag) for ag in agents]

@@ -30,15 +30,13 @@ import numpy as np
 
 from acld_gym.util.stats import iqm
 from train.agent import ActorProgram, TrainedAgent
-from train.bench.evaluate import batched_ise, eval_episodes, lqr_ise
+from train.bench.evaluate import CASES, batched_ise, eval_episodes, lqr_ise, relative_ise
 
 #: The actor program of a saturated linear law (:func:`train.agent.linear_program`; an
 #: exported SB3 actor has the first operation only: the program clips its output anyway).
 LINEAR_OPS = ({"op": "linear", "layer": 0}, {"op": "clip", "low": -1.0, "high": 1.0})
 #: The metadata that must agree for two laws to act on the same observation alike.
 SAME = ("env", "observation", "residual", "action_headroom")
-#: Table order of the evaluation's cases.
-CASES = (1, 2, 3, "random")
 
 
 def mean_law(agents: list[TrainedAgent]) -> TrainedAgent:
@@ -101,14 +99,15 @@ def main(argv: list[str] | None = None) -> int:
     groups = cyclic_groups(len(agents), args.k)
     env_id = agents[0].metadata["env"]["id"]  # the one env of all (mean_law checks "env")
     episodes = eval_episodes()
-    lqr = lqr_ise(env_id, episodes)
+    refs = {"lqr": lqr_ise(env_id, episodes)}
 
     def rel(agent) -> list[float]:
-        ise = batched_ise(agent, env_id, episodes)
-        return [ise[c] / lqr[c] for c in CASES]
+        ise = relative_ise(batched_ise(agent, env_id, episodes), refs)
+        return [ise[c] for c in CASES]
 
     single = [rel(ag) for ag in agents]
-    means = [rel(mean_law([agents[i] for i in g])) for g in groups]
+    # k = 1: each group is one agent, whose mean law is its own (evaluated once)
+    means = single if args.k == 1 else [rel(mean_law([agents[i] for i in g])) for g in groups]
     for g, r in zip(groups, means, strict=True):
         print(json.dumps({"laws": [agents[i].name for i in g], "ise_rel_lqr": r}))
     for label, rows in (("single", single), (f"mean of {args.k}", means)):

@@ -45,7 +45,10 @@ from train.agent import TrainedAgent
 from train.bench.evaluate import (
     CASES,
     DEFAULT_ENV_ID,
-    ise_rel_lqr,
+    eval_episodes,
+    lqr_ise,
+    relative_ise,
+    rollout_ise,
     validation_cost,
     validation_seeds,
 )
@@ -64,12 +67,14 @@ def mpc(env, rho: float, horizon: int = HORIZON) -> MPCPolicy:
     return MPCPolicy.for_env(env, horizon=horizon, rho=rho, state_weight=0.0)
 
 
-def row(name: str, policy, env_id: str, seeds) -> dict:
-    """The JSON line of ``policy``: its validation cost on the loads of ``seeds`` and ISE /
-    LQR per case, with the seconds both took."""
+def row(name: str, policy, env_id: str, seeds, refs: dict) -> dict:
+    """The JSON line of ``policy``: its validation cost on the loads of ``seeds`` and its ISE
+    per case relative to ``refs`` (``{"lqr": LQR's ISE per case}``, computed once for all
+    rows), with the seconds both took; the ISE as
+    :func:`train.bench.evaluate.ise_rel_lqr` has it."""
     t0 = time.perf_counter()
     cost = validation_cost(policy, env_id, seeds)
-    rel = ise_rel_lqr(policy, env_id)
+    rel = relative_ise(rollout_ise(policy, env_id, eval_episodes()), refs)
     return {
         "policy": name,
         "validation_cost": cost,
@@ -106,8 +111,9 @@ def main(argv: list[str] | None = None) -> int:
     policies = {"lqr": LQRPolicy.for_env(env)}
     policies |= {f"mpc rho={r:g}": mpc(env, r, args.horizon) for r in args.rho}
     policies |= {ag.name: ag for ag in agents}
+    refs = {"lqr": lqr_ise(args.env_id, eval_episodes())}
     for name, policy in policies.items():
-        print(json.dumps(row(name, policy, args.env_id, seeds)), flush=True)
+        print(json.dumps(row(name, policy, args.env_id, seeds, refs)), flush=True)
     return 0
 
 

@@ -25,6 +25,7 @@ from acld_gym.design.feedback import (
     passive,
 )
 from acld_gym.design.nominal import NominalDesign, nominal_design
+from acld_gym.envs.config import EnvConfig
 from acld_gym.envs.fingerprint import design_fingerprint
 from acld_gym.physics.actuator import V_LIMIT
 
@@ -33,6 +34,7 @@ __all__ = [
     "LQRPolicy",
     "SMCPolicy",
     "MPCPolicy",
+    "RewardMPCPolicy",
     "MeasurementFeedback",
     "MPC_MISSING",
     "mpc_available",
@@ -318,6 +320,49 @@ class MPCPolicy(_Policy):
                 raise RuntimeError(f"MPC: OSQP returned status {res.info.status!r}")
             out[i] = V_LIMIT * float(res.x[0])
         return out
+
+
+class RewardMPCPolicy(MPCPolicy):
+    r"""The certainty-equivalent MPC of the env's own reward: :class:`MPCPolicy` without
+    its robustness weight (``state_weight=0``) and with the voltage weight that makes its
+    cost the env's step cost (:func:`acld_gym.envs.step.reward_terms`). The env charges
+    :math:`(y / y_{ref})^2 + \lambda (V / 120\ \mathrm{V})^2` per step; times
+    :math:`(y_{ref} / 1\ \mathrm{mm})^2` that is the MPC's stage cost with
+
+    .. math:: \rho = \lambda\, (y_{ref} / 1\ \mathrm{mm})^2,
+
+    so on the nominal plant, up to the Kalman estimate and the finite horizon, it is the
+    nonlinear causal law built for the objective the agents are trained on (they are
+    scored on the ISE, which does not charge for the voltage). ``lam`` and ``y_ref``
+    default to the env's (:class:`acld_gym.envs.config.EnvConfig`); ``for_env`` reads
+    them from the env. Nominal plant only: without the state weight a 10 % stiffer or
+    softer beam makes its small-signal loop unstable (:class:`MPCPolicy`).
+    """
+
+    name = "mpc_reward"
+
+    def __init__(
+        self,
+        dt: float = 1e-3,
+        horizon: int = 60,
+        lam: float = EnvConfig.lam,
+        y_ref: float = EnvConfig.y_ref,
+        nom=None,
+        mesh: str = "converged",
+    ):
+        if not lam >= 0:
+            raise ValueError(f"lam must be non-negative, got {lam!r}")
+        if not y_ref > 0:
+            raise ValueError(f"y_ref must be a positive deflection [m], got {y_ref!r}")
+        self.lam, self.y_ref = float(lam), float(y_ref)
+        rho = self.lam * (self.y_ref / 1e-3) ** 2
+        super().__init__(dt, horizon, rho=rho, state_weight=0.0, nom=nom, mesh=mesh)
+
+    @classmethod
+    def for_env(cls, env, **kwargs):
+        """The policy for ``env``'s nominal model and reward (its ``lam`` and ``y_ref``)."""
+        e = env.unwrapped
+        return super().for_env(env, **({"lam": e.lam, "y_ref": e.y_ref} | kwargs))
 
 
 class MeasurementFeedback:

@@ -11,7 +11,9 @@ estimate, over a horizon of H steps, it minimises
 which for :math:`\\rho = \\lambda` (the env's ``lam``, 0.01) is the env's step cost with its
 default ``y_ref`` of 1 mm (:func:`acld_gym.envs.step.reward_terms`) up to the estimate, the
 horizon and each load's constant scale. It is :class:`baselines.policies.MPCPolicy`
-without its robustness weight (``state_weight=0``), on the env's nominal model. Being
+without its robustness weight (``state_weight=0``), on the env's nominal model; at
+:math:`\\rho = \\lambda` it is :class:`baselines.policies.RewardMPCPolicy`, the
+``mpc_reward`` row of ``python -m train.compare``'s tables. Being
 certainty-equivalent and of finite horizon it is not the optimum of the objective, so a
 weight :math:`\\rho` below :math:`\\lambda` may serve the objective better; the script
 sweeps ``--rho``.

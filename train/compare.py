@@ -2,7 +2,8 @@
 
 For each thesis load case (1, 2, 3) and a fixed held-out set of random loads
 (``case "random"``: the mean over the set; seeds disjoint from anything used in
-training), runs passive / LQR / SMC / MPC, every shipped agent (``train/agents/``,
+training), runs passive / LQR / SMC / MPC, the MPC of the env's own reward
+(``mpc_reward``, :func:`reference_policies`), every shipped agent (``train/agents/``,
 labelled by how it was trained: "from scratch" or "DAgger from MPC + RL") and the
 clairvoyant bound through ``ACLDBeam-v1`` (+/-120 V, 1 ms, default Kalman observer) and prints
 peak [mm], 5 % settling [s], ISE [m^2 s], ISE relative to LQR and to the bound,
@@ -55,6 +56,7 @@ __all__ = [
     "agent_names",
     "load_agents",
     "training_labels",
+    "reference_policies",
     "compare",
     "relative",
     "markdown_table",
@@ -97,6 +99,20 @@ def load_agents(directory: str | Path = AGENTS_DIR, names=None, mesh: str = "con
     directory = Path(directory)
     names = agent_names(directory, mesh) if names is None else names
     return {name: TrainedAgent.load(directory / name, name) for name in names}
+
+
+def reference_policies(mesh: str = "converged") -> dict:
+    """Passive, LQR, SMC and MPC (:func:`baselines.evaluate.default_policies`) and, where
+    the MPC's QP solver is installed, the MPC of the env's own reward
+    (:class:`baselines.policies.RewardMPCPolicy`, ``"mpc_reward"``: the nonlinear law built
+    for the objective the agents are trained on, at the env's default ``lam`` and
+    ``y_ref``), designed on the nominal ``mesh`` plant."""
+    from baselines.policies import RewardMPCPolicy, mpc_available
+
+    out = default_policies(mesh)
+    if mpc_available():
+        out[RewardMPCPolicy.name] = RewardMPCPolicy(mesh=mesh)
+    return out
 
 
 def training_labels(policies: dict) -> dict[str, str]:
@@ -160,24 +176,27 @@ def relative(rows: list[EvalRow], labels: dict | None = None) -> list[dict]:
 
 
 def markdown_table(rows: list[dict]) -> str:
-    """The comparison as one markdown table (rows from :func:`relative`); the effort after
-    settling is "-" where there is no settled window (random loads)."""
+    """The comparison as one markdown table (rows from :func:`relative`): the ISE, the
+    episode's return (the env's reward, which charges for the voltage; the mean over the
+    random loads), the effort, "-" after settling where there is no settled window
+    (random loads)."""
 
     def num(x, fmt: str, scale: float = 1.0) -> str:
         return "-" if x is None else format(x * scale, fmt)
 
     head = (
         "| case | policy | trained | peak [mm] | settling [s] | ISE [m^2 s] | ISE / LQR "
-        "| ISE / bound | max abs V [V] | V rms [V] | Q [mvar] | TV after settling [kV/s] "
-        "| at limit after settling | ms / step |"
+        "| ISE / bound | return | max abs V [V] | V rms [V] | Q [mvar] "
+        "| TV after settling [kV/s] | at limit after settling | ms / step |"
     )
-    out = [head, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    out = [head, "|" + "---|" * head.count(" | ") + "---|"]
     for d in rows:
         out.append(
             f"| {d['case']} | {d['policy']} | {d.get('training', '')} "
             f"| {d['peak_mm']:.3f} | {d['settling_s']:.3f} "
             f"| {d['ise']:.3e} | {d['ise_rel_lqr']:.2f} | {d['ise_rel_bound']:.2f} "
-            f"| {d['max_voltage_V']:.0f} | {num(d.get('rms_voltage_V'), '.1f')} "
+            f"| {d['return']:.1f} | {d['max_voltage_V']:.0f} "
+            f"| {num(d.get('rms_voltage_V'), '.1f')} "
             f"| {num(d.get('reactive_power_var'), '.1f', 1e3)} "
             f"| {num(d.get('total_variation_V_per_s'), '.1f', 1e-3)} "
             f"| {num(d.get('limit_fraction'), '.0%')} | {d['ms_per_step']:.3f} |"
@@ -344,7 +363,7 @@ def main(argv: list[str] | None = None) -> int:
         agents = load_agents(args.agents, names, mesh=args.mesh)
     except (OSError, ValueError) as exc:
         parser.error(str(exc))
-    policies = {**default_policies(args.mesh), **agents}
+    policies = {**reference_policies(args.mesh), **agents}
     seeds = tuple(range(HELDOUT_SEEDS[0], HELDOUT_SEEDS[0] + args.random_episodes))
     episodes: dict = {}
     rows = compare(

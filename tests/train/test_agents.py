@@ -100,7 +100,7 @@ def test_heldout_random_set_reproduces_the_table(agents, name):
 
 
 def test_table_is_complete():
-    policies = {"passive", "lqr", "smc", "mpc", "bound", *NAMES}
+    policies = {"passive", "lqr", "smc", "mpc", "mpc_reward", "bound", *NAMES}
     for case in (1, 2, 3, "random"):
         assert {r["policy"] for r in ROWS if r["case"] == case} >= policies
     for r in ROWS:

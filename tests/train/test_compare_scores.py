@@ -21,7 +21,7 @@ def _scores():
 
 def test_every_policy_of_the_shipped_table_has_a_full_score():
     scores = _scores()
-    assert {"passive", "lqr", "smc", "mpc", "bound"} <= set(scores)
+    assert {"passive", "lqr", "smc", "mpc", "mpc_reward", "bound"} <= set(scores)
     for name, s in scores.items():
         assert s["n_episodes"] >= 100 and s["test_set"] == "ACLDBeam-v1/test-v1", name
         assert s["ci_low"] <= s["iqm"] <= s["ci_high"]
@@ -70,6 +70,7 @@ def test_the_markdown_has_the_effort_and_the_score(tmp_path, capsys):
     text = md.read_text()
     assert "| V rms [V] | Q [mvar] | TV after settling [kV/s] |" in text
     assert "| vrs | from scratch |" in text and "95 % CI" in text
+    assert "| ISE / bound | return |" in text and "| mpc_reward | designed |" in text
     rows = json.loads(js.read_text())
     assert markdown_table(rows) in text and markdown_scores(rows) in text
     assert {r["score"]["n_episodes"] for r in rows} == {2}

@@ -100,8 +100,15 @@ def test_benchmark_runs_end_to_end(tmp_path, capsys):
             s = a["ise_rel_lqr"][case]
             assert 0 < s["ci_low"] <= s["iqm"] <= s["ci_high"] < 10
         assert len(a["curve"]) >= 2 and a["curve"][0]["steps"] == 0
+        # the env's own objective per seed (256 validation loads) and its IQM
+        costs = [s["validation_cost"] for s in a["per_seed"]]
+        assert all(0 < c < 2 for c in costs)
+        assert min(costs) <= a["validation_cost"]["iqm"] <= max(costs)
+    refs = summary["reference_validation_cost"]
+    assert refs["passive"] == pytest.approx(1.0) and refs["lqr"] < refs["passive"]
     md = (out / "results.md").read_text()
     assert "| tiny_vrs (vrs) | 8,000 | 2 |" in md and "mpc (reference)" in md
+    assert f"| lqr (reference) | - | - | 1.000 | 1.000 | 1.000 | 1.000 | {refs['lqr']:.4f} |" in md
     # a repeat with --resume trains nothing
     assert main([*argv, "--resume"]) == 0
     assert "0 runs (4 reused)" in capsys.readouterr().out

@@ -16,6 +16,7 @@ from train.bench.report import (
     main,
     markdown,
     replace_block,
+    stretch_lines,
 )
 from train.config import read_config
 
@@ -128,3 +129,40 @@ def test_plot_writes_the_figure_and_refuses_a_directory(tmp_path, capsys):
     with pytest.raises(SystemExit) as e:
         main([str(RESULTS), "--plot", str(tmp_path)])
     assert e.value.code == 2 and "--plot" in capsys.readouterr().err
+
+
+def _algo(iqms, cost=None):
+    cells = {c: {"iqm": v, "ci_low": v, "ci_high": v, "n": 5} for c, v in iqms.items()}
+    out = {"ise_rel_lqr": cells}
+    if cost is not None:
+        out["validation_cost"] = {"iqm": cost, "ci_low": cost, "ci_high": cost, "n": 5}
+    return out
+
+
+def test_the_stretch_lines_compare_each_algorithm_with_the_random_search_per_case():
+    cases = ("1", "2", "3", "random")
+    base = _algo(dict(zip(cases, (0.83679, 0.857, 0.98782, 0.957), strict=True)), 0.5125)
+    tie = _algo(dict(zip(cases, (0.83679, 0.83, 0.98, 0.95), strict=True)), 0.5150)
+    ahead = _algo(dict(zip(cases, (0.83669, 0.83, 0.98, 0.95), strict=True)))
+    lines = stretch_lines({"algorithms": {"vrs": base, "ppo": tie, "sac": ahead}})
+    ppo = next(x for x in lines if x.startswith("- ppo"))
+    # a tie is not below: 3 of 4, with the case and both figures to five decimals
+    assert "below on 3 of 4 cases" in ppo and "case 1 0.83679 >= 0.83679" in ppo
+    assert "random 0.95000 < 0.95700" in ppo
+    assert ppo.endswith("validation cost 0.51500 >= 0.51250.")
+    sac = next(x for x in lines if x.startswith("- sac"))
+    assert "below on 4 of 4 cases" in sac and "validation cost" not in sac  # none recorded
+    assert stretch_lines({"algorithms": {"ppo": tie}}) == []  # no search, no stretch
+
+
+def test_a_summary_without_validation_costs_prints_dashes():
+    summary = json.loads(RESULTS.read_text())
+    for a in summary["algorithms"].values():
+        a["validation_cost"] = None
+        for s in a["per_seed"]:
+            s["validation_cost"] = None
+    summary.pop("reference_validation_cost", None)
+    text = markdown(summary)
+    row = next(x for x in text.splitlines() if x.startswith("| ppo | 0 "))
+    assert row.split(" | ")[-2] == "-"  # the per-seed validation cost
+    assert "| lqr (reference) | - | - | 1.000 | 1.000 | 1.000 | 1.000 | - | - |" in text

@@ -38,6 +38,7 @@ __all__ = [
     "batched_ise",
     "relative_ise",
     "VALIDATION_SEED0",
+    "OBJECTIVE_LOADS",
     "validation_seeds",
     "validation_cost",
     "validation_rollout",
@@ -134,6 +135,12 @@ def _side_by_side(policy, venvs: list, obs: list, value) -> tuple[list, list]:
 VALIDATION_SEED0 = 200_000
 
 
+#: Validation loads of the benchmark's per-seed objective figure (``validation_cost`` in a
+#: trial's record and the report): the 256 the recipes select their runs on
+#: (``select: {episodes: 256}`` in ``train/benchmark/ppo.yaml`` and ``sac.yaml``).
+OBJECTIVE_LOADS = 256
+
+
 def validation_seeds(n: int) -> tuple:
     """The first ``n`` validation seeds (random loads), from :data:`VALIDATION_SEED0`."""
     return tuple(range(VALIDATION_SEED0, VALIDATION_SEED0 + int(n)))
@@ -219,7 +226,11 @@ def references(
     bound: bool = True,
 ) -> dict[str, Any]:
     """Mean ISE per case of passive, LQR, SMC, MPC and the clairvoyant bound,
-    ``{"env_id": ..., "episodes": ..., "passive": {case: ise}, ...}`` (cases as strings).
+    ``{"env_id": ..., "episodes": ..., "passive": {case: ise}, ...}`` (cases as strings),
+    and the :func:`validation_cost` of passive, LQR and SMC on the first
+    :data:`OBJECTIVE_LOADS` validation loads, ``"validation_cost": {name: cost}`` (the
+    MPC's, a QP per load and step, and the bound's are left out: not needed to read the
+    agents' figure, and slow).
 
     Read from ``cache`` (JSON) when it holds the same env id and episodes, else computed
     (the bound takes about 30 s) and written there atomically.
@@ -234,12 +245,17 @@ def references(
             data.get("env_id") == env_id
             and data.get("episodes") == key
             and (not bound or "bound" in data)
+            and "validation_cost" in data
         ):
             return data
     pols = reference_policies(env_id)
     data: dict[str, Any] = {"env_id": env_id, "episodes": key}
     for name, pol in pols.items():
         data[name] = {str(c): v for c, v in rollout_ise(pol, env_id, episodes).items()}
+    seeds = validation_seeds(OBJECTIVE_LOADS)
+    data["validation_cost"] = {
+        name: validation_cost(pols[name], env_id, seeds) for name in ("passive", "lqr", "smc")
+    }
     if bound:
         data["bound"] = {}
         for case, seeds in episodes.items():

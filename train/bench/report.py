@@ -9,7 +9,7 @@ import numpy as np
 
 from acld_gym.util.atomic import save_figure
 
-from .evaluate import CASES
+from .evaluate import CASES, OBJECTIVE_LOADS
 from .trials import REFERENCES
 
 __all__ = [
@@ -17,6 +17,7 @@ __all__ = [
     "goals_of",
     "summarize",
     "markdown",
+    "stretch_lines",
     "ratio_log_axis",
     "curves_figure",
     "plot_curves",
@@ -62,8 +63,11 @@ def summarize(records: list[dict], refs: dict) -> dict:
             k: {c: refs[k][c] / lqr[c] for c in lqr} for k in ("passive", *REFERENCES) if k in refs
         },
     }
+    if "validation_cost" in refs:
+        out["reference_validation_cost"] = dict(refs["validation_cost"])
     for name in dict.fromkeys(r["name"] for r in records):
         runs = sorted((r for r in records if r["name"] == name), key=lambda r: r["seed"])
+        costs = [r.get("validation_cost") for r in runs]
         rel = np.array([[r["final_ise"][str(c)] / lqr[str(c)] for c in CASES] for r in runs])
         stats = {str(c): iqm_with_ci(rel[:, j]) for j, c in enumerate(CASES)}
         goals = goals_of(rel, stats, out["references"], runs)
@@ -83,6 +87,11 @@ def summarize(records: list[dict], refs: dict) -> dict:
             "restart_above": runs[0]["config"].get("restart_above"),
             "seeds": [r["seed"] for r in runs],
             "ise_rel_lqr": stats,
+            # the env's own objective (train.bench.evaluate.OBJECTIVE_LOADS validation
+            # loads); None for trials recorded before it was (acld-gym < 0.19)
+            "validation_cost": (
+                None if None in costs else iqm_with_ci(np.array(costs, dtype=float))
+            ),
             "goals": goals,
             "train_seconds": {
                 "iqm": iqm([r["train_seconds"] for r in runs]),
@@ -99,6 +108,7 @@ def summarize(records: list[dict], refs: dict) -> dict:
                     "train_cpu_seconds": r.get("train_cpu_seconds", np.nan),
                     "runs": len(r.get("record", {}).get("restarts", {}).get("runs", [None])),
                     **{str(c): float(rel[i, j]) for j, c in enumerate(CASES)},
+                    "validation_cost": costs[i],
                 }
                 for i, r in enumerate(runs)
             ],
@@ -120,31 +130,40 @@ def budget(a: dict) -> str:
 def markdown(summary: dict) -> str:
     """The summary as markdown: the IQM table, the goals and the per-seed table."""
 
-    def cell(s):
-        return f"{s['iqm']:.3f} [{s['ci_low']:.3f}, {s['ci_high']:.3f}]"
+    def cell(s, fmt=".3f"):
+        return f"{s['iqm']:{fmt}} [{s['ci_low']:{fmt}}, {s['ci_high']:{fmt}}]"
+
+    def cost(x, fmt=".4f"):
+        return "-" if x is None else (cell(x, fmt) if isinstance(x, dict) else f"{x:{fmt}}")
 
     n_rand = len(summary["episodes"]["random"])
+    ref_costs = summary.get("reference_validation_cost", {})
     lines = [
         f"ISE / ISE_LQR on `{summary['env_id']}` (+/-120 V, 1 ms, Kalman observer, "
         f"deterministic policy): IQM over seeds [95 % stratified-bootstrap CI]; thesis "
-        f"cases seed 0, `random` = mean ISE over {n_rand} held-out episodes / LQR's.",
+        f"cases seed 0, `random` = mean ISE over {n_rand} held-out episodes / LQR's. "
+        f"*Validation cost*: the env's own objective, which the agents are trained on and "
+        f"which charges for the voltage: the step cost on each of {OBJECTIVE_LOADS} "
+        "validation loads divided by the passive beam's, averaged (passive 1, lower is "
+        "better; `train.bench.evaluate.validation_cost`).",
         "",
         "| algorithm | budget [env steps] | seeds | case 1 | case 2 | case 3 | random "
-        "| train wall / CPU time per seed [s] (IQM; max) |",
-        "|---|---|---|---|---|---|---|---|",
+        "| validation cost | train wall / CPU time per seed [s] (IQM; max) |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
     for name, a in summary["algorithms"].items():
         t, cpu = a["train_seconds"], a["train_cpu_seconds"]
         lines.append(
             f"| {name} ({a['algo']}) | {budget(a)} | {len(a['seeds'])} | "
             + " | ".join(cell(a["ise_rel_lqr"][str(c)]) for c in CASES)
+            + f" | {cost(a.get('validation_cost'))}"
             + f" | {t['iqm']:.0f} / {cpu['iqm']:.0f}; {t['max']:.0f} / {cpu['max']:.0f} |"
         )
     for ref, vals in summary["references"].items():
         lines.append(
             f"| {ref} (reference) | - | - | "
             + " | ".join(f"{vals[str(c)]:.3f}" for c in CASES)
-            + " | - |"
+            + f" | {cost(ref_costs.get(ref))} | - |"
         )
     lines += [
         "",
@@ -157,12 +176,14 @@ def markdown(summary: dict) -> str:
         lines.append(
             f"| {name} | " + " | ".join("yes" if v else "no" for v in a["goals"].values()) + " |"
         )
+    lines += stretch_lines(summary)
     lines += [
         "",
-        "Per seed (ISE / LQR):",
+        "Per seed (ISE / LQR; validation cost):",
         "",
-        "| algorithm | seed | case 1 | case 2 | case 3 | random | train wall / CPU [s] |",
-        "|---|---|---|---|---|---|---|",
+        "| algorithm | seed | case 1 | case 2 | case 3 | random | validation cost "
+        "| train wall / CPU [s] |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     for name, a in summary["algorithms"].items():
         for s in a["per_seed"]:
@@ -171,10 +192,49 @@ def markdown(summary: dict) -> str:
             if a.get("restart_above"):  # how many runs this seed took
                 seed = f"{seed} ({s['runs']} run{'s' if s['runs'] > 1 else ''})"
             lines.append(
-                f"| {name} | {seed} | {vals} | {s['train_seconds']:.0f} / "
-                f"{s['train_cpu_seconds']:.0f} |"
+                f"| {name} | {seed} | {vals} | {cost(s.get('validation_cost'), '.5f')} "
+                f"| {s['train_seconds']:.0f} / {s['train_cpu_seconds']:.0f} |"
             )
     return "\n".join(lines) + "\n"
+
+
+#: The algorithm issue 20's stretch goal measures the deep-RL agents against.
+STRETCH_BASE = "vrs"
+
+
+def stretch_lines(summary: dict) -> list[str]:
+    """Issue 20's stretch goal, read off the summary: for each algorithm but
+    :data:`STRETCH_BASE`, the cases whose IQM of ISE / LQR is below the random search's
+    (five decimals: the two can be that close) and, where both have it, the IQM of the
+    validation cost against the search's. No lines without the search."""
+    algos = summary["algorithms"]
+    base = algos.get(STRETCH_BASE)
+    if base is None or len(algos) < 2:
+        return []
+    out = [
+        "",
+        f"Stretch (issue 20): the IQM below {STRETCH_BASE}'s on every case "
+        "(ISE / LQR, and the validation cost, lower is better):",
+        "",
+    ]
+    for name, a in algos.items():
+        if name == STRETCH_BASE:
+            continue
+        cells = []
+        for c in CASES:
+            x, y = a["ise_rel_lqr"][str(c)]["iqm"], base["ise_rel_lqr"][str(c)]["iqm"]
+            label = "random" if c == "random" else f"case {c}"
+            cells.append(f"{label} {x:.5f} {'<' if x < y else '>='} {y:.5f}")
+        wins = sum(
+            a["ise_rel_lqr"][str(c)]["iqm"] < base["ise_rel_lqr"][str(c)]["iqm"] for c in CASES
+        )
+        line = f"- {name}: below on {wins} of {len(CASES)} cases ({'; '.join(cells)})"
+        va, vb = a.get("validation_cost"), base.get("validation_cost")
+        if va is not None and vb is not None:
+            x, y = va["iqm"], vb["iqm"]
+            line += f"; validation cost {x:.5f} {'<' if x < y else '>='} {y:.5f}"
+        out.append(line + ".")
+    return out
 
 
 def plot_curves(summary: dict, path: Path) -> Path:

@@ -46,13 +46,21 @@ def run_trial(
     record (JSON-able: the learning curve, mean ISE per case at each evaluation, batched --
     with restarts, the returned run's, ``train_algo``;
     the final ISE per case, single-env rollouts; the training wall time, evaluations
-    excluded; the command) and the final policy. With ``out``, the policy is saved as an
+    excluded; the final policy's ``validation_cost``, the env's own objective on the
+    first :data:`train.bench.evaluate.OBJECTIVE_LOADS` validation loads; the command) and
+    the final policy. With ``out``, the policy is saved as an
     agent in :func:`agent_dir`. ``workers``: how many of the trial's runs (``restarts``)
     train at once (:func:`train.bench.algos.train_algo`: the same result, in less time)."""
     import torch
 
     from .algos import train_algo
-    from .evaluate import eval_episodes, rollout_ise
+    from .evaluate import (
+        OBJECTIVE_LOADS,
+        eval_episodes,
+        rollout_ise,
+        validation_cost,
+        validation_seeds,
+    )
 
     torch.set_num_threads(1)
     cfg = TrainConfig.from_dict(config)
@@ -61,6 +69,7 @@ def run_trial(
     policy, record = train_algo(cfg, seed, env_id, CaseISE(env_id, episodes), workers)
     wall = time.perf_counter() - t0
     final = rollout_ise(policy, env_id, episodes)
+    cost = validation_cost(policy, env_id, validation_seeds(OBJECTIVE_LOADS))
     rec = {
         "name": name,
         "algo": cfg.algo,
@@ -76,6 +85,7 @@ def run_trial(
         "train_cpu_seconds": float(record.get("train_cpu_seconds", np.nan)),
         "wall_seconds": wall,
         "final_ise": {str(c): v for c, v in final.items()},
+        "validation_cost": cost,
         "curve": record["curve"],
         "record": {
             k: v

@@ -252,9 +252,9 @@ def references(
     data: dict[str, Any] = {"env_id": env_id, "episodes": key}
     for name, pol in pols.items():
         data[name] = {str(c): v for c, v in rollout_ise(pol, env_id, episodes).items()}
-    seeds = validation_seeds(OBJECTIVE_LOADS)
+    loads = validation_seeds(OBJECTIVE_LOADS)
     data["validation_cost"] = {
-        name: validation_cost(pols[name], env_id, seeds) for name in ("passive", "lqr", "smc")
+        name: validation_cost(pols[name], env_id, loads) for name in ("passive", "lqr", "smc")
     }
     if bound:
         data["bound"] = {}

@@ -128,7 +128,8 @@ def budget(a: dict) -> str:
 
 
 def markdown(summary: dict) -> str:
-    """The summary as markdown: the IQM table, the goals and the per-seed table."""
+    """The summary as markdown: the IQM table (ISE / LQR and the validation cost), the
+    goals, the stretch goal (:func:`stretch_lines`) and the per-seed table."""
 
     def cell(s, fmt=".3f"):
         return f"{s['iqm']:{fmt}} [{s['ci_low']:{fmt}}, {s['ci_high']:{fmt}}]"

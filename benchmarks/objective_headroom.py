@@ -69,14 +69,14 @@ def mpc(env, rho: float, horizon: int = HORIZON) -> MPCPolicy:
     return MPCPolicy.for_env(env, horizon=horizon, rho=rho, state_weight=0.0)
 
 
-def row(name: str, policy, env_id: str, seeds, refs: dict) -> dict:
+def row(name: str, policy, env_id: str, seeds, episodes: dict, refs: dict) -> dict:
     """The JSON line of ``policy``: its validation cost on the loads of ``seeds`` and its ISE
-    per case relative to ``refs`` (``{"lqr": LQR's ISE per case}``, computed once for all
-    rows), with the seconds both took; the ISE as
+    per case on ``episodes`` relative to ``refs`` (``{"lqr": LQR's ISE per case}``, both
+    computed once for all rows), with the seconds both took; the ISE as
     :func:`train.bench.evaluate.ise_rel_lqr` has it."""
     t0 = time.perf_counter()
     cost = validation_cost(policy, env_id, seeds)
-    rel = relative_ise(rollout_ise(policy, env_id, eval_episodes()), refs)
+    rel = relative_ise(rollout_ise(policy, env_id, episodes), refs)
     return {
         "policy": name,
         "validation_cost": cost,
@@ -113,9 +113,10 @@ def main(argv: list[str] | None = None) -> int:
     policies = {"lqr": LQRPolicy.for_env(env)}
     policies |= {f"mpc rho={r:g}": mpc(env, r, args.horizon) for r in args.rho}
     policies |= {ag.name: ag for ag in agents}
-    refs = {"lqr": lqr_ise(args.env_id, eval_episodes())}
+    episodes = eval_episodes()
+    refs = {"lqr": lqr_ise(args.env_id, episodes)}
     for name, policy in policies.items():
-        print(json.dumps(row(name, policy, args.env_id, seeds, refs)), flush=True)
+        print(json.dumps(row(name, policy, args.env_id, seeds, episodes, refs)), flush=True)
     return 0
 
 

@@ -221,21 +221,22 @@ def stretch_lines(summary: dict) -> list[str]:
     for name, a in algos.items():
         if name == STRETCH_BASE:
             continue
-        cells = []
+        cells, wins = [], 0
         for c in CASES:
             x, y = a["ise_rel_lqr"][str(c)]["iqm"], base["ise_rel_lqr"][str(c)]["iqm"]
-            label = "random" if c == "random" else f"case {c}"
-            cells.append(f"{label} {x:.5f} {'<' if x < y else '>='} {y:.5f}")
-        wins = sum(
-            a["ise_rel_lqr"][str(c)]["iqm"] < base["ise_rel_lqr"][str(c)]["iqm"] for c in CASES
-        )
+            wins += x < y
+            cells.append(f"{'random' if c == 'random' else f'case {c}'} {_versus(x, y)}")
         line = f"- {name}: below on {wins} of {len(CASES)} cases ({'; '.join(cells)})"
         va, vb = a.get("validation_cost"), base.get("validation_cost")
         if va is not None and vb is not None:
-            x, y = va["iqm"], vb["iqm"]
-            line += f"; validation cost {x:.5f} {'<' if x < y else '>='} {y:.5f}"
+            line += f"; validation cost {_versus(va['iqm'], vb['iqm'])}"
         out.append(line + ".")
     return out
+
+
+def _versus(x: float, y: float) -> str:
+    """``x < y`` or ``x >= y``, both to five decimals."""
+    return f"{x:.5f} {'<' if x < y else '>='} {y:.5f}"
 
 
 def plot_curves(summary: dict, path: Path) -> Path:

@@ -206,17 +206,12 @@ def lqr_ise(env_id: str = DEFAULT_ENV_ID, episodes: dict | None = None) -> dict:
 
 
 def reference_policies(env_id: str = DEFAULT_ENV_ID) -> dict:
-    """Passive, LQR, SMC and MPC designed on ``env_id``'s own nominal model (used only to
-    report the evaluation, never in training)."""
-    from baselines.policies import LQRPolicy, MPCPolicy, PassivePolicy, SMCPolicy
+    """Passive, LQR, SMC and MPC (:func:`baselines.evaluate.policies_for`) designed on
+    ``env_id``'s own nominal model and observation (used only to report the evaluation,
+    never in training)."""
+    from baselines.evaluate import policies_for
 
-    env = _make_env(env_id, 1)  # designed for its observation (measurement: own observer)
-    return {
-        "passive": PassivePolicy.for_env(env),
-        "lqr": LQRPolicy.for_env(env),
-        "smc": SMCPolicy.for_env(env),
-        "mpc": MPCPolicy.for_env(env),
-    }
+    return policies_for(_make_env(env_id, 1))
 
 
 def references(

@@ -504,6 +504,8 @@ class TrainConfig:
             if isinstance(default, (int, float)) and not isinstance(value, bool):
                 if isinstance(default, int) and key not in ("learning_rate", "clip_range"):
                     check_int(f"model.{key}", value, _INT_MIN.get(key, 1))
+                elif key in ("gamma", "gae_lambda"):  # a discount, a GAE weight: (0, 1]
+                    check_real(f"model.{key}", value, 0.0, 1.0, low_open=True)
                 else:
                     check_real(f"model.{key}", value, 0.0)
 

@@ -22,7 +22,7 @@ def test_every_recipe_file_validates(name):
     assert cfg.algo in ALGOS and cfg.timesteps > 0
     assert read_config(name) == (name, read_config(config_path(name))[1])
     if cfg.algo != "vrs":
-        assert 0 < cfg.gamma < 1 and "policy" in cfg.model
+        assert 0 < cfg.gamma <= 1 and "policy" in cfg.model
 
 
 def test_recipes_are_from_scratch_unless_named_so():
@@ -64,6 +64,9 @@ BASE = dict(algo="ppo", timesteps=10, n_envs=2, model={"policy": "MlpPolicy"})
         ({"model": {"policy": "MlpPolicy", "learning_rat": 1}}, "learning_rat"),
         ({"model": {"policy": "MlpPolicy", "n_steps": "64"}}, "n_steps"),
         ({"model": {"policy": "MlpPolicy", "max_grad_norm": "1.0e6"}}, "max_grad_norm"),
+        ({"model": {"policy": "MlpPolicy", "gamma": 1.01}}, "model.gamma"),
+        ({"model": {"policy": "MlpPolicy", "gamma": 0}}, "model.gamma"),
+        ({"model": {"policy": "MlpPolicy", "gae_lambda": 1.5}}, "model.gae_lambda"),
         ({"normalize": {"norm_obbs": True}}, "norm_obbs"),
         ({"features": "fourier"}, "features"),
         ({"episode_scale": 1}, "episode_scale"),

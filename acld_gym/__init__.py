@@ -15,7 +15,7 @@ holds the tools.
 
 from acld_gym.envs.presets import register_presets
 
-__version__ = "0.19.2"
+__version__ = "0.19.3"
 
 #: The current environment id.
 ENV_ID = "ACLDBeam-v1"

@@ -11,8 +11,10 @@ The seeds are disjoint from every seed used to train or select the shipped polic
 
 * training: SB3 runs seed sub-env i with ``seed + i`` (a few thousand at most); the random
   search (``train.bench.search``) draws its episode seeds from [1_000_000, 2**31);
-* model selection: the thesis cases (seed 0) and the held-out random loads
-  ``train.compare.HELDOUT_SEEDS`` = [100_000, 100_020).
+* model selection: the thesis cases (seed 0), the held-out random loads
+  ``train.bench.evaluate.HELDOUT_SEEDS`` = [100_000, 100_020) and the validation loads
+  the recipes select their runs on, from ``train.bench.evaluate.VALIDATION_SEED0`` =
+  200_000 (256 at most).
 
 The block [500_000, 600_000) is reserved for test sets: training and model selection must
 not use it. Every registered id (:data:`acld_gym.envs.presets.PRESETS`) has its entry in

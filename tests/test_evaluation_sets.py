@@ -8,7 +8,8 @@ import pytest
 
 import acld_gym
 from acld_gym.benchmark import RESERVED_SEEDS, TEST_SEEDS, TEST_SETS, EvaluationSet, evaluation_set
-from train.compare import AGENTS_DIR, HELDOUT_SEEDS
+from train.bench.evaluate import HELDOUT_SEEDS, OBJECTIVE_LOADS, validation_seeds
+from train.compare import AGENTS_DIR
 
 #: The random search draws its episode seeds from [1_000_000, 2**31) (train.bench.search).
 SEARCH_SEEDS = range(1_000_000, 2**31)
@@ -19,6 +20,7 @@ def test_test_set_is_disjoint_from_training_and_selection(env_id):
     seeds = set(TEST_SEEDS[env_id])
     assert len(seeds) >= 100
     assert not seeds & set(HELDOUT_SEEDS)  # model selection
+    assert not seeds & set(validation_seeds(OBJECTIVE_LOADS))  # the recipes' selection
     assert min(seeds) > 10_000  # SB3 sub-env seeds are seed + i, a few thousand at most
     assert max(seeds) < SEARCH_SEEDS.start
     assert seeds <= set(RESERVED_SEEDS)

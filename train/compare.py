@@ -50,6 +50,8 @@ from baselines.evaluate import (
     plot_episodes,
 )
 
+from .bench.evaluate import HELDOUT_SEEDS  # re-exported (defined with the other eval seeds)
+
 __all__ = [
     "AGENTS_DIR",
     "HELDOUT_SEEDS",
@@ -67,8 +69,6 @@ __all__ = [
 ]
 
 AGENTS_DIR = Path(__file__).resolve().parent / "agents"
-#: Seeds of the held-out random-load episodes (training uses seeds < 1000 per sub-env).
-HELDOUT_SEEDS = tuple(range(100_000, 100_020))
 
 
 def agent_names(directory: str | Path = AGENTS_DIR, mesh: str = "converged") -> list[str]:

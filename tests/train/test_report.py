@@ -1,33 +1,93 @@
-"""The benchmark's tables in the docs are generated from the committed per-seed results
-(``python -m train.bench.report train/benchmark/results-v1.json --write docs/training.md``)."""
+"""The benchmark's tables in the docs and the README's headline are generated from the
+committed per-seed results (``python -m train.bench.report train/benchmark/results-v1.json
+--write docs/training.md README.md``)."""
 
 from __future__ import annotations
 
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from train.bench.report import (
     BEGIN,
     GOALS,
+    MARK_BEGIN,
+    MARK_END,
     budget,
     curves_figure,
+    headline,
     main,
     markdown,
     replace_block,
+    seeds_beating_references,
     stretch_lines,
+    write_blocks,
 )
 from train.config import read_config
 
 RESULTS = Path("train/benchmark/results-v1.json")
 PAGE = Path("docs/training.md")
+README = Path("README.md")
 
 
 def test_docs_tables_are_the_committed_results():
     summary = json.loads(RESULTS.read_text())
     text = PAGE.read_text()
     assert replace_block(text, markdown(summary), str(RESULTS), str(PAGE)) == text
+
+
+def test_readme_headline_is_the_committed_results():
+    summary = json.loads(RESULTS.read_text())
+    text = README.read_text()
+    assert write_blocks(text, summary, str(RESULTS), str(README)) == text
+    assert headline(summary) in text and "benchmark-tables" not in text
+
+
+def test_the_headline_counts_the_seeds_better_than_lqr_and_smc():
+    """One row per algorithm with its IQMs as the full table rounds them, and the seeds
+    below LQR and SMC on cases 1, 2 and random by the first goal's rule: a seed pushed to
+    LQR's level on case 2, or to SMC's on the random loads, is no longer counted."""
+    summary = json.loads(RESULTS.read_text())
+    row = next(x for x in headline(summary).splitlines() if x.startswith("| SB3 PPO (`ppo`)"))
+    iqm = summary["algorithms"]["ppo"]["ise_rel_lqr"]
+    assert row.split(" | ")[1:5] == [f"{iqm[c]['iqm']:.3f}" for c in ("1", "2", "3", "random")]
+    assert " | 5 of 5 | " in row
+    seeds = summary["algorithms"]["ppo"]["per_seed"]
+    seeds[0]["2"] = 1.0
+    seeds[3]["random"] = summary["references"]["smc"]["random"]
+    seeds[4]["3"] = 1.5  # case 3 is not in the rule
+    row = next(x for x in headline(summary).splitlines() if x.startswith("| SB3 PPO (`ppo`)"))
+    assert " | 3 of 5 | " in row
+    rel = [[s[c] for c in ("1", "2", "3", "random")] for s in seeds]
+    beats = seeds_beating_references(rel, summary["references"])
+    assert beats.tolist() == [False, True, True, False, True]
+    assert not GOALS["every_seed_beats_lqr_and_smc"](
+        np.array(rel), None, summary["references"], None
+    )
+
+
+def test_write_fills_every_block_of_every_page_or_none(tmp_path, capsys):
+    """``--write`` takes several pages; each gets every generated block it holds (tables,
+    headline), and a page with none is an error that leaves every page as it was."""
+    summary = json.loads(RESULTS.read_text())
+    both, other = tmp_path / "both.md", tmp_path / "other.md"
+    marks = {
+        kind: (MARK_BEGIN.format(kind=kind, src=RESULTS, dst=both), MARK_END.format(kind=kind))
+        for kind in ("tables", "headline")
+    }
+    original = "".join(f"{b}\nold\n{e}\nkeep\n" for b, e in marks.values())
+    both.write_text(original)
+    other.write_text("no markers\n")
+    with pytest.raises(SystemExit) as e:
+        main([str(RESULTS), "--write", str(both), str(other)])
+    assert e.value.code == 2 and "expected one" in capsys.readouterr().err
+    assert both.read_text() == original and other.read_text() == "no markers\n"
+    assert main([str(RESULTS), "--write", str(both)]) == 0
+    out = both.read_text()
+    assert "old" not in out and out.count("keep\n") == 2
+    assert markdown(summary) in out and headline(summary) in out
 
 
 def test_committed_results_hold_every_seed_and_the_goals():

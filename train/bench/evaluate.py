@@ -2,7 +2,7 @@
 
 The agents are scored by ISE / ISE_LQR through the env (+/-120 V, 1 ms, default Kalman
 observer, deterministic policy): thesis cases 1, 2, 3 with seed 0 and the held-out
-random set (:data:`train.compare.HELDOUT_SEEDS`; ``ISE / LQR`` there is the mean ISE
+random set (:data:`HELDOUT_SEEDS`; ``ISE / LQR`` there is the mean ISE
 over the set divided by LQR's mean, as in ``python -m train.compare``). LQR, SMC,
 MPC and the clairvoyant bound are computed here ONLY to normalise and report the
 final numbers; no training loop ever sees them.
@@ -33,6 +33,7 @@ from acld_gym.util.atomic import write_text
 __all__ = [
     "CASES",
     "DEFAULT_ENV_ID",
+    "HELDOUT_SEEDS",
     "eval_episodes",
     "rollout_ise",
     "batched_ise",
@@ -57,13 +58,17 @@ DEFAULT_ENV_ID = acld_gym.ENV_ID
 CurveCallback = Callable[[int, Any], Mapping | None]
 #: Evaluation cases, in table order (every named load case).
 CASES: tuple = LOAD_CASES
+#: Seeds of the held-out random-load episodes every policy is reported on (``python -m
+#: train.compare``, the benchmark's ``random`` column); disjoint from training's (SB3's
+#: sub-env seeds, < 1000 per run; the random search's, from 1_000_000), from the validation
+#: loads (:data:`VALIDATION_SEED0` on) and from the published test sets
+#: (:data:`acld_gym.benchmark.RESERVED_SEEDS`).
+HELDOUT_SEEDS = tuple(range(100_000, 100_020))
 
 
 def eval_episodes(random_episodes: int | None = None) -> dict:
     """``{case: seeds}``: seed 0 for the thesis cases, the held-out seeds (all 20, or the
     first ``random_episodes``) for ``"random"``."""
-    from ..compare import HELDOUT_SEEDS
-
     n = len(HELDOUT_SEEDS) if random_episodes is None else int(random_episodes)
     return {1: (0,), 2: (0,), 3: (0,), "random": tuple(HELDOUT_SEEDS[:n])}
 
@@ -131,7 +136,7 @@ def _side_by_side(policy, venvs: list, obs: list, value) -> tuple[list, list]:
 
 #: First random-load seed of the validation loads (checkpoint selection,
 #: :class:`train.config.SelectConfig`): seeds from here on, disjoint from the held-out test
-#: loads (:data:`train.compare.HELDOUT_SEEDS`, 100000-100019).
+#: loads (:data:`HELDOUT_SEEDS`, 100000-100019).
 VALIDATION_SEED0 = 200_000
 
 

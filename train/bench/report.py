@@ -17,7 +17,10 @@ __all__ = [
     "goals_of",
     "summarize",
     "markdown",
+    "headline",
     "stretch_lines",
+    "seeds_beating_references",
+    "write_blocks",
     "ratio_log_axis",
     "curves_figure",
     "plot_curves",
@@ -28,10 +31,7 @@ __all__ = [
 #: :data:`CASES`), their IQM ``stats``, the references (ISE / LQR) and the runs.
 GOALS = {
     "every_seed_beats_lqr_and_smc": lambda rel, stats, refs, runs: bool(
-        all(
-            (rel[:, j] < min(1.0, refs.get("smc", {}).get(c, np.inf))).all()
-            for j, c in ((0, "1"), (1, "2"), (3, "random"))
-        )
+        seeds_beating_references(rel, refs).all()
     ),
     "every_seed_case3_within_2pct": lambda rel, stats, refs, runs: bool((rel[:, 2] <= 1.02).all()),
     "iqm_cases_1_2_at_most_0.90": lambda rel, stats, refs, runs: all(
@@ -42,6 +42,17 @@ GOALS = {
         max(r["train_seconds"] for r in runs) <= 900.0
     ),
 }
+
+
+def seeds_beating_references(rel: np.ndarray, refs: dict) -> np.ndarray:
+    """Per seed (a row of ``rel``, ISE / LQR on :data:`CASES`), whether it is below LQR
+    and SMC (``refs["smc"]``, ISE / LQR per case) on cases 1, 2 and the random loads: the
+    first goal's rule, per seed."""
+    rel = np.atleast_2d(np.asarray(rel, dtype=float))
+    cols = ((0, "1"), (1, "2"), (3, "random"))
+    return np.all(
+        [rel[:, j] < min(1.0, refs.get("smc", {}).get(c, np.inf)) for j, c in cols], axis=0
+    )
 
 
 def goals_of(rel: np.ndarray, stats: dict, refs: dict, runs: list[dict]) -> dict:
@@ -196,6 +207,59 @@ def markdown(summary: dict) -> str:
                 f"| {name} | {seed} | {vals} | {cost(s.get('validation_cost'), '.5f')} "
                 f"| {s['train_seconds']:.0f} / {s['train_cpu_seconds']:.0f} |"
             )
+    return "\n".join(lines) + "\n"
+
+
+#: How :func:`headline` names the benchmark's algorithms (any other: its own name).
+LABELS = {"vrs": "random search", "ppo": "SB3 PPO", "sac": "SB3 SAC"}
+#: What :func:`headline` says a reference row is (any other: "designed").
+KINDS = {"passive": "no control", "bound": "clairvoyant"}
+
+
+def headline(summary: dict) -> str:
+    r"""The README's headline table: per algorithm the IQM over the seeds of ISE / LQR per
+    case and of the validation cost, how many seeds are below LQR and SMC on cases 1, 2
+    and the random loads (:func:`seeds_beating_references`) and the training time per
+    seed (IQM; the longest), then the reference rows; the full tables are
+    :func:`markdown`'s."""
+    refs, ref_costs = summary["references"], summary.get("reference_validation_cost", {})
+    lines = [
+        "| trained from scratch | case 1 | case 2 | case 3 | random | validation cost "
+        "| seeds better than LQR and SMC | training per seed [min] (IQM; longest) |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for name, a in summary["algorithms"].items():
+        rel = [[s[str(c)] for c in CASES] for s in a["per_seed"]]
+        wins = int(seeds_beating_references(rel, refs).sum())
+        cost = a.get("validation_cost")
+        t = a["train_seconds"]
+        lines.append(
+            f"| {LABELS.get(name, name)} (`{name}`) | "
+            + " | ".join(f"{a['ise_rel_lqr'][str(c)]['iqm']:.3f}" for c in CASES)
+            + f" | {'-' if cost is None else format(cost['iqm'], '.4f')}"
+            + f" | {wins} of {len(a['per_seed'])} | {t['iqm'] / 60:.1f}; {t['max'] / 60:.1f} |"
+        )
+    for ref, vals in refs.items():
+        cost = ref_costs.get(ref)
+        lines.append(
+            f"| {ref} ({KINDS.get(ref, 'designed')}) | "
+            + " | ".join(f"{vals[str(c)]:.3f}" for c in CASES)
+            + f" | {'-' if cost is None else format(cost, '.4f')} | - | - |"
+        )
+    n_rand = len(summary["episodes"]["random"])
+    lines += [
+        "",
+        f"ISE / LQR on `{summary['env_id']}` (IQM over the seeds; lower is better; `random` "
+        f"is {n_rand} held-out loads). Validation cost: the env's own reward, which charges "
+        f"for the voltage, on {OBJECTIVE_LOADS} validation loads, divided by the passive "
+        "beam's (passive 1, lower is better).",
+    ]
+    if summary.get("command"):  # the command, then what the run recorded of it
+        command, _, note = summary["command"].partition(" (")
+        notes = [note.removesuffix(")")] if note else []
+        if summary.get("wall_seconds") is not None:
+            notes.append(f"{summary['wall_seconds'] / 60:.0f} min in all")
+        lines.append(f"Run: `{command}`" + (f" ({'; '.join(notes)})" if notes else "") + ".")
     return "\n".join(lines) + "\n"
 
 
@@ -369,27 +433,48 @@ def curves_figure(summary: dict):
     return fig
 
 
-#: The markers around the generated tables in a Markdown page (``--write``).
-BEGIN = "<!-- benchmark-tables:begin (python -m train.bench.report {src} --write {dst}) -->"
-END = "<!-- benchmark-tables:end -->"
+#: The generated blocks a Markdown page may hold (``--write``), by kind: the full tables
+#: (:func:`markdown`, the training page) and the headline (:func:`headline`, the README).
+BLOCKS = {"tables": markdown, "headline": headline}
+
+#: The markers around a generated block (``kind`` one of :data:`BLOCKS`).
+MARK_BEGIN = "<!-- benchmark-{kind}:begin (python -m train.bench.report {src} --write {dst}) -->"
+MARK_END = "<!-- benchmark-{kind}:end -->"
+
+#: The markers of the tables' block.
+BEGIN = MARK_BEGIN.replace("{kind}", "tables")
+END = MARK_END.format(kind="tables")
 
 
-def replace_block(text: str, tables: str, src: str, dst: str) -> str:
-    """``text`` with the part between :data:`BEGIN` and :data:`END` replaced by ``tables``;
-    ``ValueError`` if the markers are missing."""
-    begin = BEGIN.format(src=src, dst=dst)
-    if text.count(begin) != 1 or text.count(END) != 1 or text.index(begin) > text.index(END):
-        raise ValueError(f"{dst}: expected one {begin!r} ... {END!r} block")
+def replace_block(text: str, tables: str, src: str, dst: str, kind: str = "tables") -> str:
+    """``text`` with the part between the markers of ``kind`` (:data:`MARK_BEGIN`,
+    :data:`MARK_END`) replaced by ``tables``; ``ValueError`` if the markers are missing."""
+    begin, end = MARK_BEGIN.format(kind=kind, src=src, dst=dst), MARK_END.format(kind=kind)
+    if text.count(begin) != 1 or text.count(end) != 1 or text.index(begin) > text.index(end):
+        raise ValueError(f"{dst}: expected one {begin!r} ... {end!r} block")
     head, rest = text.split(begin)
-    _, tail = rest.split(END)
-    return f"{head}{begin}\n\n{tables}\n{END}{tail}"
+    _, tail = rest.split(end)
+    return f"{head}{begin}\n\n{tables}\n{end}{tail}"
+
+
+def write_blocks(text: str, summary: dict, src: str, dst: str) -> str:
+    """``text`` with every generated block it holds (:data:`BLOCKS`, each once) written
+    from ``summary``; ``ValueError`` if it holds none."""
+    kinds = [k for k in BLOCKS if MARK_END.format(kind=k) in text]
+    if not kinds:
+        begins = " or ".join(repr(MARK_BEGIN.format(kind=k, src=src, dst=dst)) for k in BLOCKS)
+        raise ValueError(f"{dst}: expected one {begins} block")
+    for kind in kinds:
+        text = replace_block(text, BLOCKS[kind](summary), src, dst, kind)
+    return text
 
 
 def main(argv: list[str] | None = None) -> int:
-    """``python -m train.bench.report RESULTS.json [--write PAGE.md] [--plot FIG.png]``: the
-    benchmark's tables (:func:`markdown`) from a committed results file, printed or written
-    between the markers of a page (atomically); ``--plot`` also draws its learning curves
-    (:func:`plot_curves`)."""
+    """``python -m train.bench.report RESULTS.json [--write PAGE.md ...] [--plot FIG.png]``:
+    the benchmark's tables (:func:`markdown`) from a committed results file, printed, or
+    written into the generated blocks of each page (:func:`write_blocks`: the tables, the
+    headline; atomically, every page checked before any is written); ``--plot`` also draws
+    its learning curves (:func:`plot_curves`)."""
     import argparse
     import json
 
@@ -400,9 +485,10 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument(
         "--write",
         type=Path,
+        nargs="+",
         default=None,
         metavar="PAGE",
-        help="replace the generated block of this Markdown page",
+        help="replace the generated blocks of these Markdown pages",
     )
     p.add_argument(
         "--plot",
@@ -428,12 +514,15 @@ def main(argv: list[str] | None = None) -> int:
         if args.plot is None:
             print(tables, end="")
         return 0
-    try:
-        text = replace_block(args.write.read_text(), tables, str(args.results), str(args.write))
-    except (OSError, ValueError) as exc:
-        p.error(str(exc))
-    write_text(args.write, text)
-    print(f"wrote the tables of {args.results} into {args.write}")
+    texts = {}
+    for page in args.write:
+        try:
+            texts[page] = write_blocks(page.read_text(), summary, str(args.results), str(page))
+        except (OSError, ValueError, KeyError, TypeError) as exc:
+            p.error(str(exc))
+    for page, text in texts.items():
+        write_text(page, text)
+        print(f"wrote the tables of {args.results} into {page}")
     return 0
 
 

@@ -435,7 +435,7 @@ def test_recipe_seed_on_case1(algo, bound):
     """One seed of a teacher-free recipe (train/benchmark/<algo>.yaml, full budget) against
     LQR on case 1."""
     from train.bench.algos import train_algo
-    from train.bench.evaluate import reference_policies, rollout_ise
+    from train.bench.evaluate import lqr_ise, rollout_ise
     from train.config import TrainConfig
 
     env_id = "ACLDBeam-v1"
@@ -443,5 +443,5 @@ def test_recipe_seed_on_case1(algo, bound):
     policy, record = train_algo(cfg, seed=0, env_id=env_id)
     eps = {1: (0,)}
     agent = rollout_ise(policy, env_id, eps)[1]
-    lqr = rollout_ise(reference_policies(env_id)["lqr"], env_id, eps)[1]
+    lqr = lqr_ise(env_id, eps)[1]
     assert agent < bound * lqr, (agent / lqr, record)

@@ -46,7 +46,6 @@ __all__ = [
     "lqr_validation_cost",
     "ise_rel_lqr",
     "lqr_ise",
-    "reference_policies",
     "references",
     "CurveCallback",
     "eval_schedule",
@@ -210,15 +209,6 @@ def lqr_ise(env_id: str = DEFAULT_ENV_ID, episodes: dict | None = None) -> dict:
     return rollout_ise(lqr, env_id, eval_episodes() if episodes is None else episodes)
 
 
-def reference_policies(env_id: str = DEFAULT_ENV_ID) -> dict:
-    """Passive, LQR, SMC and MPC (:func:`baselines.evaluate.policies_for`) designed on
-    ``env_id``'s own nominal model and observation (used only to report the evaluation,
-    never in training)."""
-    from baselines.evaluate import policies_for
-
-    return policies_for(_make_env(env_id, 1))
-
-
 def references(
     env_id: str = DEFAULT_ENV_ID,
     cache: str | Path | None = None,
@@ -235,7 +225,7 @@ def references(
     Read from ``cache`` (JSON) when it holds the same env id and episodes, else computed
     (the bound takes about 30 s) and written there atomically.
     """
-    from baselines.evaluate import bound_episode, metrics_row
+    from baselines.evaluate import bound_episode, metrics_row, policies_for
 
     episodes = eval_episodes(random_episodes)
     key = {str(c): list(s) for c, s in episodes.items()}
@@ -248,7 +238,9 @@ def references(
             and "validation_cost" in data
         ):
             return data
-    pols = reference_policies(env_id)
+    # passive, LQR, SMC and MPC designed on env_id's own nominal model and observation
+    # (to report the evaluation only, never in training)
+    pols = policies_for(_make_env(env_id, 1))
     data: dict[str, Any] = {"env_id": env_id, "episodes": key}
     for name, pol in pols.items():
         data[name] = {str(c): v for c, v in rollout_ise(pol, env_id, episodes).items()}

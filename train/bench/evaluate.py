@@ -58,10 +58,10 @@ CurveCallback = Callable[[int, Any], Mapping | None]
 #: Evaluation cases, in table order (every named load case).
 CASES: tuple = LOAD_CASES
 #: Seeds of the held-out random-load episodes every policy is reported on (``python -m
-#: train.compare``, the benchmark's ``random`` column); disjoint from training's (SB3's
-#: sub-env seeds, < 1000 per run; the random search's, from 1_000_000), from the validation
-#: loads (:data:`VALIDATION_SEED0` on) and from the published test sets
-#: (:data:`acld_gym.benchmark.RESERVED_SEEDS`).
+#: train.compare``, the benchmark's ``random`` column); disjoint from the validation loads
+#: (:data:`VALIDATION_SEED0` on), from the published test sets
+#: (:data:`acld_gym.benchmark.RESERVED_SEEDS`) and from the random search's episode seeds
+#: (from 1_000_000); an SB3 run seeds sub-env i with its seed + i.
 HELDOUT_SEEDS = tuple(range(100_000, 100_020))
 
 

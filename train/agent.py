@@ -219,8 +219,7 @@ def export_sb3(model, obs_norm=None) -> ActorProgram:
     import torch.nn as nn
     from stable_baselines3.common.torch_layers import FlattenExtractor
 
-    from .bench.sb3_policies import DropLast
-    from .features import DirectionFeatures
+    from .features import DirectionFeatures, DropLast
 
     ops: list[dict] = []
     arrays: dict[str, np.ndarray] = {}

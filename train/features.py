@@ -1,4 +1,6 @@
-r"""Scale-free observation features for the agents' networks.
+r"""Observation features for the agents' actors: the scale-free direction features
+(:class:`DirectionFeatures`) and the asymmetric actor's view without the privileged entries
+(:class:`DropLast`).
 
 Near the +/-120 V limit the best voltage is close to bang-bang: the constrained
 MPC saturates in 86 % of the steps of random-load episodes, and the sign of its
@@ -16,7 +18,7 @@ from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 
 from .direction import EPS, direction_features
 
-__all__ = ["DirectionFeatures", "direction_features", "FEATURES"]
+__all__ = ["DirectionFeatures", "DropLast", "direction_features", "FEATURES"]
 
 
 class DirectionFeatures(BaseFeaturesExtractor):
@@ -41,6 +43,23 @@ class DirectionFeatures(BaseFeaturesExtractor):
     def forward(self, observations: torch.Tensor) -> torch.Tensor:
         r = torch.sqrt(torch.sum(observations * observations, dim=-1, keepdim=True) + EPS**2)
         return torch.cat([observations / r, torch.log(r)], dim=-1)
+
+
+class DropLast(BaseFeaturesExtractor):
+    """The observation without its last ``n`` entries (default 1): the actor of an
+    asymmetric actor-critic, which must not read the privileged entries the training env
+    appends, the log(reward scale) (``observe_reward_scale``, :mod:`acld_gym.envs.scale`)
+    and any after it."""
+
+    def __init__(self, observation_space: spaces.Box, n: int = 1):
+        dim = int(observation_space.shape[0])
+        if not (isinstance(n, int) and 1 <= n < dim):
+            raise ValueError(f"n: expected an integer in [1, {dim - 1}], got {n!r}")
+        self.n = n
+        super().__init__(observation_space, features_dim=dim - n)
+
+    def forward(self, observations: torch.Tensor) -> torch.Tensor:
+        return observations[:, : -self.n]
 
 
 #: ``features`` values of a training config and their extractor classes.

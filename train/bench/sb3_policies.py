@@ -26,7 +26,7 @@ import acld_gym  # noqa: F401  (registers the env ids)
 from acld_gym.util.validate import check_real
 
 from ..agent import actor_extractor
-from ..features import DirectionFeatures, direction_features
+from ..features import DirectionFeatures, DropLast, direction_features  # DropLast re-exported
 
 __all__ = [
     "QuadraticFeatures",
@@ -58,23 +58,6 @@ class QuadraticFeatures(BaseFeaturesExtractor):
     def forward(self, observations: torch.Tensor) -> torch.Tensor:
         outer = observations.unsqueeze(2) * observations.unsqueeze(1)
         return torch.cat([observations, outer.flatten(1)], dim=-1)
-
-
-class DropLast(BaseFeaturesExtractor):
-    """The observation without its last ``n`` entries (default 1): the actor of an
-    asymmetric actor-critic, which must not read the privileged entries the training env
-    appends, the log(reward scale) (``observe_reward_scale``, :mod:`acld_gym.envs.scale`)
-    and any after it."""
-
-    def __init__(self, observation_space: spaces.Box, n: int = 1):
-        dim = int(observation_space.shape[0])
-        if not (isinstance(n, int) and 1 <= n < dim):
-            raise ValueError(f"n: expected an integer in [1, {dim - 1}], got {n!r}")
-        self.n = n
-        super().__init__(observation_space, features_dim=dim - n)
-
-    def forward(self, observations: torch.Tensor) -> torch.Tensor:
-        return observations[:, : -self.n]
 
 
 class ScaledQuadraticFeatures(QuadraticFeatures):

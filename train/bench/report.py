@@ -225,7 +225,8 @@ def headline(summary: dict) -> str:
     refs, ref_costs = summary["references"], summary.get("reference_validation_cost", {})
     lines = [
         "| trained from scratch | case 1 | case 2 | case 3 | random | validation cost "
-        "| seeds better than LQR and SMC | training per seed [min] (IQM; longest) |",
+        "| seeds better than LQR and SMC (cases 1, 2, random) | training per seed [min] "
+        "(IQM; longest) |",
         "|---|---|---|---|---|---|---|---|",
     ]
     for name, a in summary["algorithms"].items():

@@ -11,7 +11,6 @@ import numpy as np
 import pytest
 
 from train.bench.report import (
-    BEGIN,
     GOALS,
     MARK_BEGIN,
     MARK_END,
@@ -20,6 +19,7 @@ from train.bench.report import (
     headline,
     main,
     markdown,
+    render_blocks,
     replace_block,
     seeds_beating_references,
     stretch_lines,
@@ -41,7 +41,7 @@ def test_docs_tables_are_the_committed_results():
 def test_readme_headline_is_the_committed_results():
     summary = json.loads(RESULTS.read_text())
     text = README.read_text()
-    assert write_blocks(text, summary, str(RESULTS), str(README)) == text
+    assert write_blocks(text, render_blocks(summary), str(RESULTS), str(README)) == text
     assert headline(summary) in text and "benchmark-tables" not in text
 
 
@@ -138,7 +138,7 @@ def test_a_recipe_that_retries_failed_runs_shows_the_most_and_each_seeds_runs(al
 
 def test_write_replaces_only_the_block(tmp_path, capsys):
     page = tmp_path / "page.md"
-    begin = BEGIN.format(src=RESULTS, dst=page)
+    begin = MARK_BEGIN.format(kind="tables", src=RESULTS, dst=page)
     page.write_text(f"# head\n{begin}\nold\n<!-- benchmark-tables:end -->\ntail\n")
     assert main([str(RESULTS), "--write", str(page)]) == 0
     out = page.read_text()

@@ -20,6 +20,7 @@ __all__ = [
     "headline",
     "stretch_lines",
     "seeds_beating_references",
+    "render_blocks",
     "write_blocks",
     "ratio_log_axis",
     "curves_figure",
@@ -49,7 +50,7 @@ def seeds_beating_references(rel: np.ndarray, refs: dict) -> np.ndarray:
     and SMC (``refs["smc"]``, ISE / LQR per case) on cases 1, 2 and the random loads: the
     first goal's rule, per seed."""
     rel = np.atleast_2d(np.asarray(rel, dtype=float))
-    cols = ((0, "1"), (1, "2"), (3, "random"))
+    cols = [(CASES.index(c), str(c)) for c in (1, 2, "random")]
     return np.all(
         [rel[:, j] < min(1.0, refs.get("smc", {}).get(c, np.inf)) for j, c in cols], axis=0
     )
@@ -442,10 +443,6 @@ BLOCKS = {"tables": markdown, "headline": headline}
 MARK_BEGIN = "<!-- benchmark-{kind}:begin (python -m train.bench.report {src} --write {dst}) -->"
 MARK_END = "<!-- benchmark-{kind}:end -->"
 
-#: The markers of the tables' block.
-BEGIN = MARK_BEGIN.replace("{kind}", "tables")
-END = MARK_END.format(kind="tables")
-
 
 def replace_block(text: str, tables: str, src: str, dst: str, kind: str = "tables") -> str:
     """``text`` with the part between the markers of ``kind`` (:data:`MARK_BEGIN`,
@@ -458,15 +455,20 @@ def replace_block(text: str, tables: str, src: str, dst: str, kind: str = "table
     return f"{head}{begin}\n\n{tables}\n{end}{tail}"
 
 
-def write_blocks(text: str, summary: dict, src: str, dst: str) -> str:
-    """``text`` with every generated block it holds (:data:`BLOCKS`, each once) written
-    from ``summary``; ``ValueError`` if it holds none."""
-    kinds = [k for k in BLOCKS if MARK_END.format(kind=k) in text]
+def render_blocks(summary: dict) -> dict[str, str]:
+    """Every generated block (:data:`BLOCKS`) of ``summary``, by kind."""
+    return {kind: render(summary) for kind, render in BLOCKS.items()}
+
+
+def write_blocks(text: str, blocks: dict[str, str], src: str, dst: str) -> str:
+    """``text`` with every generated block it holds (each once) replaced by its rendered
+    ``blocks`` (:func:`render_blocks`); ``ValueError`` if it holds none."""
+    kinds = [k for k in blocks if MARK_END.format(kind=k) in text]
     if not kinds:
-        begins = " or ".join(repr(MARK_BEGIN.format(kind=k, src=src, dst=dst)) for k in BLOCKS)
+        begins = " or ".join(repr(MARK_BEGIN.format(kind=k, src=src, dst=dst)) for k in blocks)
         raise ValueError(f"{dst}: expected one {begins} block")
     for kind in kinds:
-        text = replace_block(text, BLOCKS[kind](summary), src, dst, kind)
+        text = replace_block(text, blocks[kind], src, dst, kind)
     return text
 
 
@@ -501,7 +503,7 @@ def main(argv: list[str] | None = None) -> int:
     args = p.parse_args(argv)
     try:
         summary = json.loads(args.results.read_text())
-        tables = markdown(summary)
+        blocks = render_blocks(summary)
     except (OSError, ValueError, KeyError, TypeError) as exc:
         p.error(f"results: {args.results} is not a benchmark results file ({exc})")
     if args.plot is not None:
@@ -513,13 +515,13 @@ def main(argv: list[str] | None = None) -> int:
         print(f"wrote the learning curves of {args.results} to {args.plot}")
     if args.write is None:
         if args.plot is None:
-            print(tables, end="")
+            print(blocks["tables"], end="")
         return 0
     texts = {}
     for page in args.write:
         try:
-            texts[page] = write_blocks(page.read_text(), summary, str(args.results), str(page))
-        except (OSError, ValueError, KeyError, TypeError) as exc:
+            texts[page] = write_blocks(page.read_text(), blocks, str(args.results), str(page))
+        except (OSError, ValueError) as exc:
             p.error(str(exc))
     for page, text in texts.items():
         write_text(page, text)

@@ -4,14 +4,19 @@ Every result file of the package (JSON tables, figures, agents, cached plants) i
 written to a temporary file in the same directory and moved into place with
 ``os.replace`` (atomic on POSIX and Windows). A write that fails midway -- a full disk,
 ``ulimit -f`` -- leaves the previous file intact and no temporary behind.
+:func:`write_texts` writes several files all or none; :func:`replace_dir` replaces a whole
+folder (an agent) with one rename, so a reader sees the old folder or the new one.
 :func:`check_writable` lets a command refuse an unusable output path before it spends
 minutes computing.
 """
 
 from __future__ import annotations
 
+import ctypes
+import ctypes.util
 import json
 import os
+import shutil
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
@@ -21,6 +26,8 @@ __all__ = [
     "write_atomic",
     "write_text",
     "write_json",
+    "write_texts",
+    "replace_dir",
     "check_writable",
     "check_directory",
     "save_figure",
@@ -59,6 +66,87 @@ def write_text(path: str | Path, text: str) -> Path:
 def write_json(path: str | Path, obj: Any) -> Path:
     """Write ``obj`` as indented JSON to ``path`` atomically."""
     return write_text(path, json.dumps(obj, indent=2) + "\n")
+
+
+def write_texts(texts: dict[str | Path, str]) -> list[Path]:
+    """Write several UTF-8 files all or none: every text goes to a temporary file beside its
+    target first (a full disk fails here, before any target changes), then each is moved into
+    place with ``os.replace``. Returns the paths written."""
+    staged: list[tuple[str, Path]] = []
+    try:
+        for path, text in texts.items():
+            path = Path(path)
+            path.parent.mkdir(parents=True, exist_ok=True)
+            fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+            staged.append((tmp, path))
+            with os.fdopen(fd, "wb") as fh:
+                fh.write(text.encode())
+                fh.flush()
+                os.fsync(fh.fileno())
+            umask = os.umask(0)
+            os.umask(umask)
+            os.chmod(tmp, 0o666 & ~umask)
+    except BaseException:
+        for tmp, _ in staged:
+            Path(tmp).unlink(missing_ok=True)
+        raise
+    for tmp, path in staged:
+        os.replace(tmp, path)
+    return [path for _, path in staged]
+
+
+_RENAME_EXCHANGE = 2  # linux/fs.h
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap two paths atomically (Linux ``renameat2(RENAME_EXCHANGE)``); False where the
+    call is unavailable (another OS, an old kernel, a file system without it)."""
+    try:
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
+        renameat2 = libc.renameat2
+    except (OSError, AttributeError):
+        return False
+    at_fdcwd = -100
+    rc = renameat2(at_fdcwd, os.fsencode(a), at_fdcwd, os.fsencode(b), _RENAME_EXCHANGE)
+    return rc == 0
+
+
+def replace_dir(path: str | Path, fill: Callable[[Path], Any]) -> Path:
+    """Build a folder with ``fill(tmp)`` in a temporary sibling of ``path``, then put it in
+    place whole: a new ``path`` is one ``rename``; an existing one is swapped with the new
+    folder in one atomic exchange where the OS has it (Linux), else renamed aside and
+    replaced (a reader may then briefly find no folder, never a mixed one). A ``fill`` that
+    fails -- a full disk, ``ulimit -f`` -- leaves ``path`` as it was and no temporary."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp"))
+    try:
+        fill(tmp)
+        for f in tmp.rglob("*"):
+            if f.is_file():
+                with open(f, "rb") as fh:
+                    os.fsync(fh.fileno())
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o777 & ~umask)
+        if not path.exists() and not path.is_symlink():
+            os.rename(tmp, path)
+        elif path.is_dir() and not path.is_symlink() and _exchange(tmp, path):
+            shutil.rmtree(tmp)  # now the old folder
+        else:
+            old = Path(tempfile.mkdtemp(dir=path.parent, prefix=f".{path.name}.", suffix=".old"))
+            os.rmdir(old)
+            os.rename(path, old)
+            os.rename(tmp, path)
+            if old.is_dir() and not old.is_symlink():
+                shutil.rmtree(old)
+            else:
+                old.unlink()
+    except BaseException:
+        if tmp.exists():
+            shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return path
 
 
 def check_writable(path: str | Path, what: str = "output") -> Path:

@@ -39,6 +39,7 @@ __all__ = [
     "ENTRY_POINT",
     "VECTOR_ENTRY_POINT",
     "preset",
+    "check_env_id",
     "register_presets",
 ]
 
@@ -70,12 +71,21 @@ PRESETS: dict[str, dict] = {
 }
 
 
+def check_env_id(value, name: str = "env_id") -> str:
+    """``value`` if it is one of this package's registered ids (:data:`PRESETS`), matched as
+    a plain string; else ``ValueError`` naming ``name`` and the ids. Never passed to an
+    importer first: Gymnasium's ``"module:Env"`` form would import ``module``, so an id
+    read from a file or a command line is checked here before ``gym.make`` sees it."""
+    if not isinstance(value, str) or value not in PRESETS:
+        raise ValueError(f"{name} must be one of this package's ids {list(PRESETS)}, got {value!r}")
+    return value
+
+
 def preset(env_id: str, **changes):
     """The :class:`acld_gym.envs.config.EnvConfig` of a registered id (with ``changes``)."""
     from acld_gym.envs.config import make_config
 
-    if env_id not in PRESETS:
-        raise ValueError(f"env_id must be one of {list(PRESETS)}, got {env_id!r}")
+    check_env_id(env_id)
     return make_config(**{**PRESETS[env_id], **changes})
 
 

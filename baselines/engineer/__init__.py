@@ -1,0 +1,47 @@
+"""The engineer's references: designs for each level's known actuator and sensor.
+
+What a level's engineer knows -- its datasheet (:mod:`acld_gym.envs.presets`: the
+computation delay, the amplifier's bandwidth and slew rate, the sensor's noise, what the
+env observes) and the package's public nominal design -- goes into the designs; what they
+cannot know (the episode's load, temperature and parameters) stays out.
+
+* :class:`DelayLQGPolicy` (``"lqg"``): output-feedback LQG on the env's reward, its model
+  augmented with the commands in flight and the amplifier's lag, its Kalman filter fed the
+  voltage that reaches the amplifier;
+* :class:`ActuatorMPCPolicy` (``"mpc_rig"``): the MPC of the env's reward with the delay by
+  prediction, the slew limit as a rate constraint and the lag in its model;
+
+:func:`engineer_policies` returns a level's references by name.
+"""
+
+from __future__ import annotations
+
+from baselines.policies import mpc_available
+
+from .base import RigPolicy
+from .loop import closed_loop, env_plant, spectral_radius
+from .lqg import DelayLQGPolicy
+from .model import RigModel, rig_model
+from .mpc import ActuatorMPCPolicy
+
+__all__ = [
+    "RigPolicy",
+    "DelayLQGPolicy",
+    "ActuatorMPCPolicy",
+    "RigModel",
+    "rig_model",
+    "closed_loop",
+    "spectral_radius",
+    "env_plant",
+    "engineer_policies",
+]
+
+
+def engineer_policies(env) -> dict:
+    """The engineer's references of ``env``'s level (any wrapper of an ``ACLDBeamEnv``),
+    name -> policy with SB3's ``predict``: ``"lqg"`` and, where the QP solver osqp is
+    installed, ``"mpc_rig"``."""
+    out = {"lqg": DelayLQGPolicy.for_env(env)}
+    if mpc_available():
+        out["mpc_rig"] = ActuatorMPCPolicy.for_env(env)
+    return out

@@ -1,0 +1,182 @@
+r"""The engineer's MPC for the level's known actuator, on the env's reward."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from acld_gym.physics.actuator import V_LIMIT
+from baselines.policies import MPCPolicy
+
+from .base import RigPolicy
+
+__all__ = ["ActuatorMPCPolicy"]
+
+
+@dataclass(frozen=True, eq=False)
+class _Reduced:
+    C: np.ndarray
+    order: int
+
+
+@dataclass(frozen=True, eq=False)
+class _Design:
+    reduced: _Reduced
+    weight: np.ndarray
+
+    def state_weight(self, weight: float) -> np.ndarray:
+        return weight * self.weight
+
+
+@dataclass(frozen=True, eq=False)
+class _PlantPart:
+    """The plant part of a :class:`~baselines.engineer.model.RigModel` (the reduced model
+    with the amplifier's lag) presented as the nominal design :class:`MPCPolicy` builds
+    its prediction matrices from (``reduced.Ad``, ``reduced.Bd``, ``design.reduced.C``,
+    ``design.state_weight``): the QP machinery is reused as it is."""
+
+    reduced: object
+    design: _Design
+
+
+class _RateMPC(MPCPolicy):
+    """:class:`MPCPolicy`'s QP with the slew limit as rate constraints on the voltages:
+    :math:`|u_0 - v_{-1}| \\le \\sigma`, :math:`|u_j - u_{j-1}| \\le \\sigma` (units of
+    120 V; σ the slew per period), besides the box."""
+
+    slew = None  # per period, units of 120 V; None: the box alone
+
+    def _solver(self, i: int):
+        if self.slew is None:
+            return super()._solver(i)
+        if i not in self._solvers:
+            import scipy.sparse as sp
+
+            P, _, H = self._setup
+            D = sp.eye(H, format="csc") - sp.eye(H, k=-1, format="csc")
+            prob = self._osqp.OSQP()
+            prob.setup(
+                P=P,
+                q=np.zeros(H),
+                A=sp.vstack([sp.identity(H, format="csc"), D], format="csc"),
+                l=np.r_[-np.ones(H), -self.slew * np.ones(H)],
+                u=np.r_[np.ones(H), self.slew * np.ones(H)],
+                verbose=False,
+                eps_abs=1e-7,
+                eps_rel=1e-7,
+                polishing=False,
+                max_iter=20000,
+            )
+            self._solvers[i] = prob
+        return self._solvers[i]
+
+    def first_moves(self, x: np.ndarray, held: np.ndarray) -> np.ndarray:
+        """The first voltage [V] of the QP from plant states ``x`` (N, n) after the
+        amplifier's output ``held`` (N,) [V]."""
+        out = np.empty(x.shape[0])
+        H = self._setup[2]
+        for i in range(x.shape[0]):
+            prob = self._solver(i)
+            if self.slew is None:
+                prob.update(q=self._linear_term(x[i]))
+            else:
+                h = held[i] / V_LIMIT
+                lo = np.r_[-np.ones(H), h - self.slew, -self.slew * np.ones(H - 1)]
+                hi = np.r_[np.ones(H), h + self.slew, self.slew * np.ones(H - 1)]
+                prob.update(q=self._linear_term(x[i]), l=lo, u=hi)
+            res = prob.solve(raise_error=False)
+            if res.info.status not in ("solved", "solved inaccurate"):
+                raise RuntimeError(f"MPC: OSQP returned status {res.info.status!r}")
+            out[i] = V_LIMIT * float(res.x[0])
+        return out
+
+
+class ActuatorMPCPolicy(RigPolicy):
+    r"""MPC of the env's reward that knows the level's actuator.
+
+    * **The delay by prediction.** The d commands in flight are known, so the filter's
+      estimate (:mod:`baselines.engineer.base`) is carried d periods ahead exactly,
+      :math:`\hat x_{k+d|k} = A_p^d \hat x_{k|k} + \sum_{j<d} A_p^{d-1-j} b_p v_{k+j}`
+      (:math:`v` the voltages they produce at the amplifier), and the command
+      :math:`u_k` chosen now is the first that can still be chosen: it reaches the
+      amplifier at k + d.
+    * **The QP** from :math:`\hat x_{k+d|k}` is :class:`baselines.policies.MPCPolicy`'s
+      (OSQP, warm-started, condensed in the H voltages) on the plant part of the design
+      model -- with the amplifier's lag as a state where the level has one -- and the
+      env's reward as its cost, as :class:`baselines.policies.RewardMPCPolicy`:
+
+      .. math::
+
+          \min_{u} \sum_{j=1}^{H} \hat y_{k+d+j}^2 + \rho \sum_{i=0}^{H-1} (u_{k+i}/120)^2,
+          \qquad \rho = \lambda (y_{ref} / 1\ \mathrm{mm})^2,
+          \qquad |u| \le 120\ \mathrm{V},
+
+      plus, with a slew limit σ = ``slew_rate * dt``, the rate constraints
+      :math:`|u_k - v_{k+d-1}| \le σ`, :math:`|u_{k+i} - u_{k+i-1}| \le σ`.
+      ``state_weight`` adds :class:`MPCPolicy`'s small multiple of the thesis LQR's state
+      weight (its robustness term; 0: the reward alone).
+
+    **Knows**: the nominal beam, the delay, the amplifier's bandwidth and slew rate, the
+    sensor's noise, the reward. **Does not know**: the episode's load, temperature and
+    parameters. The first voltage is applied; about rest, with no constraint active, it is
+    the linear law :meth:`small_signal_gain` on :math:`\hat z`.
+    """
+
+    name = "mpc_rig"
+
+    def __init__(
+        self,
+        nom,
+        config,
+        horizon: int = 60,
+        state_weight: float = 0.0,
+        model_std: float | None = None,
+        load_std: float = 1.0,
+        model=None,
+    ):
+        super().__init__(nom, config, model_std=model_std, load_std=load_std, model=model)
+        m = self.model
+        k = nom.design.reduced.order
+        W = np.zeros((m.n_plant, m.n_plant))
+        if state_weight > 0:  # the thesis LQR's weight, on the reduced state (its own basis)
+            W[:k, :k] = nom.design.state_weight(1.0)
+        part = _PlantPart(
+            reduced=m.plant, design=_Design(_Reduced(C=m.c[None, :], order=m.n_plant), W)
+        )
+        rho = m.lam * (m.y_ref / 1e-3) ** 2
+        self.mpc = _RateMPC(
+            m.plant.dt, horizon, rho=rho, state_weight=state_weight, nom=part, mesh=nom.mesh
+        )
+        self.mpc.slew = None if m.slew_step is None else m.slew_step / V_LIMIT
+        self.horizon = horizon
+
+    def _ahead(self, z: np.ndarray, held: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(x̂_{k+d|k}, v_{k+d-1})``: the plant's estimate carried over the commands in
+        flight, and the amplifier's output when the next command reaches it."""
+        m, n_p = self.model, self.model.n_plant
+        x, v = z[:, :n_p].copy(), np.asarray(held, dtype=float).copy()
+        for j in range(m.delay):
+            v = m.drive(z[:, n_p + j], v)
+            x = x @ m.plant.Ad.T + np.outer(v, m.plant.Bd[:, 0])
+        return x, v
+
+    def command(self, z: np.ndarray, held: np.ndarray) -> np.ndarray:
+        x, v = self._ahead(z, held)
+        return self.mpc.first_moves(x, v)
+
+    def prediction_map(self) -> np.ndarray:
+        r"""P (n_p, n) with :math:`\hat x_{k+d|k} = P \hat z_k` (no slew limit binding)."""
+        m, n_p, d = self.model, self.model.n_plant, self.model.delay
+        P = np.zeros((n_p, n_p + d))
+        P[:, :n_p] = np.eye(n_p)
+        Ap, bp = m.plant.Ad, m.plant.Bd[:, 0]
+        for j in range(d):
+            P = Ap @ P
+            P[:, n_p + j] += bp
+        return P
+
+    def small_signal_gain(self) -> np.ndarray:
+        """The unconstrained QP's first move as a gain on :math:`\\hat z`,
+        :math:`u = -K_{QP} P \\hat z` (:meth:`prediction_map` P)."""
+        return self.mpc.small_signal_gain() @ self.prediction_map()

@@ -11,34 +11,53 @@ anything when read:
   **observation fingerprint** of the env it was trained on
   (:mod:`acld_gym.envs.fingerprint`).
 
-:meth:`TrainedAgent.load` reads only those two files. It refuses an agent whose
-fingerprint does not match what that env's observation is today, on this machine
-(another basis, mesh, observer or scaling), and :func:`baselines.evaluate.rollout`
-refuses to run it in an env whose observation differs: an agent never acts on
-coordinates it was not trained on. Training runs also keep SB3's ``model.zip`` and
-``vecnormalize.pkl`` for resuming training; loading *those* unpickles code, so only
-load them from a source you trust (``TrainedAgent`` never does).
+:meth:`TrainedAgent.load` reads only those two files, and treats them as data from an
+unknown source: it never imports or executes anything and never leaves the folder. The
+env id the metadata names must be one of this package's registered ids, matched as a
+string (:mod:`train.agent_schema`; Gymnasium's ``"module:Env"`` form would import
+``module``); no symbolic link is followed; the archive's members are checked by name and
+declared size against the actor program before anything is decompressed
+(:mod:`train.agent_files`). Every fault is an :class:`AgentFileError` naming the file and
+the field. It refuses an agent whose fingerprint does not match what that env's
+observation is today, on this machine (another basis, mesh, observer or scaling), and
+:func:`baselines.evaluate.rollout` refuses to run it in an env whose observation differs:
+an agent never acts on coordinates it was not trained on.
+
+:meth:`TrainedAgent.save` writes the folder whole: built in a temporary sibling and
+swapped in with one rename, so a reader (or a full disk) sees the old agent or the new
+one. Training runs also keep SB3's ``model.zip`` and ``vecnormalize.pkl`` for resuming
+training; loading *those* unpickles code, so only load them from a source you trust
+(``TrainedAgent`` never does).
 """
 
 from __future__ import annotations
 
-import json
-import zipfile
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
-from acld_gym.util.atomic import write_atomic, write_json
-
+from .agent_files import (
+    MAX_CURVE_BYTES,
+    MAX_METADATA_BYTES,
+    MAX_POLICY_BYTES,
+    AgentFolder,
+    read_arrays,
+    write_folder,
+)
+from .agent_schema import FORMAT, AgentFileError, check_ops, parse_metadata
 from .direction import direction_features
+from .sb3_export import actor_extractor, actor_parts, export_sb3
 from .voltage import VoltageMap
+
+#: Largest ``policy.npz`` on disk: the arrays' limit and room for the archive's directory.
+_MAX_ARCHIVE_BYTES = MAX_POLICY_BYTES + (1 << 20)
 
 __all__ = [
     "TrainedAgent",
     "ActorProgram",
     "AgentFileError",
     "export_sb3",
+    "actor_extractor",
     "actor_parts",
     "linear_program",
     "observation_width",
@@ -57,8 +76,6 @@ MODEL_FILE = "model.zip"
 STATS_FILE = "vecnormalize.pkl"
 #: A trained agent's learning curve (``timesteps,case,ise``: the evaluations of its run).
 CURVE_FILE = "learning_curve.csv"
-#: Version of the agent format.
-FORMAT = 2
 
 
 def versions() -> dict[str, str]:
@@ -77,10 +94,6 @@ def versions() -> dict[str, str]:
     return out
 
 
-class AgentFileError(ValueError):
-    """An agent directory's file is missing, damaged or inconsistent (names the file)."""
-
-
 class ActorProgram:
     """The deterministic actor as a list of numpy operations on the raw observation.
 
@@ -89,35 +102,39 @@ class ActorProgram:
     ``{"op": "linear"}`` (arrays ``W{i}``, ``b{i}``), ``{"op": "tanh" | "relu"}``,
     ``{"op": "clip", "low": l, "high": h}``. The output is the action in [-1, 1].
 
-    Every array must be finite and of the shape its operation needs, the first layer's
-    input ``n_obs`` wide if given (the observation's width) and the last layer's output
-    one action; otherwise :class:`AgentFileError` names the array.
+    The operations must be well formed (:func:`train.agent_schema.check_ops`), every array
+    finite and of the shape its operation needs, the first layer's input ``n_obs`` wide if
+    given (the observation's width) and the last layer's output one action; otherwise
+    :class:`AgentFileError` names the operation or the array.
     """
 
-    _KINDS = ("normalize", "direction", "linear", "tanh", "relu", "clip")
-
     def __init__(self, ops: list[dict], arrays: dict[str, np.ndarray], n_obs: int | None = None):
-        self.ops = [dict(op) for op in ops]
+        self.ops = [dict(op) for op in check_ops(list(ops), META_FILE)]
         self.arrays = {k: np.asarray(v, dtype=np.float64) for k, v in arrays.items()}
-        layer = 0
-        for op in self.ops:
-            kind = op.get("op")
-            if kind not in self._KINDS:
-                raise AgentFileError(f"{META_FILE}: actor: unknown operation {kind!r}")
-            if kind == "linear":
+        for key in self.needed_arrays(self.ops):
+            if key not in self.arrays:
+                raise AgentFileError(f"{POLICY_FILE}: missing array {key!r}")
+        self.check_width(n_obs)
+
+    @staticmethod
+    def needed_arrays(ops: list[dict]) -> list[str]:
+        """The arrays the operations ``ops`` use, in order; fills in each linear
+        operation's default ``layer`` (the count of linear operations before it)."""
+        out, layer = [], 0
+        for op in ops:
+            if op["op"] == "linear":
                 op.setdefault("layer", layer)
                 layer += 1
-                for key in (f"W{op['layer']}", f"b{op['layer']}"):
-                    if key not in self.arrays:
-                        raise AgentFileError(f"{POLICY_FILE}: missing array {key!r}")
-            if kind == "normalize" and not {"mean", "var"} <= set(self.arrays):
-                raise AgentFileError(f"{POLICY_FILE}: normalize needs 'mean' and 'var'")
-        self._check_arrays(n_obs)
+                out += [f"W{op['layer']}", f"b{op['layer']}"]
+            elif op["op"] == "normalize":
+                out += ["mean", "var"]
+        return list(dict.fromkeys(out))
 
-    def _check_arrays(self, n_obs: int | None) -> None:
+    def check_width(self, n_obs: int | None) -> None:
         """Every array the operations use is finite and of the shape its place in the
         program fixes: ``mean``, ``var`` (d,), ``W{i}`` (width in, width out), ``b{i}``
-        (width out,), the output one action; d is ``n_obs`` (or the first array's width)."""
+        (width out,), the output one action; d is ``n_obs`` (or the first array's width).
+        :class:`AgentFileError` naming the array otherwise."""
         for key, value in self.arrays.items():
             if not np.all(np.isfinite(value)):
                 raise AgentFileError(f"{POLICY_FILE}: array {key!r} has non-finite values")
@@ -175,119 +192,6 @@ class ActorProgram:
             else:
                 z = np.clip(z, op["low"], op["high"])
         return np.clip(z, -1.0, 1.0).reshape(-1, 1)
-
-
-def actor_extractor(model):
-    """The features extractor of an SB3 model's deterministic actor (what
-    :func:`actor_parts` returns first), whatever the layers after it."""
-    pol = model.policy
-    actor = getattr(pol, "actor", None)
-    if actor is not None:  # SAC, TQC, CrossQ, TD3
-        return actor.features_extractor
-    if hasattr(pol, "mlp_extractor"):  # PPO / A2C
-        return pol.pi_features_extractor
-    return pol.features_extractor  # ARS (sb3-contrib)
-
-
-def actor_parts(model) -> tuple[Any, list, bool]:
-    """The deterministic actor of an SB3 model as ``(features extractor, layers in order,
-    squash)``: ``squash`` is True where SB3 applies a tanh after the last layer. One walk
-    for :func:`export_sb3` and for folding a whitening into the first linear layer
-    (:func:`train.bench.sb3_train.fold_whitening`)."""
-    import torch.nn as nn
-
-    pol = model.policy
-    extractor = actor_extractor(model)
-    actor = getattr(pol, "actor", None)
-    if actor is not None and hasattr(actor, "latent_pi"):  # SAC, TQC, CrossQ: tanh(mu(latent))
-        mu = actor.mu
-        layers = [*actor.latent_pi, *(mu if isinstance(mu, nn.Sequential) else [mu])]
-        return extractor, layers, True
-    if actor is not None and hasattr(actor, "mu"):  # TD3: mu is the whole net, Tanh last
-        return extractor, list(actor.mu), False
-    if not hasattr(pol, "mlp_extractor"):  # ARS (sb3-contrib): action_net is the actor
-        return extractor, list(pol.action_net), False
-    # PPO / A2C: Gaussian mean, clipped to the box
-    return extractor, [*pol.mlp_extractor.policy_net, pol.action_net], bool(pol.squash_output)
-
-
-def export_sb3(model, obs_norm=None) -> ActorProgram:
-    """The deterministic actor of an SB3 ``MlpPolicy`` (PPO, SAC, TD3, TQC, CrossQ, ARS,
-    ...) and its ``VecNormalize`` observation statistics as an :class:`ActorProgram` (equal
-    to SB3's ``predict`` to float32 round-off; tests/train/test_distill.py and, for
-    CrossQ's batch renormalisation, tests/train/test_benchmark.py)."""
-    import torch.nn as nn
-    from stable_baselines3.common.torch_layers import FlattenExtractor
-
-    from .features import DirectionFeatures, DropLast
-
-    ops: list[dict] = []
-    arrays: dict[str, np.ndarray] = {}
-    if obs_norm is not None and getattr(obs_norm, "norm_obs", False):
-        ops.append(
-            {"op": "normalize", "clip": float(obs_norm.clip_obs), "eps": float(obs_norm.epsilon)}
-        )
-        arrays["mean"] = obs_norm.obs_rms.mean.copy()
-        arrays["var"] = obs_norm.obs_rms.var.copy()
-    extractor, layers, squash = actor_parts(model)
-    if isinstance(extractor, DirectionFeatures):
-        ops.append({"op": "direction"})
-    elif isinstance(extractor, DropLast):  # an asymmetric agent: the actor never read the
-        pass  # appended log(reward scale), and the deployed env does not append it
-    elif not isinstance(extractor, FlattenExtractor):
-        raise TypeError(
-            f"export_sb3 supports the flatten or direction features only, got "
-            f"{type(extractor).__name__}"
-        )
-    layer = 0
-    for m in layers:
-        if isinstance(m, nn.Linear):
-            arrays[f"W{layer}"] = m.weight.detach().double().numpy().T.copy()
-            arrays[f"b{layer}"] = m.bias.detach().double().numpy().copy()
-            ops.append({"op": "linear", "layer": layer})
-            layer += 1
-        elif _is_batch_renorm(m):  # CrossQ's; in eval mode an affine map of each feature
-            w, b = _batch_renorm_affine(m)
-            arrays[f"W{layer}"] = np.diag(w)
-            arrays[f"b{layer}"] = b
-            ops.append({"op": "linear", "layer": layer})
-            layer += 1
-        elif isinstance(m, nn.Tanh):
-            ops.append({"op": "tanh"})
-        elif isinstance(m, nn.ReLU):
-            ops.append({"op": "relu"})
-        elif isinstance(m, nn.Hardtanh):
-            ops.append({"op": "clip", "low": float(m.min_val), "high": float(m.max_val)})
-        else:
-            raise TypeError(f"export_sb3: unsupported layer {m!r}")
-    if squash:
-        ops.append({"op": "tanh"})
-    return ActorProgram(ops, arrays)
-
-
-def _is_batch_renorm(m) -> bool:
-    """Whether ``m`` is sb3-contrib's ``BatchRenorm`` (CrossQ's layers)."""
-    try:
-        from sb3_contrib.common.torch_layers import BatchRenorm
-    except ImportError:  # sb3-contrib not installed: no BatchRenorm to meet
-        return False
-    return isinstance(m, BatchRenorm)
-
-
-def _batch_renorm_affine(m) -> tuple[np.ndarray, np.ndarray]:
-    r"""The per-feature map :math:`x \mapsto w x + b` of sb3-contrib's ``BatchRenorm`` in
-    evaluation mode, as SB3's ``predict`` runs it: :math:`w = \gamma / \sqrt{\sigma^2 +
-    \epsilon}`, :math:`b = \beta - w \mu` with the running mean :math:`\mu` and variance
-    :math:`\sigma^2` (``ra_mean``, ``ra_var``) and the affine ``scale`` :math:`\gamma` and
-    ``bias`` :math:`\beta` (1 and 0 if not ``affine``)."""
-
-    def arr(t):
-        return t.detach().double().numpy().copy()
-
-    mean, var = arr(m.ra_mean), arr(m.ra_var)
-    gamma, beta = (arr(m.scale), arr(m.bias)) if m.affine else (1.0, 0.0)
-    w = np.broadcast_to(gamma / np.sqrt(var + float(m.eps)), mean.shape).copy()
-    return w, np.broadcast_to(beta, mean.shape) - w * mean
 
 
 def linear_program(
@@ -376,75 +280,94 @@ class TrainedAgent:
         return self.metadata.get("training", "unknown")
 
     # --- files ------------------------------------------------------------------------
-    def save(self, directory: str | Path) -> Path:
-        """Write ``policy.npz`` and ``metadata.json`` (atomically) to ``directory``."""
-        d = Path(directory)
+    def save(self, directory: str | Path, files: dict[str, str] | None = None) -> Path:
+        """Write the agent folder ``directory`` whole: ``policy.npz``, ``metadata.json``
+        and the text ``files`` (name: text, e.g. its ``learning_curve.csv``), built in a
+        temporary sibling and swapped in with one rename
+        (:func:`train.agent_files.write_folder`): what was there before is replaced, or,
+        if the write fails, left as it was. ``ValueError`` if ``directory`` holds other
+        files than an agent's or a training run's."""
         meta = dict(self.metadata, format=FORMAT, actor=self.actor.ops)
-        write_atomic(d / POLICY_FILE, lambda fh: np.savez(fh, **self.actor.arrays))
-        write_json(d / META_FILE, meta)
-        return d
+        return write_folder(directory, self.actor.arrays, meta, dict(files or {}))
 
     @classmethod
     def load(
         cls, directory: str | Path, name: str | None = None, check: bool = True
     ) -> TrainedAgent:
-        """Load an agent directory without executing anything from it.
+        """Load an agent directory as data (module docstring): nothing from it is
+        imported or executed, no link followed, no member decompressed before it is
+        checked. ``FileNotFoundError`` if ``directory`` does not exist; every fault of
+        its files an :class:`AgentFileError` naming the file and the field.
 
         With ``check`` (default), the recorded observation fingerprint is compared with
         the observation of the env it names, as defined by this installation on this
         machine; a mismatch raises :class:`AgentFileError` saying what differs.
         """
         d = Path(directory)
-        if not d.is_dir():
-            raise FileNotFoundError(f"agent directory {str(d)!r} does not exist")
-        meta_path, pol_path = d / META_FILE, d / POLICY_FILE
-        for f in (meta_path, pol_path):
-            if not f.is_file():
-                raise FileNotFoundError(f"agent directory {str(d)!r} lacks {f.name}")
+        with AgentFolder(d) as folder:
+            meta_bytes = folder.read(META_FILE, MAX_METADATA_BYTES)
+            policy_bytes = folder.read(POLICY_FILE, _MAX_ARCHIVE_BYTES)
+        meta = parse_metadata(meta_bytes, str(d / META_FILE))
+        ops = [dict(op) for op in meta["actor"]]
+        arrays = read_arrays(policy_bytes, ActorProgram.needed_arrays(ops), str(d / POLICY_FILE))
         try:
-            meta = json.loads(meta_path.read_text())
-        except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-            raise AgentFileError(f"{meta_path}: not valid JSON ({exc})") from None
-        if not isinstance(meta, dict) or not {"actor", "observation", "env"} <= set(meta):
-            raise AgentFileError(
-                f"{meta_path}: expected an agent's metadata with 'actor', 'observation' and 'env'"
-            )
-        try:
-            with np.load(pol_path, allow_pickle=False) as z:
-                arrays = {k: z[k] for k in z.files}
-        except (OSError, ValueError, zipfile.BadZipFile, EOFError) as exc:
-            raise AgentFileError(f"{pol_path}: not a readable numpy archive ({exc})") from None
-        try:
-            actor = ActorProgram(meta["actor"], arrays, observation_width(meta))
+            actor = ActorProgram(ops, arrays, observation_width(meta))
         except AgentFileError as exc:
             raise AgentFileError(f"{d}/{exc}") from None
-        agent = cls(actor, meta, name or meta.get("algo", "agent"), d)
+        agent = cls(actor, meta, name or meta.get("algo") or "agent", d)
         if check:
             agent.check_current()
         return agent
 
+    def learning_curve(self) -> str | None:
+        """The text of the folder's ``learning_curve.csv`` (read as :meth:`load` reads, at
+        most :data:`train.agent_files.MAX_CURVE_BYTES`, UTF-8), or None if it has none."""
+        if self.directory is None:
+            return None
+        with AgentFolder(self.directory) as folder:
+            if not folder.exists(CURVE_FILE):
+                return None
+            data = folder.read(CURVE_FILE, MAX_CURVE_BYTES)
+        try:
+            return data.decode("utf-8")
+        except UnicodeDecodeError:
+            raise AgentFileError(f"{self.directory / CURVE_FILE}: not UTF-8 text") from None
+
     def check_current(self) -> None:
         """Raise :class:`AgentFileError` if the env the agent names observes differently
-        today (:mod:`acld_gym.envs.fingerprint`)."""
+        today (:mod:`acld_gym.envs.fingerprint`), or if its settings (``env.kwargs``) are
+        not ones that env takes. The id was checked as data when the metadata was read
+        (:mod:`train.agent_schema`); it is checked again here before ``gym.make``."""
         import gymnasium as gym
 
         import acld_gym  # noqa: F401  (registers the ids)
         from acld_gym.envs.fingerprint import fingerprint_differences, observation_fingerprint
+        from acld_gym.envs.presets import check_env_id
 
+        where = self.directory if self.directory is not None else self.name
+        meta_file = f"{where}/{META_FILE}" if self.directory is not None else str(where)
         env_meta = self.metadata["env"]
-        env = gym.make(env_meta["id"], **env_meta.get("kwargs", {}))
+        try:
+            env_id = check_env_id(env_meta["id"], "env.id")
+            env = gym.make(env_id, **env_meta.get("kwargs", {}))
+        except (TypeError, ValueError, gym.error.Error) as exc:
+            raise AgentFileError(f"{meta_file}: env: {exc}") from None
         try:
             diff = fingerprint_differences(
                 self.observation_fingerprint, observation_fingerprint(env)
             )
+            width = env.observation_space.shape[0]
         finally:
             env.close()
         if diff:
-            where = self.directory if self.directory is not None else self.name
             raise AgentFileError(
                 f"agent {str(where)!r} was trained on another observation "
-                f"than {env_meta['id']}'s today: " + "; ".join(diff)
+                f"than {env_id}'s today: " + "; ".join(diff)
             )
+        try:
+            self.actor.check_width(width)
+        except AgentFileError as exc:
+            raise AgentFileError(f"{where}/{exc}") from None
 
     # --- policy -----------------------------------------------------------------------
     def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):

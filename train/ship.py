@@ -2,19 +2,27 @@
 (``policy.npz``, ``metadata.json`` with the command, seed, versions, how it was trained
 and the observation fingerprint of the run, and ``learning_curve.csv``).
 ``python -m train.ship OUT NAME --best CONFIG``: the same for the seed of a benchmark
-config best on the thesis cases (:func:`best_seed`)."""
+config best on the thesis cases (:func:`best_seed`).
+
+The run's files are read as :meth:`train.agent.TrainedAgent.load` reads them (no link
+followed out of the run's folder, every field checked); the shipped folder is written
+whole, swapped in with one rename (:meth:`train.agent.TrainedAgent.save`), so a reader or
+a full disk sees the old agent or the new one. An existing ``NAME`` is replaced only with
+``--force``."""
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 from pathlib import Path
 
 from acld_gym.physics.loads import THESIS_CASES
-from acld_gym.util.atomic import write_text
 
-from .agent import CURVE_FILE, META_FILE, MODEL_FILE, POLICY_FILE, STATS_FILE, TrainedAgent
+from .agent import CURVE_FILE, TrainedAgent
+from .agent_files import check_replaceable
+from .agent_schema import is_real
 from .compare import AGENTS_DIR
 
 __all__ = ["best_seed", "ship", "main"]
@@ -33,36 +41,64 @@ def best_seed(out: str | Path, config: str) -> int:
         raise FileNotFoundError(
             f"no benchmark results {str(path)!r} (the --out of python -m train.benchmark)"
         )
-    algos = json.loads(path.read_text()).get("algorithms", {})
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (UnicodeDecodeError, ValueError, RecursionError) as exc:
+        raise ValueError(f"{str(path)!r}: not valid JSON ({str(exc)[:80]})") from None
+    algos = data.get("algorithms") if isinstance(data, dict) else None
+    if not isinstance(algos, dict):
+        raise ValueError(f"{str(path)!r}: expected an object with 'algorithms'")
     if config not in algos:
         raise ValueError(f"config {config!r} is not in {str(path)!r}; it has {sorted(algos)}")
-    per_seed = algos[config].get("per_seed")
+    per_seed = algos[config].get("per_seed") if isinstance(algos[config], dict) else None
     keys = ("seed", *RULE_CASES)
-    if not per_seed or not all(isinstance(r, dict) and all(k in r for k in keys) for r in per_seed):
-        raise ValueError(f"{str(path)!r}: config {config!r} needs per_seed rows with {list(keys)}")
+    if not isinstance(per_seed, list) or not per_seed or not all(_rule_row(r) for r in per_seed):
+        raise ValueError(
+            f"{str(path)!r}: config {config!r} needs per_seed rows with {list(keys)} "
+            "(an integer seed >= 0 and finite ratios)"
+        )
     means = [sum(float(r[c]) for c in RULE_CASES) / len(RULE_CASES) for r in per_seed]
     return int(per_seed[means.index(min(means))]["seed"])
 
 
-def ship(run: str | Path, name: str, agents_dir: str | Path = AGENTS_DIR) -> Path:
+def _rule_row(row) -> bool:
+    """Whether a per-seed row has a seed (an integer >= 0) and a finite ratio per case."""
+    if not isinstance(row, dict) or not all(k in row for k in ("seed", *RULE_CASES)):
+        return False
+    seed = row["seed"]
+    ok_seed = isinstance(seed, int) and not isinstance(seed, bool) and seed >= 0
+    return ok_seed and all(is_real(row[c]) for c in RULE_CASES)
+
+
+def check_name(name) -> str:
+    """``name`` if it can name a shipped agent: letters, digits and underscores (a folder
+    name, never a path); ``ValueError`` otherwise."""
+    if not isinstance(name, str) or not name.replace("_", "").isalnum() or not name.isascii():
+        raise ValueError(f"name must be letters, digits and underscores, got {name!r}")
+    return name
+
+
+def ship(
+    run: str | Path, name: str, agents_dir: str | Path = AGENTS_DIR, force: bool = False
+) -> Path:
     """Copy an agent directory (``python -m train`` writes one in its ``--out``,
     ``python -m train.benchmark`` one per trial in ``<out>/agents/<config>-s<seed>``: the
     run's final policy, ``policy.npz`` + ``metadata.json``, nothing pickled) and its
-    learning curve to ``agents_dir/name``, atomically per file; returns that directory.
-    The agent is validated (:meth:`train.agent.TrainedAgent.load`) before it is copied."""
-    run = Path(run)
-    for f in (run / POLICY_FILE, run / META_FILE):
-        if not f.is_file():
-            raise FileNotFoundError(f"agent directory {str(run)!r} lacks {f.name}")
+    learning curve to ``agents_dir/name``, the folder written whole (module docstring);
+    returns that directory. The agent is read and validated as
+    :meth:`train.agent.TrainedAgent.load` does before anything is written;
+    ``FileExistsError`` if ``agents_dir/name`` exists and not ``force``."""
+    check_name(name)
     agent = TrainedAgent.load(run, check=False)
-    agent.metadata["checkpoint"] = "final policy"
+    curve = agent.learning_curve()
     dst = Path(agents_dir) / name
-    agent.save(dst)
-    if (run / CURVE_FILE).is_file():
-        write_text(dst / CURVE_FILE, (run / CURVE_FILE).read_text())
-    for stale in (MODEL_FILE, STATS_FILE):  # pickled files of an older format
-        (dst / stale).unlink(missing_ok=True)
-    return dst
+    if os.path.lexists(dst) and not force:
+        raise FileExistsError(
+            f"agent {name!r} exists in {str(Path(agents_dir))!r}; pass --force to replace it"
+        )
+    check_replaceable(dst)
+    agent.metadata["checkpoint"] = "final policy"
+    return agent.save(dst, {CURVE_FILE: curve} if curve is not None else None)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -81,9 +117,12 @@ def main(argv: list[str] | None = None) -> int:
     )
     p.add_argument("name", help="agent name, e.g. ppo, sac, ppo_robust")
     p.add_argument("--agents", default=str(AGENTS_DIR), help="destination (default: shipped)")
+    p.add_argument("--force", action="store_true", help="replace an existing agent of that name")
     args = p.parse_args(argv)
-    if not args.name.replace("_", "").isalnum():
-        p.error(f"name must be letters, digits and underscores, got {args.name!r}")
+    try:
+        check_name(args.name)
+    except ValueError as exc:
+        p.error(str(exc))
     try:
         run = args.run
         if args.best is not None:
@@ -92,7 +131,7 @@ def main(argv: list[str] | None = None) -> int:
             seed = best_seed(run, args.best)
             run = agent_dir(run, args.best, seed)
             print(f"{args.best}: seed {seed} is best on cases 1-3")
-        dst = ship(run, args.name, args.agents)
+        dst = ship(run, args.name, args.agents, force=args.force)
     except (OSError, ValueError) as exc:
         p.error(str(exc))
     print(f"shipped {dst}/")

@@ -162,7 +162,8 @@ def test_action_headroom_is_applied_and_checked(agent_dir):
     v, _ = TrainedAgent.load(agent_dir).predict(obs)
     assert np.allclose(v[:, 0], np.clip(240.0 * a, -120, 120), atol=1e-4)
     (agent_dir / META_FILE).write_text(json.dumps(dict(meta, action_headroom=0.5)))
-    with pytest.raises(AgentFileError, match=rf"{META_FILE}: headroom must be a number"):
+    want = rf"{META_FILE}: action_headroom: expected a number in \[1, 100\]"
+    with pytest.raises(AgentFileError, match=want):
         TrainedAgent.load(agent_dir)
 
 

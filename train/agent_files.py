@@ -1,0 +1,315 @@
+"""An agent folder's files, read without trusting them and written whole.
+
+Reading (:class:`AgentFolder`, :func:`read_arrays`) never leaves the folder: the folder and
+each file are opened without following a symbolic link (``O_NOFOLLOW``, the files relative
+to the folder's descriptor), only regular files are read, and each has a size limit. The
+policy archive is checked by its central directory -- member names against the arrays
+the actor program uses, declared sizes against :data:`MAX_POLICY_BYTES`, no encryption,
+stored or deflated -- and each member's ``.npy`` header (a real dtype, one or two
+dimensions, the declared size) before its data is decompressed. Every fault is an
+:class:`AgentFileError` naming the file.
+
+Writing (:func:`write_folder`) builds the whole folder in a temporary sibling and swaps it
+in with one rename (:func:`acld_gym.util.atomic.replace_dir`): a reader, or a disk that
+fills midway, sees the old agent or the new one, never new weights under old metadata.
+"""
+
+from __future__ import annotations
+
+import errno
+import io
+import json
+import math
+import os
+import stat
+import zipfile
+from collections.abc import Iterable
+from pathlib import Path
+
+import numpy as np
+
+from acld_gym.util.atomic import replace_dir
+
+from .agent_schema import AgentFileError
+
+__all__ = [
+    "MAX_METADATA_BYTES",
+    "MAX_POLICY_BYTES",
+    "MAX_CURVE_BYTES",
+    "REPLACEABLE",
+    "AgentFolder",
+    "read_arrays",
+    "check_replaceable",
+    "write_folder",
+]
+
+#: Largest ``metadata.json`` read (a shipped one is about 5 kB).
+MAX_METADATA_BYTES = 1 << 20
+#: Largest total of the arrays in ``policy.npz``, as declared and as read (a shipped agent
+#: has 336 bytes; a 3 x 1024 float64 MLP about 17 MB).
+MAX_POLICY_BYTES = 64 << 20
+#: Largest ``learning_curve.csv`` read (a shipped one is about 1.5 kB).
+MAX_CURVE_BYTES = 4 << 20
+#: Most members a policy archive may list.
+MAX_MEMBERS = 256
+#: The files an existing folder may hold for :func:`write_folder` to replace it: an agent's
+#: and a training run's (``python -m train`` writes ``trial.json`` beside the agent; older
+#: runs kept SB3's pickles).
+REPLACEABLE = frozenset(
+    {
+        "policy.npz",
+        "metadata.json",
+        "learning_curve.csv",
+        "trial.json",
+        "model.zip",
+        "vecnormalize.pkl",
+    }
+)
+_NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
+_FLAGS = os.O_RDONLY | _NOFOLLOW | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)
+_BY_FD = os.open in os.supports_dir_fd and bool(_NOFOLLOW)
+
+
+class AgentFolder:
+    """An agent folder opened for reading (a context manager): :meth:`read` returns a
+    file's bytes, never through a symbolic link and never from outside the folder.
+
+    ``FileNotFoundError`` / ``NotADirectoryError`` if ``path`` is not a folder;
+    :class:`AgentFileError` if it is a symbolic link.
+    """
+
+    def __init__(self, path: str | Path):
+        self.path = Path(path)
+        try:
+            info = os.lstat(self.path)
+        except FileNotFoundError:
+            raise FileNotFoundError(f"agent directory {str(self.path)!r} does not exist") from None
+        if stat.S_ISLNK(info.st_mode):
+            raise AgentFileError(
+                f"{self.path}: is a symbolic link; an agent is read from a real folder only "
+                "(pass the folder it points to)"
+            )
+        if not stat.S_ISDIR(info.st_mode):
+            raise NotADirectoryError(f"agent directory {str(self.path)!r} is not a directory")
+        self.fd = None
+        if _BY_FD:
+            flags = os.O_RDONLY | _NOFOLLOW | getattr(os, "O_DIRECTORY", 0)
+            try:
+                self.fd = os.open(self.path, flags | getattr(os, "O_CLOEXEC", 0))
+            except OSError as exc:
+                raise AgentFileError(f"{self.path}: cannot be opened ({exc.strerror})") from None
+
+    def __enter__(self) -> AgentFolder:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def close(self) -> None:
+        if self.fd is not None:
+            os.close(self.fd)
+            self.fd = None
+
+    def exists(self, name: str) -> bool:
+        """Whether the folder has an entry ``name`` (a link counts; :meth:`read` refuses it)."""
+        try:
+            self._lstat(name)
+        except FileNotFoundError:
+            return False
+        return True
+
+    def _lstat(self, name: str) -> os.stat_result:
+        if self.fd is not None:
+            return os.stat(name, dir_fd=self.fd, follow_symlinks=False)
+        return os.lstat(self.path / name)
+
+    def read(self, name: str, limit: int) -> bytes:
+        """The bytes of the regular file ``name`` of the folder, at most ``limit`` of them;
+        :class:`AgentFileError` naming it if it is missing, a link, not a regular file or
+        larger."""
+        where = self.path / name
+        try:
+            info = self._lstat(name)
+        except FileNotFoundError:
+            raise AgentFileError(f"agent directory {str(self.path)!r} lacks {name}") from None
+        except OSError as exc:
+            raise AgentFileError(f"{where}: cannot be read ({exc.strerror})") from None
+        if stat.S_ISLNK(info.st_mode):
+            raise AgentFileError(
+                f"{where}: is a symbolic link; an agent's files must be regular files in its "
+                "own folder"
+            )
+        if not stat.S_ISREG(info.st_mode):
+            raise AgentFileError(f"{where}: is not a regular file")
+        try:
+            if self.fd is not None:
+                fd = os.open(name, _FLAGS, dir_fd=self.fd)
+            else:
+                fd = os.open(where, _FLAGS)
+        except OSError as exc:
+            why = "a symbolic link" if exc.errno in (errno.ELOOP, errno.EMLINK) else exc.strerror
+            raise AgentFileError(f"{where}: cannot be read ({why})") from None
+        try:
+            now = os.fstat(fd)
+            if not stat.S_ISREG(now.st_mode):  # replaced between lstat and open
+                raise AgentFileError(f"{where}: is not a regular file")
+            if now.st_size > limit:
+                raise AgentFileError(
+                    f"{where}: {now.st_size} bytes, more than the {limit} an agent's {name} "
+                    "may have"
+                )
+            with os.fdopen(os.dup(fd), "rb") as fh:  # (read(n) would allocate n bytes)
+                data = fh.read(now.st_size + 1)
+        except OSError as exc:
+            raise AgentFileError(f"{where}: cannot be read ({exc.strerror})") from None
+        finally:
+            os.close(fd)
+        if len(data) > now.st_size:
+            raise AgentFileError(f"{where}: changed while it was read")
+        return data
+
+
+def read_arrays(data: bytes, needed: Iterable[str], where: str) -> dict[str, np.ndarray]:
+    """The arrays of a ``policy.npz`` read as ``data``, exactly those named ``needed`` (the
+    actor program's), as float64; checked (module docstring) before any member's data is
+    decompressed. :class:`AgentFileError` naming ``where`` and the member otherwise."""
+    needed = sorted(set(needed))
+    try:
+        archive = zipfile.ZipFile(io.BytesIO(data))
+        infos = archive.infolist()
+    except (zipfile.BadZipFile, zipfile.LargeZipFile, OSError, ValueError, EOFError) as exc:
+        raise AgentFileError(f"{where}: not a readable numpy archive ({exc})") from None
+    if len(infos) > MAX_MEMBERS:
+        raise AgentFileError(f"{where}: {len(infos)} members, more than {MAX_MEMBERS}")
+    names = [i.filename for i in infos]
+    if len(set(names)) != len(names):
+        raise AgentFileError(f"{where}: a member name appears twice")
+    held = {n[: -len(".npy")] for n in names if n.endswith(".npy")}
+    unused = sorted(n for n in names if not (n.endswith(".npy") and n[: -len(".npy")] in needed))
+    if unused:
+        raise AgentFileError(
+            f"{where}: members {[_cut(n) for n in unused][:8]} are not arrays the actor "
+            f"program uses (it uses {needed})"
+        )
+    for key in needed:
+        if key not in held:
+            raise AgentFileError(f"{where}: missing array {key!r}")
+    total = sum(i.file_size for i in infos)
+    if total > MAX_POLICY_BYTES:
+        raise AgentFileError(
+            f"{where}: its arrays declare {total} bytes, more than {MAX_POLICY_BYTES}"
+        )
+    for info in infos:
+        key = info.filename[: -len(".npy")]
+        if info.flag_bits & 0x1:
+            raise AgentFileError(f"{where}: array {key!r} is encrypted")
+        if info.compress_type not in (zipfile.ZIP_STORED, zipfile.ZIP_DEFLATED):
+            raise AgentFileError(f"{where}: array {key!r} uses an unsupported compression")
+    out = {}
+    with archive:
+        for info in infos:
+            out[info.filename[: -len(".npy")]] = _read_member(archive, info, where)
+    return out
+
+
+def _cut(name: str) -> str:
+    return name if len(name) <= 40 else name[:37] + "..."
+
+
+def _read_member(archive: zipfile.ZipFile, info: zipfile.ZipInfo, where: str) -> np.ndarray:
+    """One ``.npy`` member: its header checked against its declared size, then its data."""
+    key = info.filename[: -len(".npy")]
+    fmt = np.lib.format
+    try:
+        with archive.open(info) as fh:
+            version = fmt.read_magic(fh)
+            readers = {(1, 0): fmt.read_array_header_1_0, (2, 0): fmt.read_array_header_2_0}
+            if version not in readers:
+                raise ValueError(f"unsupported .npy version {version}")
+            shape, fortran, dtype = readers[version](fh, max_header_size=10000)
+            if dtype.kind not in "fiu" or dtype.fields is not None or dtype.subdtype is not None:
+                raise AgentFileError(
+                    f"{where}: array {key!r} holds {dtype.str!r} values, expected real numbers"
+                )
+            if not 1 <= len(shape) <= 2:
+                raise AgentFileError(
+                    f"{where}: array {key!r} has shape {shape}, expected a vector or a matrix"
+                )
+            nbytes = math.prod(shape) * dtype.itemsize
+            if fh.tell() + nbytes != info.file_size:
+                raise AgentFileError(
+                    f"{where}: array {key!r} declares {info.file_size} bytes, its header "
+                    f"{fh.tell() + nbytes}"
+                )
+            raw = fh.read(nbytes)
+            if len(raw) != nbytes or fh.read(1):
+                raise ValueError("its data do not match its header")
+    except AgentFileError:
+        raise
+    except (zipfile.BadZipFile, OSError, ValueError, EOFError, TypeError) as exc:
+        raise AgentFileError(f"{where}: array {key!r} is damaged ({_cut(str(exc))})") from None
+    arr = np.frombuffer(raw, dtype=dtype).reshape(shape, order="F" if fortran else "C")
+    return arr.astype(np.float64)
+
+
+def check_replaceable(path: str | Path) -> Path:
+    """``path`` (absolute) if :func:`write_folder` may put an agent there: it does not
+    exist, or is an agent's or a run's folder (only :data:`REPLACEABLE` files), and is not
+    the working directory or one holding it. ``ValueError`` naming it otherwise: call it
+    before computing anything."""
+    path = Path(os.path.abspath(path))
+    if not path.name or path == Path(path.anchor):
+        raise ValueError(f"{str(path)!r} cannot be an agent folder")
+    if not os.path.lexists(path):
+        return path
+    if path.is_symlink():
+        return path  # replaced by the folder, its target untouched
+    if not path.is_dir():
+        raise ValueError(f"{str(path)!r} exists and is not a directory")
+    cwd = Path.cwd().resolve()
+    if cwd == path.resolve() or path.resolve() in cwd.parents:
+        raise ValueError(f"{str(path)!r} holds the working directory; it cannot be replaced")
+    with os.scandir(path) as entries:
+        other = sorted(
+            e.name for e in entries if e.name not in REPLACEABLE or e.is_dir(follow_symlinks=False)
+        )
+    if other:
+        raise ValueError(
+            f"{str(path)!r} holds {[_cut(n) for n in other][:5]} besides an agent's files; "
+            "an agent replaces its folder whole: choose a new or an agent's folder"
+        )
+    return path
+
+
+def write_folder(
+    path: str | Path, arrays: dict[str, np.ndarray], meta: dict, texts: dict[str, str]
+) -> Path:
+    """Put an agent folder at ``path`` whole (module docstring): ``policy.npz`` with
+    ``arrays``, ``metadata.json`` with ``meta`` (non-finite numbers as null) and each text
+    file of ``texts``; the folder's previous content is gone, or, if anything fails, left
+    as it was. ``ValueError`` if :func:`check_replaceable` refuses ``path``."""
+    path = check_replaceable(path)
+    for name in texts:
+        if name in ("policy.npz", "metadata.json") or Path(name).name != name:
+            raise ValueError(f"{name!r} is not an extra file name of an agent folder")
+    meta_text = json.dumps(_finite(meta), indent=2, allow_nan=False) + "\n"
+
+    def fill(tmp: Path) -> None:
+        with open(tmp / "policy.npz", "wb") as fh:
+            np.savez(fh, **arrays)
+        (tmp / "metadata.json").write_text(meta_text, encoding="utf-8")
+        for name, text in texts.items():
+            (tmp / name).write_text(text, encoding="utf-8")
+
+    return replace_dir(path, fill)
+
+
+def _finite(obj):
+    """JSON data with non-finite floats as None (strict JSON, which the reader demands)."""
+    if isinstance(obj, dict):
+        return {k: _finite(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_finite(v) for v in obj]
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    return obj

@@ -1,0 +1,286 @@
+"""What an agent's ``metadata.json`` may hold, checked as data before anything uses it.
+
+:func:`parse_metadata` turns the file's bytes into a dict whose every field the package
+reads has the type and range it needs: the env id is one of this package's registered
+ids, matched as a plain string and never handed to an importer (Gymnasium's
+``"module:Env"`` form would import ``module``); the env's keyword arguments are
+:class:`acld_gym.envs.config.EnvConfig` fields; the observation fingerprint has every
+entry :func:`acld_gym.envs.fingerprint.observation_fingerprint` records; the actor's
+program (:func:`check_ops`) has only known operations with their parameters. Anything
+else is an :class:`AgentFileError` naming the file and the field.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import numbers
+
+import numpy as np
+
+__all__ = [
+    "AgentFileError",
+    "FORMAT",
+    "MAX_DEPTH",
+    "MAX_OPS",
+    "OP_KEYS",
+    "check_ops",
+    "is_real",
+    "check_metadata",
+    "parse_metadata",
+]
+
+#: Version of the agent format this package writes (and the newest it reads).
+FORMAT = 2
+#: Deepest nesting of lists and objects a metadata file may have (a shipped one has 5).
+MAX_DEPTH = 32
+#: Most operations an actor program may have (a shipped one has 3).
+MAX_OPS = 64
+#: Each operation of an actor program and the parameters it takes (all required, except a
+#: linear layer's ``layer``, which defaults to the count of linear operations before it).
+OP_KEYS: dict[str, tuple[str, ...]] = {
+    "normalize": ("clip", "eps"),
+    "direction": (),
+    "linear": ("layer",),
+    "tanh": (),
+    "relu": (),
+    "clip": ("low", "high"),
+}
+#: The entries of an observation fingerprint (acld_gym.envs.fingerprint): strings ...
+_FINGERPRINT_TEXT = ("env_id", "mesh", "basis", "obs_mode", "observer")
+#: ... and arrays (with their number of dimensions); ``dt`` is a positive number.
+_FINGERPRINT_ARRAYS = {
+    "reduced_A": 2,
+    "reduced_B": 1,
+    "reduced_C": 1,
+    "xr_scale": 1,
+    "observer_Lc": 1,
+    "observer_Lp": 1,
+}
+#: Optional text entries (the package reads them for labels).
+_TEXT_FIELDS = ("algo", "training", "teacher", "checkpoint")
+
+
+class AgentFileError(ValueError):
+    """An agent directory's file is missing, damaged or inconsistent (names the file and,
+    for metadata, the field)."""
+
+
+def _fail(where: str, field: str, message: str) -> AgentFileError:
+    return AgentFileError(f"{where}: {field}: {message}")
+
+
+def is_real(value) -> bool:
+    """A finite real number (a JSON number, not a bool)."""
+    if not isinstance(value, numbers.Real) or isinstance(value, bool):
+        return False
+    try:
+        return math.isfinite(float(value))
+    except OverflowError:  # an integer beyond the float range
+        return False
+
+
+def _real(where: str, field: str, value, low: float | None = None, open_low: bool = False):
+    if not is_real(value):
+        raise _fail(where, field, f"expected a finite number, got {_short(value)}")
+    v = float(value)
+    if low is not None and (v < low or (open_low and v == low)):
+        rel = ">" if open_low else ">="
+        raise _fail(where, field, f"expected a number {rel} {low:g}, got {v!r}")
+    return v
+
+
+def _short(value) -> str:
+    """``repr`` of a value cut to 60 characters (a file's bytes are not echoed in full)."""
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _depth(obj) -> int:
+    """The nesting depth of JSON data, without recursion."""
+    deepest, stack = 0, [(obj, 1)]
+    while stack:
+        item, d = stack.pop()
+        if isinstance(item, (list, dict)):
+            deepest = max(deepest, d)
+            if d > MAX_DEPTH:
+                return d
+            values = item.values() if isinstance(item, dict) else item
+            stack.extend((v, d + 1) for v in values)
+    return deepest
+
+
+def _refuse_constant(name: str):
+    raise ValueError(f"{name} is not a JSON number")
+
+
+def parse_metadata(data: bytes, where: str) -> dict:
+    """The checked metadata (:func:`check_metadata`) of a ``metadata.json`` read as
+    ``data``; :class:`AgentFileError` naming ``where`` and the field otherwise."""
+    try:
+        meta = json.loads(data.decode("utf-8"), parse_constant=_refuse_constant)
+    except RecursionError:
+        raise AgentFileError(f"{where}: nested deeper than {MAX_DEPTH} levels") from None
+    except (UnicodeDecodeError, ValueError) as exc:  # JSONDecodeError is a ValueError
+        raise AgentFileError(f"{where}: not valid JSON ({_short(str(exc))[1:-1]})") from None
+    if _depth(meta) > MAX_DEPTH:
+        raise AgentFileError(f"{where}: nested deeper than {MAX_DEPTH} levels")
+    return check_metadata(meta, where)
+
+
+def check_metadata(meta, where: str = "metadata.json") -> dict:
+    """``meta`` if it is an agent's metadata whose fields the package reads are well
+    formed (module docstring); :class:`AgentFileError` naming ``where`` and the field."""
+    if not isinstance(meta, dict):
+        raise AgentFileError(f"{where}: expected a JSON object, got {type(meta).__name__}")
+    missing = [k for k in ("actor", "observation", "env") if k not in meta]
+    if missing:
+        raise AgentFileError(
+            f"{where}: expected an agent's metadata with 'actor', 'observation' and 'env'; "
+            f"it lacks {missing}"
+        )
+    fmt = meta.get("format", FORMAT)
+    if isinstance(fmt, bool) or not isinstance(fmt, int) or not 1 <= fmt <= FORMAT:
+        raise _fail(where, "format", f"expected an agent format 1 to {FORMAT}, got {_short(fmt)}")
+    _check_env(meta["env"], where)
+    _check_observation(meta["observation"], meta["env"]["id"], where)
+    check_ops(meta["actor"], where)
+    for key in _TEXT_FIELDS:
+        value = meta.get(key)
+        if value is not None and not isinstance(value, str):
+            raise _fail(where, key, f"expected a string or null, got {_short(value)}")
+    if meta.get("residual") not in (None, "lqr"):
+        raise _fail(where, "residual", f"expected null or 'lqr', got {_short(meta['residual'])}")
+    if "action_headroom" in meta:
+        from acld_gym.wrappers import MAX_HEADROOM, check_headroom
+
+        headroom = meta["action_headroom"]
+        try:  # is_real first: check_headroom cannot take an integer beyond the float range
+            check_headroom(headroom if is_real(headroom) else None, "action_headroom")
+        except ValueError:
+            raise _fail(
+                where,
+                "action_headroom",
+                f"expected a number in [1, {MAX_HEADROOM:g}], got {_short(headroom)}",
+            ) from None
+    return meta
+
+
+def _check_env(env, where: str) -> None:
+    """``env``: ``{"id": <a registered id of this package>, "kwargs": {<EnvConfig field>:
+    <a JSON value>}}``."""
+    from acld_gym.envs.presets import check_env_id
+
+    if not isinstance(env, dict):
+        raise _fail(where, "env", f"expected an object with 'id' and 'kwargs', got {_short(env)}")
+    if "id" not in env:
+        raise _fail(where, "env.id", "missing (the id of the env the agent was trained on)")
+    try:
+        check_env_id(env["id"], "env.id")
+    except ValueError as exc:
+        raise AgentFileError(f"{where}: {exc}") from None
+    unknown = sorted(set(env) - {"id", "kwargs"})
+    if unknown:
+        raise _fail(where, "env", f"unexpected keys {unknown} (expected 'id' and 'kwargs')")
+    kwargs = env.get("kwargs", {})
+    if not isinstance(kwargs, dict):
+        raise _fail(where, "env.kwargs", f"expected an object, got {_short(kwargs)}")
+    import dataclasses
+
+    from acld_gym.envs.config import EnvConfig
+
+    fields = [f.name for f in dataclasses.fields(EnvConfig)]
+    bad = sorted(k for k in kwargs if k not in fields)
+    if bad:
+        raise _fail(where, "env.kwargs", f"{bad} are not env settings (EnvConfig fields)")
+
+
+def _check_observation(obs, env_id: str, where: str) -> None:
+    """The observation fingerprint: every entry, of its type, made for ``env_id``."""
+    if not isinstance(obs, dict):
+        raise _fail(where, "observation", f"expected an object, got {_short(obs)}")
+    for key in (*_FINGERPRINT_TEXT, "dt", *_FINGERPRINT_ARRAYS):
+        if key not in obs:
+            raise _fail(where, f"observation.{key}", "missing (the observation fingerprint)")
+    for key in _FINGERPRINT_TEXT:
+        if not isinstance(obs[key], str):
+            raise _fail(where, f"observation.{key}", f"expected a string, got {_short(obs[key])}")
+    if obs["env_id"] != env_id:
+        raise _fail(
+            where, "observation.env_id", f"{obs['env_id']!r} differs from env.id {env_id!r}"
+        )
+    _real(where, "observation.dt", obs["dt"], 0.0, open_low=True)
+    for key, ndim in _FINGERPRINT_ARRAYS.items():
+        value = obs[key]
+        ok = isinstance(value, list) and _all_reals(value, ndim)
+        if ok:
+            arr = np.asarray(value, dtype=np.float64) if value else np.zeros(0)
+            ok = arr.ndim == ndim or (not value and ndim == 1)
+        if not ok:
+            shape = "a list of numbers" if ndim == 1 else "a list of equal-length lists of numbers"
+            raise _fail(where, f"observation.{key}", f"expected {shape}, got {_short(value)}")
+    for key, value in obs.items():
+        if key not in _FINGERPRINT_TEXT and key not in _FINGERPRINT_ARRAYS and key != "dt":
+            scalar = value is None or isinstance(value, (str, bool)) or is_real(value)
+            array = isinstance(value, list) and (_all_reals(value, 1) or _all_reals(value, 2))
+            if not (scalar or array):
+                raise _fail(
+                    where,
+                    f"observation.{key}",
+                    f"expected a string, a number or a list of numbers, got {_short(value)}",
+                )
+
+
+def _all_reals(value: list, ndim: int) -> bool:
+    """Whether ``value`` is a list (of lists, for ``ndim`` 2) of finite numbers, rows of
+    one length."""
+    if ndim == 1:
+        return all(is_real(v) for v in value)
+    return (
+        all(isinstance(row, list) and _all_reals(row, 1) for row in value)
+        and len({len(row) for row in value}) <= 1
+    )
+
+
+def check_ops(ops, where: str = "metadata.json") -> list[dict]:
+    """``ops`` if it is an actor program (:class:`train.agent.ActorProgram`): a list of at
+    most :data:`MAX_OPS` objects, each ``{"op": <one of OP_KEYS>}`` with exactly the
+    parameters :data:`OP_KEYS` names for it, of their types (``normalize``: ``clip`` > 0,
+    ``eps`` >= 0; ``clip``: ``low`` <= ``high``; ``linear``: ``layer`` an integer >= 0),
+    at least one linear layer; :class:`AgentFileError` naming ``where`` and the operation."""
+    if not isinstance(ops, list):
+        raise _fail(where, "actor", f"expected a list of operations, got {_short(ops)}")
+    if len(ops) > MAX_OPS:
+        raise _fail(where, "actor", f"{len(ops)} operations, more than {MAX_OPS}")
+    for i, op in enumerate(ops):
+        field = f"actor[{i}]"
+        if not isinstance(op, dict):
+            raise _fail(where, field, f"expected an object with 'op', got {_short(op)}")
+        kind = op.get("op")
+        if not isinstance(kind, str) or kind not in OP_KEYS:
+            raise _fail(
+                where, field, f"unknown operation {_short(kind)}; expected one of {list(OP_KEYS)}"
+            )
+        allowed = {"op", *OP_KEYS[kind]}
+        extra = sorted(set(op) - allowed)
+        if extra:
+            raise _fail(where, field, f"{kind!r} takes {sorted(allowed - {'op'})}, not {extra}")
+        required = [k for k in OP_KEYS[kind] if k != "layer"]
+        absent = [k for k in required if k not in op]
+        if absent:
+            raise _fail(where, field, f"{kind!r} needs {required}; it lacks {absent}")
+        if kind == "normalize":
+            _real(where, f"{field}.clip", op["clip"], 0.0, open_low=True)
+            _real(where, f"{field}.eps", op["eps"], 0.0)
+        elif kind == "clip":
+            low = _real(where, f"{field}.low", op["low"])
+            if _real(where, f"{field}.high", op["high"]) < low:
+                raise _fail(where, field, f"clip needs low <= high, got {low} > {op['high']}")
+        elif kind == "linear" and "layer" in op:
+            layer = op["layer"]
+            if isinstance(layer, bool) or not isinstance(layer, int) or not 0 <= layer < MAX_OPS:
+                want = f"expected an integer in [0, {MAX_OPS}), got {_short(layer)}"
+                raise _fail(where, f"{field}.layer", want)
+    if not any(op["op"] == "linear" for op in ops):
+        raise _fail(where, "actor", "no linear layer (an actor maps the observation to one action)")
+    return ops

@@ -46,9 +46,11 @@ import sys
 import time
 from pathlib import Path
 
-from acld_gym.util.atomic import write_text
+from acld_gym.util.atomic import check_directory, check_writable, write_text
+from acld_gym.util.validate import DataFileError, arg_type, run_main
 
 from .bench.evaluate import DEFAULT_ENV_ID
+from .bench.records import check_references, check_trial, read_json
 from .bench.report import markdown, plot_curves, summarize
 from .bench.trials import (
     DEFAULT_ALGOS,
@@ -59,7 +61,9 @@ from .bench.trials import (
     run_trials,
     trial_path,
 )
-from .config import CONFIG_DIR, read_config
+from .cli import MAX_SEED, env_id_arg
+from .config import CONFIG_DIR, TrainConfig, read_config
+from .config_checks import check_buildable
 
 __all__ = [
     "CONFIG_DIR",
@@ -96,23 +100,28 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="YAML",
         help="further config files (e.g. the ablations); alone, only these run",
     )
-    p.add_argument("--seeds", nargs="+", type=int, default=[0, 1, 2, 3, 4])
+    p.add_argument("--seeds", nargs="+", type=arg_type(int, 0, MAX_SEED), default=[0, 1, 2, 3, 4])
     p.add_argument(
         "--timesteps",
-        type=int,
+        type=arg_type(int, 1, 10**12),
         default=None,
         help="override every config's env steps per run (quick checks)",
     )
     p.add_argument(
         "--eval-points",
-        type=int,
+        type=arg_type(int, 1, 10**4),
         default=None,
         help="override the learning-curve evaluations per run",
     )
-    p.add_argument("--env-id", default=DEFAULT_ENV_ID, help=f"(default {DEFAULT_ENV_ID})")
+    p.add_argument(
+        "--env-id",
+        type=env_id_arg,
+        default=DEFAULT_ENV_ID,
+        help=f"this package's env id (default {DEFAULT_ENV_ID})",
+    )
     p.add_argument(
         "--random-episodes",
-        type=int,
+        type=arg_type(int, 1, 20),
         default=20,
         help="held-out random-load episodes of the evaluation (default 20)",
     )
@@ -124,13 +133,13 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--num-cpus",
-        type=int,
+        type=arg_type(int, 1, 1024),
         default=2,
         help="CPUs of a local Ray, or of the local backend's trial (default 2)",
     )
     p.add_argument(
         "--cpus-per-trial",
-        type=int,
+        type=arg_type(int, 1, 1024),
         default=None,
         help="CPUs of a trial whose recipe has several runs (restarts): it trains that many "
         "at once, in worker processes, to the same result in less time (default: "
@@ -171,17 +180,75 @@ def trial_workers(cpus_per_trial: int | None, num_cpus: int, address: str | None
     return 1 if address else num_cpus
 
 
+def check_outputs(out: Path, trials: list[dict], backend: str, env_id: str) -> None:
+    """``ValueError`` naming ``--out`` unless every file the command writes there can be
+    written (the tables, the figure, the references, each trial's record and agent folder,
+    Ray's storage): called before anything is computed."""
+    check_directory(out, "--out")
+    names = ["results.md", "results.json", "learning_curves.png", f"references-{env_id}.json"]
+    for t in trials:
+        names.append(str(trial_path(Path(), t["name"], t["seed"])))
+        check_directory(agent_dir(out, t["name"], t["seed"]).parent, "--out")
+    if backend == "ray":
+        check_directory(out / "ray", "--out")
+    for name in dict.fromkeys(names):
+        check_writable(out / name, "--out")
+
+
+def reusable(path: Path, trial: dict, out: Path) -> dict | None:
+    """The record at ``path`` of ``trial`` (same name, seed, config, env id and evaluation)
+    if ``--resume`` may reuse it, else None. A damaged record (:func:`train.bench.records.
+    check_trial`) or one whose agent folder no longer loads (:meth:`train.agent.
+    TrainedAgent.load`) is said in one line and trained again."""
+    if not path.is_file():
+        return None
+    what = f"{trial['name']} seed {trial['seed']}"
+    try:
+        rec = check_trial(read_json(path), path)
+    except (OSError, DataFileError) as exc:
+        print(f"  {exc}: training {what} again", flush=True)
+        return None
+    same = {k: rec.get(k) for k in ("name", "seed", "env_id", "random_episodes")}
+    if same != {k: trial[k] for k in same} or rec["config"] != json.loads(
+        json.dumps(trial["config"])
+    ):
+        return None  # another run's record (another config or env): trained again, as asked
+    from .agent import TrainedAgent
+
+    folder = agent_dir(out, trial["name"], trial["seed"])
+    try:
+        TrainedAgent.load(folder)
+    except (OSError, ValueError) as exc:
+        print(f"  {folder}: the agent does not load ({exc}): training {what} again", flush=True)
+        return None
+    return rec
+
+
+def resumed_references(env_id: str, out: Path, random_episodes: int, bound: bool) -> dict:
+    """The references of :func:`train.bench.evaluate.references`, cached in ``out``; a
+    damaged cache (:func:`train.bench.records.check_references`) is said in one line and
+    computed again (and replaced)."""
+    from .bench.evaluate import references
+
+    path = out / f"references-{env_id}.json"
+    if path.is_file():
+        try:
+            check_references(read_json(path), path, bound)
+        except (OSError, DataFileError) as exc:
+            print(f"  {exc}: computing the references again", flush=True)
+            refs = references(env_id, None, random_episodes, bound=bound)
+            write_text(path, json.dumps(refs, indent=2) + "\n")
+            return refs
+    return references(env_id, path, random_episodes, bound=bound)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    if any(s < 0 for s in args.seeds) or len(set(args.seeds)) != len(args.seeds):
-        parser.error(f"--seeds must be distinct integers >= 0, got {args.seeds}")
-    for flag in ("timesteps", "eval_points", "num_cpus", "cpus_per_trial"):
-        value = getattr(args, flag)
-        if value is not None and value < 1:
-            parser.error(f"--{flag.replace('_', '-')} must be positive, got {value}")
-    if not 1 <= args.random_episodes <= 20:
-        parser.error(f"--random-episodes must be in 1..20, got {args.random_episodes}")
+    if len(set(args.seeds)) != len(args.seeds):
+        parser.error(f"--seeds must be distinct, got {args.seeds}")
+    if args.no_train and not args.resume:
+        parser.error("--no-train needs --resume")
     backend = args.backend
     if backend == "auto":
         backend = "ray" if ray_available() else "local"
@@ -192,26 +259,23 @@ def main(argv: list[str] | None = None) -> int:
         configs = [read_config(s) for s in specs]
     except (OSError, ValueError) as exc:
         parser.error(str(exc))
+    names = [name for name, _ in configs]
+    if len(set(names)) != len(names):
+        parser.error(f"two configs of one name would share their trials: {names}")
     out = Path(args.out)
-    trials, records = [], []
+    planned = []
     for name, data in configs:
         data = dict(data)
         if args.timesteps is not None:
             data["timesteps"] = args.timesteps
         if args.eval_points is not None:
             data["eval_points"] = args.eval_points
+        try:  # with the command line's overrides, every section, before any computing
+            check_buildable(TrainConfig.from_dict(data), args.env_id)
+        except (TypeError, ValueError) as exc:
+            parser.error(f"{name}: {exc}")
         for seed in args.seeds:
-            path = trial_path(out, name, seed)
-            if args.resume and path.is_file():
-                rec = json.loads(path.read_text())
-                if (
-                    rec.get("config") == json.loads(json.dumps(data))
-                    and rec.get("env_id") == args.env_id
-                    and rec.get("random_episodes") == args.random_episodes
-                ):
-                    records.append(rec)
-                    continue
-            trials.append(
+            planned.append(
                 {
                     "name": name,
                     "config": data,
@@ -220,23 +284,25 @@ def main(argv: list[str] | None = None) -> int:
                     "random_episodes": args.random_episodes,
                 }
             )
+    try:
+        check_outputs(out, planned, backend, args.env_id)
+    except ValueError as exc:
+        parser.error(str(exc))
+    trials, records = [], []
+    for t in planned:
+        rec = reusable(trial_path(out, t["name"], t["seed"]), t, out) if args.resume else None
+        if rec is not None:
+            records.append(rec)
+        else:
+            trials.append(t)
     if args.no_train:
-        if not args.resume:
-            parser.error("--no-train needs --resume")
         for t in trials:
             print(f"  missing: {t['name']} seed {t['seed']} (not trained: --no-train)")
         trials = []
         if not records:
             parser.error(f"--no-train: no trials to report in {out / 'trials'}")
-    from .bench.evaluate import references
-
     t0 = time.perf_counter()
-    refs = references(
-        args.env_id,
-        out / f"references-{args.env_id}.json",
-        args.random_episodes,
-        bound=not args.no_bound,
-    )
+    refs = resumed_references(args.env_id, out, args.random_episodes, not args.no_bound)
     print(
         f"{len(trials)} runs ({len(records)} reused), backend {backend}, env {args.env_id}",
         flush=True,
@@ -266,4 +332,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run_main(main))

@@ -30,7 +30,7 @@ from acld_gym.util.validate import arg_type
 
 from .config import ALGOS, CONFIG_DIR, parse_load_case, read_config
 
-__all__ = ["main", "build_parser", "configure", "RECIPES", "MAX_SEED"]
+__all__ = ["main", "build_parser", "configure", "env_id_arg", "RECIPES", "MAX_SEED"]
 
 #: The recipes ``python -m train`` knows by name (a file ``train/benchmark/<algo>.yaml``).
 RECIPES = tuple(a for a in ALGOS if (CONFIG_DIR / f"{a}.yaml").is_file())
@@ -41,6 +41,18 @@ _seed = arg_type(int, 0, MAX_SEED)
 _param_noise = arg_type(float, 0.0)  # its bound (per mesh) is checked by the env's config
 _episodes = arg_type(int, 1, 20)
 _cpus = arg_type(int, 1, 1024)
+
+
+def env_id_arg(text: str) -> str:
+    """``--env-id`` value: one of this package's registered ids, matched as a plain string
+    (:func:`acld_gym.envs.presets.check_env_id`), before anything is computed; no other
+    Gymnasium id (an env of another package cannot take the beam's options)."""
+    from acld_gym.envs.presets import check_env_id
+
+    try:
+        return check_env_id(text, "expected")
+    except ValueError as err:
+        raise argparse.ArgumentTypeError(str(err).replace("expected must be", "expected")) from None
 
 
 def _load_case_arg(text: str):
@@ -92,7 +104,12 @@ def build_parser() -> argparse.ArgumentParser:
         help="per-episode parameter randomization of the training env (an env "
         "option; default: the config's, else none)",
     )
-    p.add_argument("--env-id", default=ENV_ID, help=f"(default {ENV_ID})")
+    p.add_argument(
+        "--env-id",
+        type=env_id_arg,
+        default=ENV_ID,
+        help=f"this package's env id (default {ENV_ID})",
+    )
     p.add_argument(
         "--random-episodes",
         type=_episodes,
@@ -132,11 +149,13 @@ def configure(args: argparse.Namespace) -> tuple[str, dict]:
     if args.param_noise is not None:
         data["env_kwargs"] = {**data.get("env_kwargs", {}), "param_noise": args.param_noise}
     from .config import TrainConfig
+    from .config_checks import check_buildable
 
     try:
-        TrainConfig.from_dict(data)
+        cfg = TrainConfig.from_dict(data)
     except ValueError as exc:
         raise ValueError(f"the command line's overrides: {exc}") from None
+    check_buildable(cfg, args.env_id)  # every setting the algorithm reads, before training
     return name, data
 
 
@@ -154,12 +173,6 @@ def main(argv: list[str] | None = None) -> int:
         check_writable(out / "metadata.json", "--out")
     except ValueError as exc:
         parser.error(str(exc))
-    import gymnasium as gym
-
-    try:
-        gym.spec(args.env_id)
-    except gym.error.Error as exc:
-        parser.error(f"--env-id: {exc}")
     from .bench.evaluate import eval_episodes, lqr_ise
     from .bench.trials import run_trial, save_agent
     from .config import TrainConfig

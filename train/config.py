@@ -9,7 +9,6 @@ files, build the same env (:func:`train.vec.make_vec_env`), train with the same 
 from __future__ import annotations
 
 import importlib
-import inspect
 from dataclasses import MISSING, dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
@@ -17,7 +16,7 @@ from typing import Any
 import yaml
 
 from acld_gym.physics.loads import parse_load_case
-from acld_gym.util.validate import check_int, check_real
+from acld_gym.util.validate import DataFileError, check_int, check_real
 
 __all__ = [
     "ALGOS",
@@ -48,14 +47,6 @@ ALGOS = ("vrs", *SB3_ALGOS)
 #: The recipes: ``train/benchmark/<name>.yaml``.
 CONFIG_DIR = Path(__file__).resolve().parent / "benchmark"
 RESIDUALS = (None, "lqr")
-#: Smallest value of the SB3 integer arguments that may be below 1 (-1: "as many as").
-_INT_MIN = {
-    "seed": 0,
-    "verbose": 0,
-    "learning_starts": 0,
-    "sde_sample_freq": -1,
-    "gradient_steps": -1,
-}
 
 
 @dataclass(frozen=True)
@@ -163,7 +154,7 @@ def _section(cls, data: dict, name: str):
     required = {
         f.name for f in fields(cls) if f.default is MISSING and f.default_factory is MISSING
     }
-    unknown, missing = sorted(set(data) - known), sorted(required - set(data))
+    unknown, missing = sorted(str(k) for k in set(data) - known), sorted(required - set(data))
     if unknown or missing:
         raise ValueError(
             f"{name}: unknown key(s) {unknown}, missing {missing}; expected some of {sorted(known)}"
@@ -470,44 +461,9 @@ class TrainConfig:
                 f"restarts: {self.restarts} runs need select: (the choice between "
                 "them is on the validation loads); got select: null"
             )
-        if sb3:
-            self._check_sb3()
+        from .config_checks import check_model  # the model: mapping (moved for size)
 
-    def _check_sb3(self) -> None:
-        from stable_baselines3.common.vec_env import VecNormalize
-
-        allowed = set(inspect.signature(VecNormalize).parameters) - {"venv", "gamma"}
-        bad = sorted(set(self.normalize) - allowed)
-        if bad:
-            raise ValueError(f"normalize: unknown key(s) {bad}; expected some of {sorted(allowed)}")
-        try:
-            cls = algo_class(self.algo)
-        except ImportError:  # sb3-contrib not installed: checked when the run starts
-            return
-        params = inspect.signature(cls).parameters
-        unknown = sorted(k for k in self.model if k not in params)
-        if unknown:
-            raise ValueError(
-                f"model: unknown key(s) {unknown} for {self.algo.upper()}; "
-                f"expected some of "
-                f"{sorted(k for k in params if k not in ('env', 'self'))}"
-            )
-        for key, value in self.model.items():
-            default = params[key].default
-            if (
-                isinstance(default, bool)
-                or default is None
-                or key == "policy"
-                or isinstance(value, (dict, list, tuple))
-            ):  # a schedule, a train_freq
-                continue
-            if isinstance(default, (int, float)) and not isinstance(value, bool):
-                if isinstance(default, int) and key not in ("learning_rate", "clip_range"):
-                    check_int(f"model.{key}", value, _INT_MIN.get(key, 1))
-                elif key in ("gamma", "gae_lambda"):  # a discount, a GAE weight: (0, 1]
-                    check_real(f"model.{key}", value, 0.0, 1.0, low_open=True)
-                else:
-                    check_real(f"model.{key}", value, 0.0)
+        check_model(self)
 
     @property
     def load_weights(self) -> dict:
@@ -587,7 +543,7 @@ class TrainConfig:
         if not isinstance(data, dict):
             raise ValueError(f"expected a mapping of settings, got {type(data).__name__}")
         known = set(cls.__dataclass_fields__)
-        unknown = sorted(set(data) - known)
+        unknown = sorted(str(k) for k in set(data) - known)
         if unknown:
             raise ValueError(f"unknown key(s) {unknown}; expected some of {sorted(known)}")
         missing = sorted({"algo", "timesteps"} - set(data))
@@ -615,15 +571,16 @@ def config_path(spec: str | Path) -> Path:
 
 
 def _read_yaml(path: Path) -> dict:
-    """The mapping of one YAML file; ``ValueError`` naming the file and the place."""
+    """The mapping of one YAML file; :class:`DataFileError` naming the file and the place."""
     try:
-        data = yaml.safe_load(path.read_text()) or {}
-    except yaml.YAMLError as exc:
+        data = yaml.safe_load(path.read_text(encoding="utf-8")) or {}
+    except (yaml.YAMLError, UnicodeDecodeError, RecursionError) as exc:
         where = getattr(exc, "problem_mark", None)
         at = f" (line {where.line + 1}, column {where.column + 1})" if where else ""
-        raise ValueError(f"{path}: not valid YAML{at}: {getattr(exc, 'problem', exc)}") from None
+        why = getattr(exc, "problem", None) or type(exc).__name__
+        raise DataFileError(f"{path}: not valid YAML{at}: {why}") from None
     if not isinstance(data, dict):
-        raise ValueError(f"{path}: expected a mapping of settings, got {type(data).__name__}")
+        raise DataFileError(f"{path}: expected a mapping of settings, got {type(data).__name__}")
     return data
 
 
@@ -645,10 +602,13 @@ def _resolve(path: Path, seen: tuple[Path, ...] = ()) -> dict:
         return data
     base = data.pop("base")
     if not isinstance(base, str):
-        raise ValueError(f"{path}: base: expected a config name or path, got {base!r}")
-    base_path = config_path(base)
+        raise DataFileError(f"{path}: base: expected a config name or path, got {base!r}")
+    try:
+        base_path = config_path(base)
+    except FileNotFoundError as exc:
+        raise DataFileError(f"{path}: base: {exc}") from None
     if base_path.resolve() in seen:
-        raise ValueError(f"{path}: base: {base!r} leads back to itself")
+        raise DataFileError(f"{path}: base: {base!r} leads back to itself")
     return _merged(_resolve(base_path, (*seen, path.resolve())), data)
 
 
@@ -657,13 +617,13 @@ def read_config(spec: str | Path) -> tuple[str, dict]:
     file's own with its ``base:`` applied, if it names one (an ablation is ``base: ppo`` and
     the settings it changes; nested mappings such as ``model`` merge key by key). It is what
     a trial records and ``--resume`` compares. ``ValueError`` naming the file and the key on
-    a malformed file or a bad value."""
+    a malformed file or a bad value (a :class:`acld_gym.util.validate.DataFileError`)."""
     path = config_path(spec)
     data = _resolve(path)
     try:
         TrainConfig.from_dict(data)
     except (TypeError, ValueError) as exc:
-        raise ValueError(f"{path}: {exc}") from None
+        raise DataFileError(f"{path}: {exc}") from None
     return path.stem, data
 
 

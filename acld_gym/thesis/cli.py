@@ -17,9 +17,8 @@ from acld_gym.physics.params import PRESETS
 from acld_gym.thesis.metrics import peak
 from acld_gym.thesis.reproduce import CONTROLLERS, T_END, format_table2, run_cases
 from acld_gym.util.atomic import check_directory, check_writable, write_json
-from acld_gym.util.blas import one_blas_thread
 from acld_gym.util.progress import Progress
-from acld_gym.util.validate import arg_type, closed_pipe_is_fine
+from acld_gym.util.validate import arg_type, run_main
 
 __all__ = ["main"]
 
@@ -174,9 +173,9 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     _check_outputs(parser, args)
-    with closed_pipe_is_fine(), one_blas_thread():
-        return args.func(args)
-    return 0  # the reader closed the pipe (acld-gym params | head -1)
+    # one BLAS thread, a quiet end if the reader closes the pipe (acld-gym params | head -1),
+    # one line for a failed write (a full disk)
+    return run_main(lambda: args.func(args), "acld-gym")
 
 
 if __name__ == "__main__":

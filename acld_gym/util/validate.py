@@ -1,11 +1,14 @@
 """Validation of user input shared by every layer: each check raises ``ValueError`` naming the
-argument and what was expected, before any state changes; and the command-line glue
-(argparse number types, quiet closed pipes, one BLAS thread)."""
+argument and what was expected, before any state changes; :class:`DataFileError` for a file
+the package reads that is damaged or malformed; and the command-line glue (argparse number
+types, quiet closed pipes, one BLAS thread, one line for a failed file operation)."""
 
 from __future__ import annotations
 
 import math
 import numbers
+import os
+import sys
 
 import numpy as np
 
@@ -14,8 +17,11 @@ __all__ = [
     "check_int",
     "check_choice",
     "check_seed",
+    "DataFileError",
+    "file_error",
     "arg_type",
     "closed_pipe_is_fine",
+    "os_error_line",
     "run_main",
 ]
 
@@ -71,6 +77,19 @@ def check_seed(value) -> int | None:
     return check_int("seed", value, 0, 2**63 - 1)
 
 
+class DataFileError(ValueError):
+    """A file the package reads (a results table, a config, a resume record) is damaged or
+    not of the expected form; the message names the file and the field (:func:`file_error`).
+    A ``ValueError``, so callers that catch bad input catch it too."""
+
+
+def file_error(path, field: str | None, message: str) -> DataFileError:
+    """The :class:`DataFileError` ``"<path>: <field>: <message>"`` (no field: the file as a
+    whole, ``"<path>: <message>"``)."""
+    where = f"{path}: {field}" if field else str(path)
+    return DataFileError(f"{where}: {message}")
+
+
 def arg_type(kind: type, low=None, high=None, *, low_open: bool = False):
     """An argparse ``type=`` that parses ``kind`` (int or float) and applies
     :func:`check_int` / :func:`check_real` with these bounds: one validation for every
@@ -109,11 +128,57 @@ class closed_pipe_is_fine:  # noqa: N801 (a context manager used like a function
         return False
 
 
-def run_main(main) -> int:
-    """``main()`` for a ``python -m`` entry point: one BLAS thread
-    (:mod:`acld_gym.util.blas`) and a quiet end when the reader closes the pipe."""
+def _os_error_file(exc: OSError):
+    """The file an ``OSError`` is about: its ``filename``, else (a write to an open file
+    fails without one: a full disk, ``ulimit -f``) the innermost ``path`` of the frames it
+    passed through (:mod:`acld_gym.util.atomic`'s writers name their target so)."""
+    if exc.filename is not None:
+        return exc.filename
+    found, tb = None, exc.__traceback__
+    while tb is not None:
+        path = tb.tb_frame.f_locals.get("path")
+        if isinstance(path, (str, os.PathLike)):
+            found = path
+        tb = tb.tb_next
+    return found
+
+
+def os_error_line(exc: OSError) -> str:
+    """One line for a failed file operation: the file and the system's reason."""
+    path = _os_error_file(exc)
+    reason = exc.strerror or str(exc) or type(exc).__name__
+    return f"{os.fspath(path)}: {reason}" if path is not None else reason
+
+
+def _prog(main) -> str:
+    """The command's name: ``python -m <module>`` of the running module, else the script."""
+    spec = getattr(sys.modules.get("__main__"), "__spec__", None)
+    if spec is not None and spec.name:
+        return f"python -m {spec.name.removesuffix('.__main__')}"
+    module = getattr(main, "__module__", None)
+    if module and module != "__main__":
+        return f"python -m {module}"
+    return os.path.basename(sys.argv[0]) or "acld-gym"
+
+
+def run_main(main, prog: str | None = None) -> int:
+    """``main()`` for an entry point (every ``python -m`` of the package and ``acld-gym``):
+    one BLAS thread (:mod:`acld_gym.util.blas`), a quiet end when the reader closes the pipe,
+    and no traceback for a failed file operation (a full disk, a vanished or unreadable
+    file) or a damaged input file (:class:`DataFileError`): one line on stderr,
+    ``<prog>: error: <file>: <reason>``, and exit status 1 (2 for a damaged input, as for
+    a bad argument)."""
     from acld_gym.util.blas import one_blas_thread
 
     with closed_pipe_is_fine(), one_blas_thread():
-        return main()
+        try:
+            return main()
+        except BrokenPipeError:
+            raise  # closed_pipe_is_fine's
+        except OSError as exc:
+            print(f"{prog or _prog(main)}: error: {os_error_line(exc)}", file=sys.stderr)
+            return 1
+        except DataFileError as exc:
+            print(f"{prog or _prog(main)}: error: {exc}", file=sys.stderr)
+            return 2
     return 0

@@ -10,6 +10,7 @@ import gymnasium as gym
 import numpy as np
 
 import acld_gym  # noqa: F401  (registers the env ids)
+from acld_gym.util.validate import check_choice, check_int, check_real
 from acld_gym.wrappers import whitening
 
 from ..config import TrainConfig
@@ -128,10 +129,16 @@ class RandomSearch:
     common_episodes: bool = True
 
     def __post_init__(self):
-        if not 1 <= self.top_directions <= self.n_directions:
-            raise ValueError("need 1 <= top_directions <= n_directions")
-        if self.objective not in ("log", "return"):
-            raise ValueError(f"objective must be 'log' or 'return', got {self.objective!r}")
+        check_int("model.n_directions", self.n_directions, 1, 10**6)
+        check_int("model.top_directions", self.top_directions, 1, self.n_directions)
+        check_real("model.step_size", self.step_size, 0.0, low_open=True)
+        check_real("model.noise", self.noise, 0.0, low_open=True)
+        check_real("model.init_std", self.init_std, 0.0)
+        check_real("model.anneal", self.anneal, 0.0, 1.0)
+        check_choice("model.objective", self.objective, ("log", "return"))
+        for name in ("relative", "whiten", "common_episodes"):
+            if not isinstance(getattr(self, name), bool):
+                raise ValueError(f"model.{name} must be true or false, got {getattr(self, name)!r}")
 
 
 class _CandidateEnvs:

@@ -1,0 +1,118 @@
+"""Checks of a training config's algorithm settings, beyond the fields of
+:class:`train.config.TrainConfig` themselves: :func:`check_model`, the ``model:`` mapping
+(called by the config's validation: every key a keyword of the SB3 algorithm, or a field of
+:class:`train.bench.search.RandomSearch` for ``vrs``, every number in range), and
+:func:`check_buildable`, the algorithm built once on its training env, which a command calls
+before it computes anything, so that a setting only the algorithm's own constructor reads (a
+policy's keyword argument, a schedule) fails in a second, not after the references."""
+
+from __future__ import annotations
+
+import contextlib
+import inspect
+import io
+import warnings
+from dataclasses import fields
+
+from acld_gym.util.validate import check_int, check_real
+
+__all__ = ["check_model", "check_buildable"]
+
+#: Smallest value of the SB3 integer arguments that may be below 1 (-1: "as many as").
+_INT_MIN = {
+    "seed": 0,
+    "verbose": 0,
+    "learning_starts": 0,
+    "sde_sample_freq": -1,
+    "gradient_steps": -1,
+}
+
+
+def check_model(cfg) -> None:
+    """``ValueError`` naming the key unless ``cfg.model`` (and, for the SB3 algorithms,
+    ``cfg.normalize``) holds only keys the algorithm takes, with numbers in range."""
+    if cfg.algo == "vrs":
+        _check_vrs(cfg.model)
+    else:
+        _check_sb3(cfg)
+
+
+def _check_vrs(model: dict) -> None:
+    """The ``model:`` of ``vrs``: fields of :class:`train.bench.search.RandomSearch`, whose
+    own checks then apply (imported lazily: it imports the env)."""
+    from .bench.search import RandomSearch
+
+    known = sorted(f.name for f in fields(RandomSearch))
+    unknown = sorted(str(k) for k in model if k not in known)
+    if unknown:
+        raise ValueError(f"model: unknown key(s) {unknown} for VRS; expected some of {known}")
+    RandomSearch(**model)
+
+
+def _check_sb3(cfg) -> None:
+    from stable_baselines3.common.vec_env import VecNormalize
+
+    from .config import algo_class
+
+    allowed = set(inspect.signature(VecNormalize).parameters) - {"venv", "gamma"}
+    bad = sorted(str(k) for k in set(cfg.normalize) - allowed)
+    if bad:
+        raise ValueError(f"normalize: unknown key(s) {bad}; expected some of {sorted(allowed)}")
+    try:
+        cls = algo_class(cfg.algo)
+    except ImportError:  # sb3-contrib not installed: checked when the run starts
+        return
+    params = inspect.signature(cls).parameters
+    unknown = sorted(str(k) for k in cfg.model if k not in params)
+    if unknown:
+        raise ValueError(
+            f"model: unknown key(s) {unknown} for {cfg.algo.upper()}; expected some of "
+            f"{sorted(k for k in params if k not in ('env', 'self'))}"
+        )
+    if not isinstance(cfg.model["policy"], str):
+        raise ValueError(f"model.policy must be a policy's name, got {cfg.model['policy']!r}")
+    for key, value in cfg.model.items():
+        default = params[key].default
+        if (
+            isinstance(default, bool)
+            or default is None
+            or key == "policy"
+            or isinstance(value, (dict, list, tuple))
+        ):  # a schedule, a train_freq
+            continue
+        if isinstance(default, (int, float)) and not isinstance(value, bool):
+            if isinstance(default, int) and key not in ("learning_rate", "clip_range"):
+                check_int(f"model.{key}", value, _INT_MIN.get(key, 1))
+            elif key in ("gamma", "gae_lambda"):  # a discount, a GAE weight: (0, 1]
+                check_real(f"model.{key}", value, 0.0, 1.0, low_open=True)
+            else:
+                check_real(f"model.{key}", value, 0.0)
+
+
+def check_buildable(cfg, env_id: str | None = None) -> None:
+    """Build ``cfg``'s algorithm once on its training env (SB3: the model on
+    :func:`train.vec.make_vec_env`, with the whitening's first-layer check; ``vrs``: its
+    settings) and drop it: ``ValueError`` naming the setting a constructor refuses. A
+    second or two, no env step; call it before computing anything."""
+    if cfg.algo == "vrs":
+        return  # RandomSearch is built by check_model; its env is the training env's options
+    import acld_gym
+
+    from .bench.sb3_train import first_linear, make_model
+    from .vec import make_vec_env
+
+    venv = make_vec_env(cfg, 0, env_id or acld_gym.ENV_ID)
+    try:  # quietly: the run prints SB3's warnings and messages when it builds the model
+        with warnings.catch_warnings(), contextlib.redirect_stdout(io.StringIO()):
+            warnings.simplefilter("ignore")
+            model = make_model(cfg, venv, 0)
+        if cfg.whiten_steps and not callable(getattr(model.policy, "fold_whitening", None)):
+            first_linear(model)
+    except ValueError:
+        raise
+    except Exception as exc:  # noqa: BLE001  (whatever a constructor raises: its message)
+        raise ValueError(
+            f"model: {cfg.algo.upper()} refuses the settings ({type(exc).__name__}: {exc})"
+        ) from None
+    finally:
+        venv.close()

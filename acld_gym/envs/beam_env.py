@@ -17,8 +17,9 @@ import numpy as np
 from gymnasium import spaces
 
 from acld_gym.envs.batch import COMPILED_STEP, BatchStep, StepResult
-from acld_gym.envs.checks import check_actions, check_render_mode, episode_spec
+from acld_gym.envs.checks import check_actions, check_render_mode
 from acld_gym.envs.config import ConfigAttributes, EnvConfig, make_config
+from acld_gym.envs.conflicts import made_spec
 from acld_gym.envs.episode import draw_episode, draw_noise, reset_options
 from acld_gym.envs.fingerprint import observation_fingerprint
 from acld_gym.envs.render import FigureOwner
@@ -117,9 +118,9 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
       in the new state or reward; ``info["terminated_by"]`` says which
       (``"deflection_limit"``, ``"non_finite_state"``; None otherwise).
     * ``truncated``: after ``episode_length`` seconds, ``round(episode_length / dt)``
-      steps (1 s = 1000 steps by default). ``gym.make`` adds no other limit, and
-      ``env.spec.max_episode_steps`` is that step count; ``max_episode_steps=n`` can
-      only shorten the episode (a ``TimeLimit`` of n steps).
+      steps (1 s = 1000 steps by default; ``gym.spec(id).max_episode_steps``, and
+      ``env.spec.max_episode_steps``); ``gym.make`` adds no limit of its own, and its
+      ``max_episode_steps=n`` only shortens the episode (a longer n is refused).
     * Limits: at most 1,000,000 steps per episode (``config.MAX_EPISODE_STEPS``) and
       4,000,000 tabulated steps over a vector env's sub-envs (``MAX_TABLE_STEPS``): the
       sensor noise of an episode is tabulated at reset (8 bytes per step; without the
@@ -232,7 +233,7 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
     compiled_step = COMPILED_STEP
 
     def __init__(self, config: EnvConfig | None = None, render_mode: str | None = None, **kwargs):
-        self.config = make_config(config, **kwargs)
+        self.config = make_config(config, **kwargs)  # validated, no silent conflict
         check_render_mode(render_mode, self.metadata["render_modes"])
         self.render_mode = render_mode
         self.nom = self.config.nominal()
@@ -273,21 +274,20 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
     )
     episode_plant = property(
         lambda self: self._batch.plants[0],
-        doc="The sampled plant of this episode (randomized with "
-        "``param_noise``), a "
+        doc="The sampled plant of this episode (randomized with ``param_noise``), a "
         ":class:`acld_gym.design.discrete.SampledSystem`.",
     )
 
     @property
     def spec(self):
-        """The registration spec (set by ``gym.make``), with ``max_episode_steps`` the
-        episode's own length, ``episode_length / dt`` steps, unless a shorter limit was
-        asked for."""
+        """The registration spec (set by ``gym.make``; its id must be ``config.env_id``),
+        with ``max_episode_steps`` the episode's own, ``episode_length / dt`` steps
+        (:func:`acld_gym.envs.conflicts.made_spec`)."""
         return getattr(self, "_spec", None)
 
     @spec.setter
     def spec(self, value) -> None:
-        self._spec = episode_spec(value, self.max_steps)
+        self._spec = made_spec(value, self.config, self.max_steps)
 
     @property
     def observation_fingerprint(self) -> dict:
@@ -305,7 +305,7 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
 
     # --- Gymnasium API --------------------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict | None = None):
-        case = reset_options(options, self.config.load_case)  # validated before seeding:
+        case = reset_options(options, self.config.load_case, self.dt)  # checked, then seeded:
         super().reset(seed=check_seed(seed))  # a rejected reset leaves the RNG as it was
         c = self.config
         load, plant = draw_episode(self.np_random, case, self.nom, c, self.harmonic_modes)

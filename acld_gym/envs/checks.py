@@ -1,14 +1,13 @@
 """Checks at the envs' edges: the actions (every check raises ``ValueError`` naming the
-argument and what was expected, before any state changes) and the registration spec's
-episode length. The configuration is validated once, in :mod:`acld_gym.envs.config`."""
+argument and what was expected, before any state changes) and the render mode. The
+configuration is validated once, in :mod:`acld_gym.envs.config` (the registration spec and
+settings that conflict: :mod:`acld_gym.envs.conflicts`)."""
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import numpy as np
 
-__all__ = ["check_actions", "check_render_mode", "episode_spec"]
+__all__ = ["check_actions", "check_render_mode"]
 
 
 def check_actions(action, n: int, v_max: float, vector: bool = False):
@@ -37,14 +36,3 @@ def check_render_mode(render_mode, render_modes) -> None:
         raise ValueError(
             f"render_mode must be one of {list(render_modes)} or None, got {render_mode!r}"
         )
-
-
-def episode_spec(spec, steps: int):
-    """``spec`` with ``max_episode_steps`` set to the env's ``steps`` when it has none (the
-    env truncates itself there) or a larger one (the env still ends at ``steps``)."""
-    if spec is None:
-        return None
-    limit = spec.max_episode_steps
-    if limit is None or limit > steps:
-        spec = replace(spec, max_episode_steps=int(steps))
-    return spec

@@ -22,6 +22,8 @@ import numpy as np
 
 from acld_gym.design.nominal import SENSOR_NOISE_M
 from acld_gym.design.observer import MODEL_STD
+from acld_gym.envs.conflicts import LOAD_SUBSTEPS, check_config_keywords, check_consistent
+from acld_gym.envs.presets import check_env_id
 from acld_gym.envs.scale import REWARD_SCALES
 from acld_gym.envs.step import OBS_HIST
 from acld_gym.physics.actuator import V_LIMIT
@@ -75,7 +77,8 @@ def _f(default, unit: str, doc: str, low=None, high=None) -> Any:
 class EnvConfig:
     """Everything that defines an ACLDBeam task (units and ranges in each field's
     ``metadata``; :func:`config_table`). Frozen and validated on construction: a bad value
-    raises ``ValueError`` naming the field and what was expected.
+    raises ``ValueError`` naming the field and what was expected, and so do fields that
+    contradict each other (:mod:`acld_gym.envs.conflicts`).
     :func:`dataclasses.replace` (or :meth:`replace`) validates again.
     """
 
@@ -166,7 +169,8 @@ class EnvConfig:
     temperature_range: tuple[float, float] | None = _f(
         None,
         "°C",
-        "draw the temperature per episode, uniform in (low, high); None: always temperature",
+        "draw the temperature per episode, uniform in (low, high), with temperature at 20; "
+        "None: always temperature",
     )
     reward_scale: str | None = _f(
         None,
@@ -184,7 +188,8 @@ class EnvConfig:
     env_id: str = _f(
         "ACLDBeam-v1",
         "-",
-        "the registered id this configuration belongs to (recorded in the observation fingerprint)",
+        "one of this package's ids, the one the configuration belongs to (and the env is "
+        "made as; recorded in the observation fingerprint)",
     )
 
     def __post_init__(self) -> None:
@@ -252,9 +257,9 @@ class EnvConfig:
                 "observe_reward_scale=True needs a reward_scale (e.g. "
                 "reward_scale='passive'), got reward_scale=None"
             )
-        if not isinstance(self.env_id, str) or not self.env_id:
-            raise ValueError(f"env_id must be a non-empty string, got {self.env_id!r}")
+        check_env_id(self.env_id, "env_id")
         check_episode_size(self.episode_length, self.dt)
+        check_consistent(self)  # no field that another one silently overrides
 
     # --- derived --------------------------------------------------------------------
     @property
@@ -277,9 +282,8 @@ class EnvConfig:
         nominal_design`, cached)."""
         from acld_gym.design.nominal import nominal_design
 
-        return nominal_design(
-            self.dt, 10, max(self.sensor_noise, 1e-9), mesh=self.mesh, model_std=self.model_std
-        )
+        std = max(self.sensor_noise, 1e-9)
+        return nominal_design(self.dt, LOAD_SUBSTEPS, std, mesh=self.mesh, model_std=self.model_std)
 
     def harmonic_targets(self, nom) -> tuple[float, float]:
         """The random loads' harmonic targets [rad/s]: :attr:`harmonic_modes`, or the first
@@ -298,7 +302,9 @@ _FIELDS = tuple(f.name for f in dataclasses.fields(EnvConfig))
 
 def make_config(config: EnvConfig | None = None, **kwargs) -> EnvConfig:
     """``config`` (default: :class:`EnvConfig`'s defaults, ``ACLDBeam-v1``) with the fields
-    in ``kwargs`` replaced; ``TypeError`` on a keyword that is no field."""
+    in ``kwargs`` replaced; ``TypeError`` on a keyword that is no field, ``ValueError`` if
+    ``kwargs`` are a registered id's settings that differ from the config's
+    (:func:`acld_gym.envs.conflicts.check_config_keywords`)."""
     if config is not None and not isinstance(config, EnvConfig):
         raise TypeError(f"config must be an EnvConfig or None, got {type(config).__name__}")
     unknown = sorted(set(kwargs) - set(_FIELDS))
@@ -307,6 +313,7 @@ def make_config(config: EnvConfig | None = None, **kwargs) -> EnvConfig:
             f"unexpected keyword argument(s) {unknown}; the env takes the fields of "
             f"EnvConfig: {', '.join(_FIELDS)}"
         )
+    check_config_keywords(config, kwargs)  # gym.make(id, config=...): the id's settings
     if config is None:
         return EnvConfig(**kwargs)
     return dataclasses.replace(config, **kwargs) if kwargs else config

@@ -9,8 +9,9 @@ import numpy as np
 
 from acld_gym.design.discrete import SampledSystem, discretize
 from acld_gym.design.nominal import NominalDesign
+from acld_gym.envs.conflicts import check_case
 from acld_gym.physics.actuator import with_amplifier
-from acld_gym.physics.loads import TipLoad, case_load, check_load_case, random_load
+from acld_gym.physics.loads import TipLoad, case_load, random_load
 from acld_gym.physics.temperature import shifted_parameters
 from acld_gym.physics.uncertainty import randomized_parameters
 
@@ -30,10 +31,12 @@ __all__ = [
 RESET_OPTIONS = ("load_case", "load")
 
 
-def reset_options(options, default_case):
+def reset_options(options, default_case, dt: float):
     """The load case of ``reset(options=...)``: ``options["load_case"]`` (a named case or a
     :class:`TipLoad`), ``options["load"]`` (a :class:`TipLoad`) or ``default_case``;
-    ``ValueError`` on anything else (before the env changes)."""
+    ``ValueError`` on anything else (before the env changes), or on a load the env's
+    integration at control period ``dt`` [s] cannot resolve
+    (:func:`acld_gym.envs.conflicts.check_case`)."""
     if options is not None and not isinstance(options, dict):
         raise ValueError(f"options must be a dict or None, got {options!r}")
     options = dict(options or {})
@@ -47,8 +50,8 @@ def reset_options(options, default_case):
     if "load" in options:
         if not isinstance(options["load"], TipLoad):
             raise ValueError(f"options['load'] must be a TipLoad, got {options['load']!r}")
-        return options["load"]
-    return check_load_case(options.get("load_case", default_case))
+        return check_case(options["load"], dt, "options['load']")
+    return check_case(options.get("load_case", default_case), dt, "options['load_case']")
 
 
 def draw_episode(

@@ -40,6 +40,7 @@ __all__ = [
     "VECTOR_ENTRY_POINT",
     "preset",
     "check_env_id",
+    "episode_steps",
     "register_presets",
 ]
 
@@ -89,18 +90,32 @@ def preset(env_id: str, **changes):
     return make_config(**{**PRESETS[env_id], **changes})
 
 
+def episode_steps(env_id: str) -> int:
+    """The step count of an id's episodes, ``round(episode_length / dt)`` of its settings
+    (EnvConfig's defaults where it sets none, mirrored here to keep this module light:
+    tests/envs/test_conflicts.py checks them against :func:`preset`)."""
+    fields = PRESETS[check_env_id(env_id)]
+    return int(round(fields.get("episode_length", 1.0) / fields.get("dt", 1e-3)))
+
+
 def register_presets() -> None:
-    """Register every id of :data:`PRESETS` with gymnasium (once). No ``max_episode_steps``:
-    the env truncates itself after ``episode_length / dt`` steps (its spec reports that
-    count), so ``gym.make``, ``make_vec`` and the SB3 adapter all follow ``episode_length``
-    and ``dt``; ``max_episode_steps=`` can still shorten an episode."""
-    from gymnasium.envs.registration import register, registry
+    """Register every id of :data:`PRESETS` with gymnasium (once), with its episode's step
+    count as ``gym.spec(id).max_episode_steps`` for the tools that read the registry. The
+    env truncates itself after ``episode_length / dt`` steps, so gymnasium's ``make`` and
+    ``make_vec`` add no ``TimeLimit`` of that count
+    (:class:`acld_gym.envs.registration.RegisteredSpec`): ``gym.make``, ``make_vec`` and
+    the SB3 adapter all follow ``episode_length`` and ``dt``; ``max_episode_steps=`` can
+    still shorten an episode (a longer one is refused)."""
+    from gymnasium.envs.registration import registry
+
+    from acld_gym.envs.registration import RegisteredSpec
 
     for env_id, kwargs in PRESETS.items():
         if env_id not in registry:
-            register(
+            registry[env_id] = RegisteredSpec(
                 id=env_id,
                 entry_point=ENTRY_POINT,
                 vector_entry_point=VECTOR_ENTRY_POINT,
                 kwargs=dict(kwargs),
+                episode_steps=episode_steps(env_id),
             )

@@ -30,7 +30,6 @@ from stable_baselines3.common.vec_env import VecEnv
 from acld_gym.envs.config import EnvConfig
 from acld_gym.envs.step import INFO_KEYS
 from acld_gym.envs.vector_env import ACLDBeamVectorEnv
-from acld_gym.physics.loads import check_load_case
 from acld_gym.util.validate import check_int, check_seed
 
 #: Attributes the env derives its tables and design from at construction.
@@ -172,13 +171,13 @@ class SB3VecEnv(VecEnv):
     def set_attr(self, attr_name: str, value: Any, indices=None) -> None:
         """Set an attribute of the (shared) vector env, validated now: ``load_case`` (takes
         effect at the next reset) is the one meant to change; anything else that the env
-        validates at construction is refused rather than left to fail later."""
+        validates at construction is refused rather than left to fail later. The vector env
+        checks ``load_case`` as its constructor does (:func:`acld_gym.envs.conflicts.
+        check_case`)."""
         idx = self._indices(indices)
         if idx != list(range(self.num_envs)):
             raise ValueError("SB3VecEnv: attributes are shared; set them for all sub-envs")
-        if attr_name == "load_case":
-            check_load_case(value)
-        elif attr_name in _CONFIGURED:
+        if attr_name in _CONFIGURED:
             raise ValueError(
                 f"SB3VecEnv: {attr_name} is fixed at construction; build a new env to change it"
             )

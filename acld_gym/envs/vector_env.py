@@ -32,18 +32,19 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from acld_gym.envs.batch import COMPILED_STEP, WHY, BatchStep
-from acld_gym.envs.checks import check_render_mode, episode_spec
+from acld_gym.envs.checks import check_render_mode
 from acld_gym.envs.config import (
     ConfigAttributes,
     EnvConfig,
     check_episode_size,
     make_config,
 )
+from acld_gym.envs.conflicts import check_case, check_limit, made_spec
 from acld_gym.envs.episode import draw_episode, draw_noise, reset_options
 from acld_gym.envs.render import FigureOwner
 from acld_gym.envs.step import INFO_KEYS
 from acld_gym.physics.actuator import V_LIMIT
-from acld_gym.physics.loads import case_load, check_load_case, thesis_load
+from acld_gym.physics.loads import case_load, thesis_load
 from acld_gym.util.validate import check_int, check_seed
 
 __all__ = ["ACLDBeamVectorEnv", "INFO_KEYS"]
@@ -53,8 +54,8 @@ class ACLDBeamVectorEnv(ConfigAttributes, FigureOwner, VectorEnv):
     """N independent ACLD beams (see :class:`acld_gym.envs.beam_env.ACLDBeamEnv` for the
     physics, spaces, reward and the configuration: ``config=`` or its fields as keywords).
 
-    ``max_episode_steps`` truncates episodes (as ``TimeLimit`` does for the single
-    env); the episode also ends after ``episode_length / dt`` steps.
+    ``max_episode_steps`` truncates episodes earlier than their ``episode_length / dt``
+    steps (as ``TimeLimit`` does for the single env; a later limit is refused).
     ``info`` holds the single env's keys (:data:`acld_gym.envs.step.INFO_KEYS`) as arrays,
     with their ``_key`` masks. ``render()`` draws sub-env 0 (``render_mode="rgb_array"``).
     """
@@ -83,7 +84,7 @@ class ACLDBeamVectorEnv(ConfigAttributes, FigureOwner, VectorEnv):
         check_render_mode(render_mode, self.metadata["render_modes"])
         steps = c.max_steps
         if max_episode_steps is not None:
-            steps = min(steps, check_int("max_episode_steps", max_episode_steps, 1))
+            steps = check_limit(max_episode_steps, steps)
         self.render_mode = render_mode
         self.num_envs = num_envs
         self.max_episode_steps = max_episode_steps
@@ -118,7 +119,7 @@ class ACLDBeamVectorEnv(ConfigAttributes, FigureOwner, VectorEnv):
 
     @load_case.setter
     def load_case(self, value) -> None:
-        self._default_case = check_load_case(value)
+        self._default_case = check_case(value, self.dt)
 
     @property
     def batch(self) -> BatchStep:
@@ -138,12 +139,12 @@ class ACLDBeamVectorEnv(ConfigAttributes, FigureOwner, VectorEnv):
     @property
     def spec(self):
         """The registration spec with ``max_episode_steps`` the episode's step count
-        (see :func:`acld_gym.envs.checks.episode_spec`)."""
+        (see :func:`acld_gym.envs.conflicts.made_spec`)."""
         return getattr(self, "_spec", None)
 
     @spec.setter
     def spec(self, value) -> None:
-        self._spec = episode_spec(value, self.horizon)
+        self._spec = made_spec(value, self.config, self.horizon)
 
     @property
     def loads(self) -> list:
@@ -193,7 +194,7 @@ class ACLDBeamVectorEnv(ConfigAttributes, FigureOwner, VectorEnv):
     # --- Gymnasium API --------------------------------------------------------------------
     def reset(self, *, seed: int | list[int | None] | None = None, options: dict | None = None):
         N = self.num_envs
-        case = reset_options(options, self._default_case)  # validated before any seeding
+        case = reset_options(options, self._default_case, self.dt)  # checked before seeding
         if seed is None or isinstance(seed, (list, tuple, np.ndarray)):
             seeds = None if seed is None else [check_seed(s) for s in seed]
             if seeds is not None and len(seeds) != N:

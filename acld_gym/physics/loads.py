@@ -27,7 +27,7 @@ band-limited random force), :func:`sine_sweep`, :func:`half_sine_shock` and
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import astuple, dataclass, replace
 
 import numpy as np
 
@@ -99,15 +99,7 @@ class Harmonic:
     phase: float = 0.0
 
     def __post_init__(self):
-        _finite(
-            "Harmonic",
-            "amplitude, frequency, start, duration, phase",
-            self.amplitude,
-            self.frequency,
-            self.start,
-            self.duration,
-            self.phase,
-        )
+        _finite("Harmonic", "amplitude, frequency, start, duration, phase", *astuple(self))
         if not self.duration > 0:
             raise ValueError(f"Harmonic.duration must be positive [s], got {self.duration!r}")
         if not self.frequency > 0:
@@ -188,7 +180,7 @@ class TipLoad:
 
     def __post_init__(self):
         if not isinstance(self.components, tuple) or not all(
-            isinstance(c, (Pulse, Harmonic, Samples)) for c in self.components
+            type(c) in (Pulse, Harmonic, Samples) for c in self.components
         ):
             raise ValueError(
                 "TipLoad.components must be a tuple of Pulse, Harmonic and Samples, "
@@ -202,12 +194,8 @@ class TipLoad:
         for c in self.components:
             if isinstance(c, Samples):
                 out.append(Samples(c.start, c.step, factor * c.values))
-            elif isinstance(c, Pulse):
-                out.append(Pulse(c.start, c.duration, factor * c.amplitude))
-            else:
-                out.append(
-                    Harmonic(factor * c.amplitude, c.frequency, c.start, c.duration, c.phase)
-                )
+            else:  # a pulse or a harmonic
+                out.append(replace(c, amplitude=factor * c.amplitude))
         return TipLoad(tuple(out))
 
     def __call__(self, t) -> np.ndarray:
@@ -255,6 +243,8 @@ class TipLoad:
         return tuple(sorted({c.frequency for c in self.components if isinstance(c, Harmonic)}))
 
 
+#: What evaluates a load (the compiled step and the simulators read ``components`` alone).
+_EVALUATION = ("__call__", "piece", "breakpoints", "scaled", "harmonic_frequencies", "components")
 #: The thesis's load cases by number.
 THESIS_CASES = (1, 2, 3)
 #: The name of the per-episode random load (:func:`random_load`).
@@ -276,8 +266,17 @@ def thesis_load(case: int) -> TipLoad:
 
 def check_load_case(value, name: str = "load_case"):
     """``value`` if it is a named case (:data:`LOAD_CASES`; a Python or numpy integer 1-3 is
-    returned as ``int``) or a :class:`TipLoad`; else ``ValueError`` naming ``name``."""
+    returned as ``int``) or a :class:`TipLoad` (a subclass that overrides none of
+    :data:`_EVALUATION`: every consumer evaluates a load from its components); else
+    ``ValueError`` naming ``name``."""
     if isinstance(value, TipLoad):
+        over = sorted(m for m in _EVALUATION if getattr(type(value), m) is not getattr(TipLoad, m))
+        if over:
+            raise ValueError(
+                f"{name}: a TipLoad subclass may not override {', '.join(over)} (a load is "
+                f"evaluated from its components alone), got {type(value).__name__}"
+            )
+        TipLoad.__post_init__(value)  # its components, even if its __post_init__ skipped them
         return value
     if (
         isinstance(value, (int, np.integer))

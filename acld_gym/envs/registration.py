@@ -1,0 +1,69 @@
+"""The ids in gymnasium's registry, and what ``gym.make`` was asked.
+
+Every id registers the step count of its episodes, ``gym.spec(id).max_episode_steps``
+(1000: ``episode_length / dt`` of the id's configuration), for the tools that read the
+registry. The env truncates itself after ``episode_length / dt`` steps, whatever its
+keywords make that (``gym.make(id, episode_length=1.5)``: 1500 steps), so gymnasium's own
+``make`` and ``make_vec`` must not add a ``TimeLimit`` of the registered count: it would
+cut a longer episode at 1000 steps and report 1000 for a shorter one. A
+:class:`RegisteredSpec` therefore gives those two functions no limit (exactly as before
+the count was registered: the same wrappers, the same episodes) and every other reader the
+count. ``gym.make(id, max_episode_steps=n)`` still adds gymnasium's ``TimeLimit`` of n
+steps; :func:`make_limit` reads that n, so that the env can refuse an n its episode
+never reaches (:func:`acld_gym.envs.conflicts.made_spec`).
+
+Both look at the calling frame, the one way to tell gymnasium's ``make`` from other
+readers of the same registry entry; they are tested against the installed gymnasium
+(tests/envs/test_conflicts.py), so a gymnasium that renames ``make`` fails a test instead
+of silently changing the episodes.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import sys
+from types import FrameType
+
+from gymnasium.envs import registration as _gym_registration
+from gymnasium.envs.registration import EnvSpec
+
+__all__ = ["RegisteredSpec", "make_limit", "plain_spec"]
+
+#: The code of gymnasium's ``make`` and ``make_vec`` (the readers that apply a limit).
+_MAKERS = (_gym_registration.make.__code__, _gym_registration.make_vec.__code__)
+
+
+class RegisteredSpec(EnvSpec):
+    """An :class:`gymnasium.envs.registration.EnvSpec` whose ``max_episode_steps`` is
+    ``episode_steps`` for every reader except gymnasium's ``make`` and ``make_vec``, which
+    see the spec's own limit (None for a registered id: the env truncates itself)."""
+
+    def __init__(self, *, episode_steps: int | None = None, **fields):
+        super().__init__(**fields)
+        self.episode_steps = episode_steps
+
+    @property
+    def max_episode_steps(self) -> int | None:
+        limit = self.__dict__.get("_limit")
+        if sys._getframe(1).f_code in _MAKERS or self.__dict__.get("episode_steps") is None:
+            return limit
+        return self.episode_steps
+
+    @max_episode_steps.setter
+    def max_episode_steps(self, value: int | None) -> None:
+        self.__dict__["_limit"] = value
+
+
+def make_limit(frame: FrameType | None) -> int | None:
+    """The ``max_episode_steps`` argument of gymnasium's ``make`` if ``frame`` is a call of
+    it (None otherwise, or when it was not given)."""
+    if frame is None or frame.f_code is not _gym_registration.make.__code__:
+        return None
+    return frame.f_locals.get("max_episode_steps")
+
+
+def plain_spec(spec: EnvSpec, steps: int) -> EnvSpec:
+    """A plain :class:`EnvSpec` with the fields of ``spec`` and ``max_episode_steps=steps``
+    (what an env made from it reports)."""
+    values = {f.name: getattr(spec, f.name) for f in dataclasses.fields(spec) if f.init}
+    return EnvSpec(**{**values, "max_episode_steps": int(steps)})

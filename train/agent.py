@@ -134,7 +134,10 @@ class ActorProgram:
         """Every array the operations use is finite and of the shape its place in the
         program fixes: ``mean``, ``var`` (d,), ``W{i}`` (width in, width out), ``b{i}``
         (width out,), the output one action; d is ``n_obs`` (or the first array's width).
-        :class:`AgentFileError` naming the array otherwise."""
+        With ``n_obs`` given, the actor must also give a finite action for moderate
+        observations (zero, +/-1 and +/-1000 in every entry): weights that overflow are
+        refused here, not met as a NaN voltage mid-episode. :class:`AgentFileError` naming
+        the array otherwise."""
         for key, value in self.arrays.items():
             if not np.all(np.isfinite(value)):
                 raise AgentFileError(f"{POLICY_FILE}: array {key!r} has non-finite values")
@@ -146,6 +149,11 @@ class ActorProgram:
                 self._expect("var", (width,), width)
                 if np.any(self.arrays["var"] < 0):
                     raise AgentFileError(f"{POLICY_FILE}: array 'var' has negative values")
+                if np.any(self.arrays["var"] + op["eps"] <= 0):
+                    raise AgentFileError(
+                        f"{POLICY_FILE}: array 'var' has zeros and the normalize operation "
+                        "no eps (a division by zero)"
+                    )
             elif kind == "direction" and width is not None:
                 width += 1
             elif kind == "linear":
@@ -156,6 +164,15 @@ class ActorProgram:
             raise AgentFileError(
                 f"{POLICY_FILE}: the actor's last layer gives {width} values, expected one action"
             )
+        if n_obs is not None:
+            probe = np.array([[0.0], [1.0], [-1.0], [1e3], [-1e3]]) * np.ones((1, n_obs))
+            with np.errstate(all="ignore"):
+                out = self._raw(probe)
+            if not np.all(np.isfinite(out)):
+                raise AgentFileError(
+                    f"{POLICY_FILE}: the actor's arrays overflow: a non-finite action for a "
+                    "moderate observation"
+                )
 
     def _expect(self, key: str, shape: tuple, width: int | None, ndim: int = 1) -> tuple:
         """The shape of array ``key``, checked against ``shape`` (None: any size)."""
@@ -172,8 +189,18 @@ class ActorProgram:
         return got
 
     def __call__(self, obs: np.ndarray) -> np.ndarray:
-        """Actions in [-1, 1], shape (n, 1), for raw observations (n, d)."""
-        z = np.asarray(obs, dtype=np.float64)
+        """Actions in [-1, 1], shape (n, 1), for raw observations (n, d); ``ValueError`` if
+        a finite observation gives a non-finite action (weights that overflow on it)."""
+        obs = np.asarray(obs, dtype=np.float64)
+        with np.errstate(all="ignore"):
+            a = self._raw(obs)
+        if not np.all(np.isfinite(a)) and np.all(np.isfinite(obs)):
+            raise ValueError("the actor's arrays overflow on this observation: a non-finite action")
+        return a
+
+    def _raw(self, obs: np.ndarray) -> np.ndarray:
+        """The program on ``obs`` (n, d), actions clipped to [-1, 1], NaN left as NaN."""
+        z = obs
         a = self.arrays
         for op in self.ops:
             kind = op["op"]

@@ -7,6 +7,8 @@ case 3 = 0.1 sin(179 t) N for 0.193 s (5.5 cycles).
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
@@ -241,3 +243,89 @@ def test_recorded_load_is_linear_between_its_samples():
     for bad in (np.ones((2, 2)), np.array(["a", "b"])):
         with pytest.raises(ValueError, match="values"):
             recorded_load(bad, 1e-3)
+
+
+# --- issue 65: a TipLoad is evaluated from its components alone -----------------------------
+class _Silent(TipLoad):
+    def __call__(self, t):
+        return np.zeros_like(np.asarray(t, dtype=float))
+
+
+class _OwnPieces(TipLoad):
+    def piece(self, t0, t1):
+        raise AssertionError("never called")
+
+
+class _OwnComponents(TipLoad):
+    @property
+    def components(self):
+        return ()
+
+
+class _Labelled(TipLoad):
+    """A subclass that only adds a method: the same load."""
+
+    def label(self) -> str:
+        return "labelled"
+
+
+class _Unchecked(TipLoad):
+    def __post_init__(self):  # skips TipLoad's validation
+        pass
+
+
+@pytest.mark.parametrize("cls, method", [(_Silent, "__call__"), (_OwnPieces, "piece")])
+def test_a_subclass_that_overrides_evaluation_is_refused_naming_it(cls, method):
+    from acld_gym.physics.loads import case_load, check_load_case
+
+    load = cls((Pulse(0.0, 1e-3, 1.0),))
+    for name in ("load_case", "options['load']"):
+        with pytest.raises(ValueError, match=rf"^{re.escape(name)}: .*override {method}\b"):
+            check_load_case(load, name)
+    with pytest.raises(ValueError, match="TipLoad subclass"):
+        case_load(load)
+
+
+def test_a_subclass_with_its_own_components_property_is_refused():
+    from acld_gym.physics.loads import check_load_case
+
+    load = object.__new__(_OwnComponents)  # its property shadows the field: no __init__
+    with pytest.raises(ValueError, match="override components"):
+        check_load_case(load)
+
+
+def test_a_subclass_that_adds_methods_only_is_the_same_load():
+    from acld_gym.physics.loads import check_load_case
+
+    comps = (Pulse(0.0, 1e-3, 1.0), Harmonic(0.1, 179.0, 0.0, 0.193))
+    load = _Labelled(comps)
+    assert check_load_case(load) is load
+    t = np.linspace(0.0, 0.3, 301)
+    assert_array_equal(load(t), TipLoad(comps)(t))
+
+
+def test_a_subclass_that_skips_validation_is_validated_at_use():
+    from acld_gym.physics.loads import check_load_case
+
+    bad = _Unchecked(("not a component",))
+    with pytest.raises(ValueError, match="TipLoad.components"):
+        check_load_case(bad)
+
+
+def test_components_must_be_of_the_component_types_themselves():
+    class Loud(Pulse):
+        pass
+
+    with pytest.raises(ValueError, match="TipLoad.components"):
+        TipLoad((Loud(0.0, 1e-3, 1.0),))
+
+
+def test_scaled_keeps_every_number_of_each_component():
+    load = TipLoad((Pulse(0.01, 2e-3, 0.7), Harmonic(0.3, 400.0, 0.02, 0.1, 0.4)))
+    half = load.scaled(-0.5)
+    assert half.components == (
+        Pulse(0.01, 2e-3, -0.35),
+        Harmonic(-0.15, 400.0, 0.02, 0.1, 0.4),
+    )
+    with pytest.raises(ValueError, match=r"Harmonic\.phase"):
+        Harmonic(1.0, 2.0, 0.0, 1.0, float("nan"))

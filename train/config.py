@@ -343,17 +343,14 @@ class TrainConfig:
                     f"restart_above needs restarts >= 2 (runs to choose from), "
                     f"got restarts {self.restarts}"
                 )
-        if (
-            not isinstance(self.loads, dict)
-            or not self.loads
-            or any(
-                isinstance(w, bool) or not (isinstance(w, (int, float)) and w > 0)
-                for w in self.loads.values()
-            )
-        ):
+        if not isinstance(self.loads, dict) or not self.loads:
             raise ValueError(f"loads must map cases to positive weights, got {self.loads!r}")
-        for case in self.loads:
+        for case, w in self.loads.items():
             parse_load_case(case)
+            if self.algo == "vrs":  # episodes per candidate and iteration
+                check_int(f"loads.{case}", w, 1, 10**4)
+            else:  # the sub-envs' shares
+                check_real(f"loads.{case}", w, 0.0, 1e6, low_open=True)
         if self.features not in (None, "direction"):
             raise ValueError(f"features must be 'direction' or null, got {self.features!r}")
         sb3 = self.algo != "vrs"

@@ -108,8 +108,8 @@ def check_buildable(cfg, env_id: str | None = None) -> None:
             model = make_model(cfg, venv, 0)
         if cfg.whiten_steps and not callable(getattr(model.policy, "fold_whitening", None)):
             first_linear(model)
-    except ValueError:
-        raise
+    except ValueError as exc:  # the policy's or SB3's own check: in the model: mapping
+        raise ValueError(str(exc) if str(exc).startswith("model") else f"model: {exc}") from None
     except Exception as exc:  # noqa: BLE001  (whatever a constructor raises: its message)
         raise ValueError(
             f"model: {cfg.algo.upper()} refuses the settings ({type(exc).__name__}: {exc})"

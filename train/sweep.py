@@ -15,7 +15,9 @@ import argparse
 import sys
 from pathlib import Path
 
-from .cli import RECIPES
+from acld_gym.util.validate import arg_type, run_main
+
+from .cli import MAX_SEED, RECIPES
 
 __all__ = ["trial", "score", "main"]
 
@@ -73,32 +75,60 @@ def build_parser() -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("algo", choices=RECIPES)
-    p.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
+    p.add_argument("--seeds", type=arg_type(int, 0, MAX_SEED), nargs="+", default=[0, 1, 2])
     p.add_argument(
         "--learning-rates",
-        type=float,
+        type=arg_type(float, 0.0, 1.0, low_open=True),
         nargs="+",
         default=None,
-        help="grid of learning rates (default: the config's)",
+        help="grid of learning rates in (0, 1] (default: the config's)",
     )
-    p.add_argument("--timesteps", type=int, default=200_000, help="env steps per trial")
-    p.add_argument("--num-cpus", type=int, default=2, help="CPUs for a local Ray (default 2)")
+    p.add_argument(
+        "--timesteps", type=arg_type(int, 1, 10**12), default=200_000, help="env steps per trial"
+    )
+    p.add_argument(
+        "--num-cpus",
+        type=arg_type(int, 1, 1024),
+        default=2,
+        help="CPUs for a local Ray (default 2)",
+    )
     p.add_argument("--address", default=None, help="Ray cluster address (default: local)")
     p.add_argument("--out", default="runs/sweep", help="Tune's storage directory")
     return p
 
 
+def check_args(args: argparse.Namespace) -> None:
+    """``ValueError`` naming the argument unless the sweep can run: distinct seeds and
+    learning rates, the recipe with every override of the grid valid and buildable
+    (:func:`train.config_checks.check_buildable`), ``--out`` a usable directory. Nothing is
+    computed, Ray not started."""
+    from acld_gym.util.atomic import check_directory
+
+    from .config import TrainConfig, read_config
+    from .config_checks import check_buildable
+
+    for flag, values in (("--seeds", args.seeds), ("--learning-rates", args.learning_rates)):
+        if values and len(set(values)) != len(values):
+            raise ValueError(f"{flag} must be distinct, got {values}")
+    _, data = read_config(args.algo)
+    data = dict(data, timesteps=args.timesteps)
+    for lr in args.learning_rates or [None]:
+        model = data["model"] if lr is None else {**data["model"], "learning_rate": lr}
+        try:
+            cfg = TrainConfig.from_dict({**data, "model": model})
+        except ValueError as exc:
+            raise ValueError(f"--timesteps / --learning-rates: {exc}") from None
+    check_buildable(cfg)
+    check_directory(args.out, "--out")
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    if args.timesteps < 1:
-        parser.error(f"--timesteps must be positive, got {args.timesteps}")
-    if args.num_cpus < 1:
-        parser.error(f"--num-cpus must be positive, got {args.num_cpus}")
-    if any(s < 0 for s in args.seeds):
-        parser.error(f"--seeds must be >= 0, got {args.seeds}")
-    if args.learning_rates and any(not lr > 0 for lr in args.learning_rates):
-        parser.error(f"--learning-rates must be positive, got {args.learning_rates}")
+    try:
+        check_args(args)
+    except (OSError, ValueError) as exc:
+        parser.error(str(exc))
     try:
         from ray import tune
 
@@ -128,4 +158,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run_main(main))

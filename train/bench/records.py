@@ -261,7 +261,8 @@ def check_references(data, path: str | Path, bound: bool = True) -> dict:
     r = _Reader(path)
     data = r.mapping(data, "")
     r.key(data, "env_id", "", r.text)
-    r.key(data, "episodes", "", r.mapping)
+    seeds = lambda v, f: [r.integer(x, f"{f}[{i}]") for i, x in enumerate(r.items(v, f))]  # noqa: E731
+    r.key(data, "episodes", "", lambda v, f: r.cases(v, f, seeds))
     for name in REFERENCE_NAMES + (("bound",) if bound else ()):
         r.key(data, name, "", lambda v, f: r.cases(v, f, r.real))
     for c in CASES:

@@ -7,9 +7,11 @@ from pathlib import Path
 
 import numpy as np
 
-from acld_gym.util.atomic import save_figure
+from acld_gym.util.atomic import check_writable, save_figure, write_texts
+from acld_gym.util.validate import os_error_line, run_main
 
 from .evaluate import CASES, OBJECTIVE_LOADS
+from .records import DataFileError, read_results
 from .trials import REFERENCES
 
 __all__ = [
@@ -479,9 +481,6 @@ def main(argv: list[str] | None = None) -> int:
     headline; atomically, every page checked before any is written); ``--plot`` also draws
     its learning curves (:func:`plot_curves`)."""
     import argparse
-    import json
-
-    from acld_gym.util.atomic import check_writable, write_text
 
     p = argparse.ArgumentParser(prog="python -m train.bench.report", description=main.__doc__)
     p.add_argument("results", type=Path, help="a results.json of python -m train.benchmark")
@@ -501,11 +500,11 @@ def main(argv: list[str] | None = None) -> int:
         help="also write the learning curves to this image",
     )
     args = p.parse_args(argv)
-    try:
-        summary = json.loads(args.results.read_text())
-        blocks = render_blocks(summary)
-    except (OSError, ValueError, KeyError, TypeError) as exc:
-        p.error(f"results: {args.results} is not a benchmark results file ({exc})")
+    try:  # every field the tables and the figure read, checked (DataFileError names it)
+        summary = read_results(args.results)
+    except (OSError, DataFileError) as exc:
+        p.error(os_error_line(exc) if isinstance(exc, OSError) else f"not a results file: {exc}")
+    blocks = render_blocks(summary)
     if args.plot is not None:
         try:
             check_writable(args.plot, "--plot")
@@ -523,8 +522,8 @@ def main(argv: list[str] | None = None) -> int:
             texts[page] = write_blocks(page.read_text(), blocks, str(args.results), str(page))
         except (OSError, ValueError) as exc:
             p.error(str(exc))
-    for page, text in texts.items():
-        write_text(page, text)
+    write_texts(texts)  # every page or none (a full disk fails before any is replaced)
+    for page in texts:
         print(f"wrote the tables of {args.results} into {page}")
     return 0
 
@@ -532,4 +531,4 @@ def main(argv: list[str] | None = None) -> int:
 if __name__ == "__main__":
     import sys
 
-    sys.exit(main())
+    sys.exit(run_main(main))

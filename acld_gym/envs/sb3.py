@@ -22,6 +22,7 @@ the policy output yourself if you want [-1, 1] actions.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import fields
 from typing import Any
 
 import numpy as np
@@ -32,19 +33,18 @@ from acld_gym.envs.step import INFO_KEYS
 from acld_gym.envs.vector_env import ACLDBeamVectorEnv
 from acld_gym.util.validate import check_int, check_seed
 
-#: Attributes the env derives its tables and design from at construction.
-_CONFIGURED = (
+#: Attributes the env derives its tables and design from at construction: every field of
+#: the configuration but ``load_case`` (settable: the next resets' case), and what follows.
+_CONFIGURED = tuple(f.name for f in fields(EnvConfig) if f.name != "load_case") + (
     "config",
-    "mesh",
-    "dt",
-    "episode_length",
     "observer_kind",
-    "obs_mode",
-    "sensor_noise",
-    "param_noise",
     "num_envs",
     "nom",
     "horizon",
+    "max_episode_steps",
+    "harmonic_modes",
+    "v_max",
+    "obs_hist",
 )
 
 __all__ = ["SB3VecEnv"]

@@ -8,6 +8,7 @@ the SB3 adapter alike -- and what is accepted is honoured exactly."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 
@@ -323,3 +324,18 @@ def test_a_tip_load_subclass_that_overrides_evaluation_is_refused_everywhere():
     env = gym.make("ACLDBeam-v1")
     with pytest.raises(ValueError, match=re.escape("options['load']: a TipLoad subclass")):
         env.reset(options={"load": load})
+
+
+def test_sb3_set_attr_refuses_every_setting_fixed_at_construction():
+    sb3 = SB3VecEnv(num_envs=2)
+    before = sb3.venv.config
+    for name in [f.name for f in dataclasses.fields(EnvConfig) if f.name != "load_case"] + [
+        "max_episode_steps",
+        "harmonic_modes",
+        "horizon",
+    ]:
+        with pytest.raises(ValueError, match=rf"^SB3VecEnv: {name} is fixed at construction"):
+            sb3.set_attr(name, 5000)
+    assert sb3.venv.config is before and sb3.venv.max_episode_steps is None
+    sb3.set_attr("load_case", 2)  # the one setting meant to change
+    assert sb3.venv.load_case == 2

@@ -1,18 +1,24 @@
-"""Read a policy in control terms and score it between LQR and the clairvoyant bound.
+"""Read a policy in control terms and score it between the passive beam and the clairvoyant
+bound.
 
 ``python -m baselines.analyze POLICY [POLICY ...] [--env-id ID] --json PATH [--plots DIR]
 [--markdown PATH]``
 
-POLICY is a reference policy (``passive``, ``lqr``, ``smc``, ``mpc``, designed on the env's
-nominal model) or an agent directory (``train.agent.TrainedAgent``). Through the env it
+POLICY is a reference of the level (:mod:`baselines.marks`: ``passive``; the thesis's
+delay-free ``lqr`` and ``smc`` and the nominal ``mpc``; the engineer's designs for the
+level's actuator, ``lqg`` and ``mpc_rig`` (:mod:`baselines.engineer`); the plant oracle
+``mpc_oracle`` (:mod:`baselines.oracle`)), ``references`` for all of them, or an agent
+directory (``train.agent.TrainedAgent``). Through the env it
 measures the closed-loop modes 1-3 (frequency, damping ratio) from a small tip pulse, the
 drop of each mode's load-to-tip compliance peak against the passive beam (multisine),
 for a policy linear about rest the exact closed-loop modes of the sampled loop and the
 gain and phase margins at the actuator, the effort on the thesis cases (RMS voltage,
-amplifier reactive power, chattering and time at the limit after settling), and the score
+amplifier reactive power, chattering and time at the limit after settling), and score v2
 on the env's published test set: the interquartile mean over its episodes of
-(ISE_LQR - ISE) / (ISE_LQR - ISE_bound) with a 95 % bootstrap interval. The same in Python:
-:func:`baselines.analysis.control.analyze` (re-exported here as :func:`analyze`).
+(ISE_passive - ISE) / (ISE_passive - ISE_bound) with a 95 % bootstrap interval (the bound
+1), beside the mean ISE relative to the thesis LQR's. The same in Python:
+:func:`baselines.analysis.control.analyze` (re-exported here as :func:`analyze`). The id
+and the output paths are checked before anything is computed.
 
 With one POLICY, ``--json`` writes its record; with several, a list of records, and
 ``--markdown`` the comparison tables; ``--plots`` writes ``compliance_<policy>.png`` each.
@@ -27,41 +33,51 @@ from pathlib import Path
 
 import acld_gym
 from acld_gym.benchmark import TEST_SETS
+from acld_gym.envs.presets import check_env_id
 from acld_gym.util.atomic import check_directory, check_writable, write_json, write_text
 
 from .analysis.control import Analysis, analyze
 from .evaluate import add_score_episodes_argument, check_score_episodes
 
-__all__ = ["analyze", "Analysis", "BASELINES", "resolve_policy", "main"]
+__all__ = ["analyze", "Analysis", "BASELINES", "ALL", "resolve_policy", "resolve_policies", "main"]
 
-#: The reference policies by name.
-BASELINES = ("passive", "lqr", "smc", "mpc")
+#: The references of every level by name (:func:`baselines.marks.level_references`; where
+#: the QP solver osqp is missing, a level has no ``mpc``, ``mpc_rig`` or ``mpc_oracle``).
+BASELINES = ("passive", "lqr", "smc", "mpc", "lqg", "mpc_rig", "mpc_oracle")
+#: The POLICY that stands for all of the level's references.
+ALL = "references"
 
 
-def resolve_policy(spec: str, env_id: str, env_kwargs: dict | None = None):
-    """``(policy, name)`` for a baseline name or an agent directory; ``ValueError`` naming
-    ``POLICY`` otherwise."""
+def resolve_policies(spec: str, env_id: str, env_kwargs: dict | None = None) -> list:
+    """``[(policy, name), ...]`` for a reference's name, :data:`ALL` or an agent
+    directory; ``ValueError`` naming ``POLICY`` otherwise."""
     import gymnasium as gym
 
-    if spec in BASELINES:
-        from . import policies
+    if spec in BASELINES or spec == ALL:
+        from .marks import level_references
 
-        cls = {
-            "passive": policies.PassivePolicy,
-            "lqr": policies.LQRPolicy,
-            "smc": policies.SMCPolicy,
-            "mpc": policies.MPCPolicy,
-        }[spec]
-        env = gym.make(env_id, **(env_kwargs or {}))
-        return cls.for_env(env), spec
+        refs = level_references(gym.make(env_id, **(env_kwargs or {})))
+        if spec == ALL:
+            return [(pol, name) for name, pol in refs.items()]
+        if spec not in refs:
+            raise ValueError(f"POLICY: {spec!r} is not available here (osqp is not installed)")
+        return [(refs[spec], spec)]
     path = Path(spec)
     if not path.is_dir():
         raise ValueError(
-            f"POLICY: expected one of {list(BASELINES)} or an agent directory, got {spec!r}"
+            f"POLICY: expected one of {[*BASELINES, ALL]} or an agent directory, got {spec!r}"
         )
     from train.agent import TrainedAgent
 
-    return TrainedAgent.load(path, path.name), path.name
+    return [(TrainedAgent.load(path, path.name), path.name)]
+
+
+def resolve_policy(spec: str, env_id: str, env_kwargs: dict | None = None):
+    """``(policy, name)`` for a reference's name or an agent directory (not :data:`ALL`);
+    ``ValueError`` naming ``POLICY`` otherwise."""
+    if spec == ALL:
+        raise ValueError(f"POLICY: {ALL!r} stands for several policies")
+    return resolve_policies(spec, env_id, env_kwargs)[0]
 
 
 def _finite(obj):
@@ -85,13 +101,12 @@ def build_parser() -> argparse.ArgumentParser:
         "policy",
         metavar="POLICY",
         nargs="+",
-        help=f"one of {', '.join(BASELINES)}, or an agent directory",
+        help=f"one of {', '.join(BASELINES)}, {ALL} (all of them), or an agent directory",
     )
     p.add_argument(
         "--env-id",
         default=acld_gym.ENV_ID,
-        choices=sorted(TEST_SETS),
-        help=f"the env (default {acld_gym.ENV_ID})",
+        help=f"a registered id of this package with a test set (default {acld_gym.ENV_ID})",
     )
     p.add_argument("--json", metavar="PATH", help="write the record as JSON")
     p.add_argument("--plots", metavar="DIR", help="write the compliance figures to DIR")
@@ -104,14 +119,17 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    try:  # unusable output paths and a bad POLICY fail now, before any computing
+    try:  # a bad id, unusable output paths and a bad POLICY fail now, before any computing
+        check_env_id(args.env_id, "--env-id")
+        if args.env_id not in TEST_SETS:
+            raise ValueError(f"--env-id: no published test set for {args.env_id!r}")
         for flag, path in (("--json", args.json), ("--markdown", args.markdown)):
             if path:
                 check_writable(path, flag)
         if args.plots:
             check_directory(args.plots, "--plots")
         check_score_episodes(args.score_episodes, args.env_id)
-        policies = [resolve_policy(spec, args.env_id) for spec in args.policy]
+        policies = [p for spec in args.policy for p in resolve_policies(spec, args.env_id)]
     except (OSError, ValueError) as exc:
         parser.error(str(exc))
     from .analysis.references import references

@@ -1,20 +1,24 @@
-"""Evaluate the reference policies on the thesis's three load cases in ``ACLDBeam-v1`` (or any
-registered id).
+"""Evaluate every reference of a level on the thesis's three load cases in ``ACLDBeam-v1`` (or
+any registered id), and score them.
 
 ``python -m baselines.evaluate [--env-id ID] [--mesh converged|thesis] [--json PATH]
-[--plots DIR]`` prints a table per case (peak [mm], 5 % settling [s], ISE [m^2 s], max |V|
-[V], return) for passive, LQR, SMC, MPC and the clairvoyant bound, all with the +/-120 V
-limit, 1 ms control and the default Kalman observer, in the configuration of ``--env-id``
-(default ``ACLDBeam-v1``; ``--mesh`` replaces its mesh), with each policy's effort (RMS
-voltage, amplifier reactive power, chattering and time at the limit after the tip has
-settled: :mod:`baselines.analysis.effort`), and the score of each policy on the env's
-published test set (:mod:`baselines.analysis.score`, :data:`acld_gym.benchmark.TEST_SETS`;
-``--score-episodes``); on the thesis mesh it also prints the saturated LQR/SMC rows against
-thesis Table 2. The policies are designed on the env's nominal model
-(:meth:`baselines.policies.LQRPolicy.for_env`: through the measurement observation they run
-the nominal observer themselves) and the bound has the env's actuator inside. Any object
-with SB3's ``predict`` can be evaluated with :func:`rollout`, so trained agents use the same
-code; a policy that records an ``observation_fingerprint`` is checked against the
+[--plots DIR] [--score-episodes N]`` prints a table per case (peak [mm], 5 % settling [s],
+ISE [m^2 s] and relative to the thesis LQR and to the bound, max |V| [V], return) and each
+policy's effort (RMS voltage, amplifier reactive power, chattering and time at the limit
+after the tip has settled: :mod:`baselines.analysis.effort`) for the level's references
+(:mod:`baselines.marks`): the passive beam; the thesis's LQR and SMC and the nominal MPC,
+delay-free designs on the nominal model; the engineer's designs for the level's known
+actuator (:mod:`baselines.engineer`); the plant oracle ``mpc_oracle``, which knows the
+episode's plant and actuator but not the load (:mod:`baselines.oracle`); and the
+clairvoyant bound, with the env's actuator inside -- all with the +/-120 V limit and 1 ms
+control, in the configuration of ``--env-id`` (default ``ACLDBeam-v1``; ``--mesh``
+replaces its mesh). Then it prints score v2 of each on the env's published test set
+(:mod:`baselines.analysis.score`: passive 0, bound 1; :data:`acld_gym.benchmark.TEST_SETS`;
+``--score-episodes``) beside the mean ISE relative to the thesis LQR's; on the thesis mesh
+also the saturated LQR/SMC rows against thesis Table 2. The id and the output paths are
+checked before anything is computed. Any object with SB3's ``predict`` can be evaluated
+with :func:`rollout` (:mod:`baselines.rollout`, re-exported here), so trained agents use
+the same code; a policy that records an ``observation_fingerprint`` is checked against the
 env's before it acts.
 """
 
@@ -23,8 +27,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
@@ -32,17 +35,23 @@ import numpy as np
 from acld_gym import ENV_ID
 from acld_gym.benchmark import TEST_SETS
 from acld_gym.envs.beam_env import ACLDBeamEnv
-from acld_gym.envs.fingerprint import fingerprint_differences, observation_fingerprint
-from acld_gym.envs.presets import PRESETS, preset
-from acld_gym.envs.step import reward_of
+from acld_gym.envs.presets import check_env_id, preset
 from acld_gym.physics.loads import THESIS_CASES
 from acld_gym.physics.truth import MESHES
-from acld_gym.thesis.metrics import max_abs, peak, settling_time
 from acld_gym.thesis.table2 import thesis_row
 from acld_gym.util.atomic import check_directory, check_writable, save_figure, write_json
-from acld_gym.util.blas import one_blas_thread
 from acld_gym.util.progress import Progress
 from acld_gym.util.validate import arg_type
+
+from .marks import level_references, mark_labels
+from .rollout import (  # the primitives, re-exported: their home is baselines.rollout
+    Episode,
+    EvalRow,
+    bound_episode,
+    check_compatible,
+    metrics_row,
+    rollout,
+)
 
 __all__ = [
     "EvalRow",
@@ -55,7 +64,10 @@ __all__ = [
     "policy_classes",
     "default_policies",
     "policies_for",
+    "level_references",
+    "metrics_row",
     "mean_rows",
+    "format_legend",
     "format_tables",
     "format_effort",
     "format_thesis_comparison",
@@ -64,132 +76,6 @@ __all__ = [
     "check_score_episodes",
     "plot_episodes",
 ]
-
-
-@dataclass(frozen=True)
-class Episode:
-    """Per-step record of one episode: t [s], y [m], voltage [V], reward."""
-
-    t: np.ndarray
-    y: np.ndarray
-    voltage: np.ndarray
-    reward: np.ndarray
-    seconds_per_step: float
-
-
-@dataclass(frozen=True)
-class EvalRow:
-    case: int | str
-    policy: str
-    peak_mm: float
-    settling_s: float
-    ise: float
-    max_voltage_V: float
-    # ``return`` is a keyword; stored as ``ret`` and written as "return".
-    ret: float
-    ms_per_step: float
-    # Effort (baselines.analysis.effort); the settled-window ones are NaN without a
-    # settled window (random loads).
-    rms_voltage_V: float = math.nan
-    reactive_power_var: float = math.nan
-    total_variation_V_per_s: float = math.nan
-    limit_fraction: float = math.nan
-    residual_tip_rms_m: float = math.nan
-
-    def as_dict(self) -> dict:
-        d = asdict(self)
-        d["return"] = d.pop("ret")
-        return {
-            k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in d.items()
-        }
-
-
-def check_compatible(policy, env) -> None:
-    """``ValueError`` if ``policy`` records an observation fingerprint that ``env``'s
-    observation does not match (:mod:`acld_gym.envs.fingerprint`)."""
-    expected = getattr(policy, "observation_fingerprint", None)
-    if expected is None:
-        return
-    diff = fingerprint_differences(expected, observation_fingerprint(env))
-    if diff:
-        name = getattr(policy, "name", type(policy).__name__)
-        raise ValueError(
-            f"policy {name!r} was built for another observation than this env's: " + "; ".join(diff)
-        )
-
-
-def rollout(policy, env: ACLDBeamEnv, seed: int = 0, options: dict | None = None) -> Episode:
-    """Run one deterministic episode of ``policy`` (SB3 ``predict``) in ``env``."""
-    check_compatible(policy, env)
-    obs, _ = env.reset(seed=seed, options=options)
-    t, y, v, r = [], [], [], []
-    spent = 0.0
-    done = False
-    state, start = None, np.ones(1, dtype=bool)  # SB3's recurrent-policy protocol
-    while not done:
-        t0 = time.perf_counter()
-        action, state = policy.predict(obs, state=state, episode_start=start, deterministic=True)
-        start = np.zeros(1, dtype=bool)
-        spent += time.perf_counter() - t0
-        obs, reward, term, trunc, info = env.step(action)
-        t.append(info["time"])
-        y.append(info["tip_deflection"])
-        v.append(info["voltage"])
-        r.append(reward)
-        done = term or trunc
-    return Episode(np.array(t), np.array(y), np.array(v), np.array(r), spent / len(t))
-
-
-def bound_episode(env: ACLDBeamEnv) -> Episode:
-    """The clairvoyant bound for ``env``'s current load and plant (the episode's own:
-    randomized with ``param_noise``, at its temperature, with its amplifier's lag), with the
-    env's actuator inside: the delay shifts the impulse response, the lag is part of the
-    sampled plant, the slew limit is a constraint (:func:`baselines.bound.clairvoyant_bound`).
-    Its voltages are the patch's (the amplifier's output through the lag)."""
-    from acld_gym.design.discrete import impulse_response
-
-    from .bound import clairvoyant_bound
-
-    env = env.unwrapped
-    plant, c, n = env.episode_plant, env.config, env.max_steps
-    tip = np.zeros(plant.Ad.shape[0])
-    tip[: env.nom.output.size] = env.nom.output
-    t0 = time.perf_counter()
-    with one_blas_thread():  # small dense problems (acld_gym.util.blas)
-        sol = clairvoyant_bound(
-            plant, tip, env.load, n, delay=c.actuator_delay, slew_step=c.slew_step
-        )
-    spent = time.perf_counter() - t0
-    volts = sol.voltage
-    if c.amplifier_bandwidth is not None:
-        patch = np.zeros(plant.Ad.shape[0])
-        patch[env.nom.output.size] = 1.0  # the patch voltage, a state of the lagged plant
-        volts = np.convolve(impulse_response(plant, patch, n), sol.voltage)[:n]
-    t = np.arange(1, n + 1) * env.dt
-    reward = reward_of(sol.y, volts, env.y_ref, env.lam, env.v_max)
-    return Episode(t, sol.y, volts, reward, spent / n)
-
-
-def metrics_row(case, name: str, ep: Episode) -> EvalRow:
-    from .analysis.effort import effort, settled_from
-
-    dt = float(ep.t[1] - ep.t[0]) if ep.t.size > 1 else float(ep.t[0])
-    e = effort(ep.voltage, ep.y, dt, settled_from(case))
-    return EvalRow(
-        case=case,
-        policy=name,
-        peak_mm=peak(ep.y) * 1e3,
-        settling_s=settling_time(ep.t, ep.y),
-        ise=float(np.sum(ep.y**2) * dt),
-        max_voltage_V=max_abs(ep.voltage),
-        ret=float(np.sum(ep.reward)),
-        ms_per_step=1e3 * ep.seconds_per_step,
-        rms_voltage_V=e.rms_voltage_V,
-        reactive_power_var=e.reactive_power_var,
-        total_variation_V_per_s=e.total_variation_V_per_s,
-        limit_fraction=e.limit_fraction,
-        residual_tip_rms_m=e.residual_tip_rms_m,
-    )
 
 
 def policy_classes() -> tuple:
@@ -275,6 +161,14 @@ def mean_rows(rows: list[EvalRow], case) -> list[EvalRow]:
     return out
 
 
+def format_legend(labels: dict) -> str:
+    """One line: the policies of each kind (:func:`baselines.marks.mark_labels`)."""
+    kinds: dict[str, list[str]] = {}
+    for name, kind in labels.items():
+        kinds.setdefault(kind, []).append(name)
+    return "policies: " + "; ".join(f"{', '.join(n)} = {k}" for k, n in kinds.items())
+
+
 def format_tables(rows: list[EvalRow]) -> str:
     out = []
     for case in dict.fromkeys(r.case for r in rows):
@@ -283,14 +177,14 @@ def format_tables(rows: list[EvalRow]) -> str:
         lqr = next((r.ise for r in sub if r.policy == "lqr"), None)
         out.append(f"\nload case {case}")
         out.append(
-            f"{'policy':>8} {'peak [mm]':>10} {'settle [s]':>10} {'ISE [m^2 s]':>12} "
+            f"{'policy':>10} {'peak [mm]':>10} {'settle [s]':>10} {'ISE [m^2 s]':>12} "
             f"{'/LQR':>6} {'/bound':>7} {'max|V|':>7} {'return':>10} {'ms/step':>8}"
         )
         for r in sub:
             rel_l = f"{r.ise / lqr:6.2f}" if lqr else "     -"
             rel_b = f"{r.ise / bound:7.2f}" if bound else "      -"
             out.append(
-                f"{r.policy:>8} {r.peak_mm:10.3f} {r.settling_s:10.3f} {r.ise:12.3e} "
+                f"{r.policy:>10} {r.peak_mm:10.3f} {r.settling_s:10.3f} {r.ise:12.3e} "
                 f"{rel_l} {rel_b} {r.max_voltage_V:7.1f} {r.ret:10.1f} "
                 f"{r.ms_per_step:8.3f}"
             )
@@ -308,12 +202,12 @@ def format_effort(rows: list[EvalRow]) -> list[str]:
     start = settled_from(rows[0].case)
     when = f"after {start:.3f} s:" if math.isfinite(start) else "(no settled window)"
     out = [
-        f"{'effort':>8} {'V rms [V]':>10} {'Q [mvar]':>9}  {when:>19} {'TV [kV/s]':>9} "
+        f"{'effort':>10} {'V rms [V]':>10} {'Q [mvar]':>9}  {when:>19} {'TV [kV/s]':>9} "
         f"{'at limit':>8} {'tip rms [um]':>12}"
     ]
     for r in rows:
         out.append(
-            f"{r.policy:>8} {r.rms_voltage_V:10.1f} {num(r.reactive_power_var, 9, 2, 1e3)}"
+            f"{r.policy:>10} {r.rms_voltage_V:10.1f} {num(r.reactive_power_var, 9, 2, 1e3)}"
             f"  {'':>19} {num(r.total_variation_V_per_s, 9, 2, 1e-3)} "
             f"{num(r.limit_fraction, 7, 1, 100)}% "
             f"{num(r.residual_tip_rms_m, 12, 2, 1e6)}"
@@ -425,10 +319,7 @@ def main(argv: list[str] | None = None) -> int:
         "--seed", type=arg_type(int, 0, 2**63 - 1), default=0, help="episode seed (sensor noise)"
     )
     p.add_argument(
-        "--env-id",
-        choices=list(PRESETS),
-        default=ENV_ID,
-        help=f"the registered configuration (default {ENV_ID})",
+        "--env-id", default=ENV_ID, help=f"a registered id of this package (default {ENV_ID})"
     )
     p.add_argument(
         "--mesh",
@@ -440,7 +331,8 @@ def main(argv: list[str] | None = None) -> int:
     add_score_episodes_argument(p)
     p.add_argument("--quiet", action="store_true", help="no progress line")
     args = p.parse_args(argv)
-    try:  # unusable output paths and a bad --score-episodes fail now, before any computing
+    try:  # a bad id, unusable output paths and a bad --score-episodes fail now, before
+        check_env_id(args.env_id, "--env-id")  # any computing
         if args.json:
             check_writable(args.json, "--json")
         if args.plots:
@@ -451,21 +343,31 @@ def main(argv: list[str] | None = None) -> int:
     config = preset(args.env_id, **({} if args.mesh is None else {"mesh": args.mesh}))
     probe = ACLDBeamEnv(config=config)  # build the design once before timing anything
     episodes: dict = {}
-    policies = policies_for(probe)
+    policies = level_references(probe)
     if "mpc" not in policies:
         from .policies import MPC_MISSING
 
-        print(f"mpc skipped: {MPC_MISSING}")
+        print(f"mpc and mpc_oracle skipped: {MPC_MISSING}")
+    labels = mark_labels(policies)
     rows = evaluate(
         policies, seed=args.seed, env_kwargs={"config": config}, episodes=episodes, quiet=args.quiet
     )
+    print(format_legend(labels))
     print(format_tables(rows))
     if config.mesh == "thesis":
         print(format_thesis_comparison(rows))
     mesh = {} if args.mesh is None else {"mesh": args.mesh}  # (every id has a test set)
-    scores = add_scores(policies, args.score_episodes, mesh, args.quiet, env_id=args.env_id)
+    scores = add_scores(
+        policies, args.score_episodes, mesh, args.quiet, labels=labels, env_id=args.env_id
+    )
     if args.json:
-        write_json(args.json, [dict(r.as_dict(), score=scores.get(r.policy)) for r in rows])
+        write_json(
+            args.json,
+            [
+                dict(r.as_dict(), kind=labels.get(r.policy), score=scores.get(r.policy))
+                for r in rows
+            ],
+        )
         print(f"\nwrote {args.json}")
     if args.plots:
         plot_episodes(episodes, Path(args.plots))

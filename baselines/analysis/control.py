@@ -105,7 +105,7 @@ class Analysis:
 
 
 def _case_record(policy, env_id: str, case, env_kwargs: dict, capacitance: float) -> dict:
-    from baselines.evaluate import metrics_row, rollout
+    from baselines.rollout import metrics_row, rollout
 
     env = gym.make(env_id, load_case=case, **env_kwargs)
     ep = rollout(policy, env, seed=0)
@@ -196,7 +196,10 @@ def analyze(
         )
 
         progress.stage("small-signal law")
-        law, why = small_signal_law(policy, obs_size, v_max)
+        if hasattr(policy, "start_episode"):  # an oracle (baselines.rollout): no static law
+            law, why = None, "an oracle: it reads the episode's plant at reset, a dynamic law"
+        else:
+            law, why = small_signal_law(policy, obs_size, v_max)
         exact = marg = exact_h = None
         if law is not None:
             try:

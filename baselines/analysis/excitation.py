@@ -198,9 +198,9 @@ class PulseSuperposition:
     def run(self, policy, load) -> Response:
         """``policy`` (SB3 ``predict``, deterministic; a policy with a state, such as
         :class:`baselines.policies.MeasurementFeedback`, gets it back each step as from
-        :func:`baselines.evaluate.rollout`) in the loop under ``load`` (as many periods as
+        :func:`baselines.rollout.rollout`) in the loop under ``load`` (as many periods as
         it has values, at most ``n_steps``)."""
-        from baselines.evaluate import check_compatible
+        from baselines.rollout import check_compatible
 
         f = self._check_load(load)
         check_compatible(policy, self.env)
@@ -209,6 +209,8 @@ class PulseSuperposition:
         n = f.size
         y, v, req = np.zeros(n + 1), np.empty(n), np.empty(n)
         obs, _ = self.env.reset(seed=self.seed)
+        if hasattr(policy, "start_episode"):  # an oracle (baselines.rollout.rollout)
+            policy.start_episode(self.env)
         dtype = obs.dtype
         state, start = None, np.ones(1, dtype=bool)  # SB3's recurrent-policy protocol
         for k in range(n):

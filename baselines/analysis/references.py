@@ -1,21 +1,24 @@
-r"""The score's references on a test set: LQR's and the clairvoyant bound's ISE per episode,
-computed once per test set and cached.
+r"""The score's references on a test set: the passive beam's, the thesis LQR's and the
+clairvoyant bound's ISE per episode, computed once per test set and cached.
 
 For each episode of an :class:`acld_gym.benchmark.EvaluationSet` (its seed, through the env
-as :func:`baselines.evaluate.rollout` runs it) the reference is LQR's ISE
-(:class:`baselines.policies.LQRPolicy` on the env's nominal design) and the bound's
-(:func:`baselines.evaluate.bound_episode`, 20-120 ms an episode on one BLAS thread). A
-hundred episodes take about 7 s, so they are cached in the user cache
-(:func:`acld_gym.physics.plant_cache.user_cache_dir`), in a JSON file whose name carries a
-key: the SHA-256 of the test set, the env arguments, the env's whole configuration
-(:class:`acld_gym.envs.config.EnvConfig`: the actuator, temperature and parameter-noise
-settings of a preset too), its observation fingerprint (its design and observer) and the
-package version.
+as :func:`baselines.rollout.rollout` runs it) the references are the passive beam's ISE
+(:class:`baselines.policies.PassivePolicy`: score v2's 0), the thesis LQR's
+(:class:`baselines.policies.LQRPolicy` on the env's nominal design: the thesis-facing
+column) and the bound's (:func:`baselines.rollout.bound_episode`, 20-120 ms an episode on
+one BLAS thread: score v2's 1). A hundred episodes take about 10 s, so they are cached in
+the user cache (:func:`acld_gym.physics.plant_cache.user_cache_dir`), in a JSON file whose
+name carries a key: the SHA-256 of the test set, the env arguments, the env's whole
+configuration (:class:`acld_gym.envs.config.EnvConfig`: the actuator, temperature and
+parameter-noise settings of a preset too), its observation fingerprint (its design and
+observer) and the package version.
 
-A cached file is validated before use: its format, key, seeds and lengths, every ISE
-finite and positive, the bound's below LQR's, and a spot check -- the first episode is run
-again and must give the same two ISE to :data:`SPOT_RTOL`. A file that fails is recomputed
-and rewritten (atomically), with a note on stderr; an unwritable cache only costs the time.
+A cached file is validated before use: its format (:data:`FORMAT`; a file of an older
+format, without the passive ISE, is rejected with one line and recomputed), key, seeds and
+lengths, every ISE finite and positive, the bound's below the passive and LQR's, and a spot
+check -- the first episode is run again and must give the same three ISE to
+:data:`SPOT_RTOL`. A file that fails is recomputed and rewritten (atomically), with a note
+on stderr; an unwritable cache only costs the time.
 """
 
 from __future__ import annotations
@@ -42,22 +45,26 @@ __all__ = [
     "reference_episode",
     "make_env",
     "cache_path",
+    "KINDS",
     "FORMAT",
     "SPOT_RTOL",
 ]
 
-#: Version of the cache files' layout and of the way references are computed.
-FORMAT = 1
+#: Version of the cache files' layout and of the way references are computed (2: with the
+#: passive beam's ISE, score v2's anchor).
+FORMAT = 2
 #: Relative agreement of the spot check's re-run with the cached first episode.
 SPOT_RTOL = 1e-6
 
 
 @dataclass(frozen=True)
 class References:
-    """LQR's and the bound's ISE [m^2 s] on each episode of the test set ``name``."""
+    """The passive beam's, the thesis LQR's and the bound's ISE [m^2 s] on each episode of
+    the test set ``name``."""
 
     name: str
     seeds: tuple[int, ...]
+    passive_ise: np.ndarray
     lqr_ise: np.ndarray
     bound_ise: np.ndarray
 
@@ -67,15 +74,23 @@ def make_env(test: EvaluationSet, env_kwargs: dict | None = None):
     return gym.make(test.env_id, load_case=test.load_case, **(env_kwargs or {}))
 
 
-def reference_episode(env, seed: int) -> tuple[float, float]:
-    """``(LQR's ISE, the bound's ISE)`` of the episode ``seed`` of ``env``."""
-    from baselines.evaluate import bound_episode, metrics_row, rollout
-    from baselines.policies import LQRPolicy
+#: The reference ISE arrays of a file and of :class:`References`, in this order.
+KINDS = ("passive_ise", "lqr_ise", "bound_ise")
 
-    lqr = metrics_row("test", "lqr", rollout(LQRPolicy.for_env(env), env, seed=seed)).ise
+
+def reference_episode(env, seed: int) -> tuple[float, float, float]:
+    """``(passive ISE, the thesis LQR's ISE, the bound's ISE)`` of the episode ``seed`` of
+    ``env``."""
+    from baselines.policies import LQRPolicy, PassivePolicy
+    from baselines.rollout import bound_episode, metrics_row, rollout
+
+    passive, lqr = (
+        metrics_row("test", cls.name, rollout(cls.for_env(env), env, seed=seed)).ise
+        for cls in (PassivePolicy, LQRPolicy)
+    )
     env.reset(seed=seed)
     bound = metrics_row("test", "bound", bound_episode(env)).ise
-    return lqr, bound
+    return passive, lqr, bound
 
 
 def _key(test: EvaluationSet, env_kwargs: dict, env) -> str:
@@ -116,32 +131,33 @@ def _validated(path: Path, test: EvaluationSet, key: str, env) -> References | N
         reject(f"unreadable: {exc}")
         return None
     if not isinstance(rec, dict) or rec.get("format") != FORMAT or rec.get("key") != key:
-        reject("another format or key")
+        reject(f"another format (score v2's references need format {FORMAT}) or key")
         return None
     if rec.get("seeds") != list(test.seeds):
         reject("other seeds")
         return None
     try:
-        lqr = np.asarray(rec["lqr_ise"], dtype=float)
-        bound = np.asarray(rec["bound_ise"], dtype=float)
+        arrays = [np.asarray(rec[kind], dtype=float) for kind in KINDS]
     except (KeyError, TypeError, ValueError):
         reject("no ISE arrays")
         return None
     n = len(test.seeds)
-    if lqr.shape != (n,) or bound.shape != (n,):
+    if any(a.shape != (n,) for a in arrays):
         reject("wrong lengths")
         return None
-    if not (np.all(np.isfinite(lqr)) and np.all(np.isfinite(bound)) and np.all(bound > 0)):
+    if not all(np.all(np.isfinite(a)) and np.all(a > 0) for a in arrays):
         reject("non-finite or non-positive ISE")
         return None
-    if np.any(bound > lqr * (1 + 1e-9)):
-        reject("a bound above LQR")
+    passive, lqr, bound = arrays
+    if np.any(bound > np.minimum(lqr, passive) * (1 + 1e-9)):
+        reject("a bound above the passive beam or LQR")
         return None
     spot = reference_episode(env, test.seeds[0])
-    if not np.allclose(spot, (lqr[0], bound[0]), rtol=SPOT_RTOL, atol=0.0):
-        reject(f"the first episode gives {spot}, the file {lqr[0], bound[0]}")
+    first = tuple(float(a[0]) for a in arrays)
+    if not np.allclose(spot, first, rtol=SPOT_RTOL, atol=0.0):
+        reject(f"the first episode gives {spot}, the file {first}")
         return None
-    return References(test.name, test.seeds, lqr, bound)
+    return References(test.name, test.seeds, *arrays)
 
 
 def references(
@@ -158,24 +174,17 @@ def references(
         if refs is not None:
             return refs
     n = len(test.seeds)
-    lqr, bound = np.empty(n), np.empty(n)
+    arrays = np.empty((len(KINDS), n))
     with Progress(n, f"references {test.name}", quiet) as progress:
         for i, s in enumerate(test.seeds):
             progress.stage(f"episode {i + 1}/{n}")
-            lqr[i], bound[i] = reference_episode(env, s)
+            arrays[:, i] = reference_episode(env, s)
     if cache:
+        record = {"format": FORMAT, "key": key, "test_set": test.name, "seeds": list(test.seeds)}
         try:
             write_json(
-                path,
-                {
-                    "format": FORMAT,
-                    "key": key,
-                    "test_set": test.name,
-                    "seeds": list(test.seeds),
-                    "lqr_ise": lqr.tolist(),
-                    "bound_ise": bound.tolist(),
-                },
+                path, record | {kind: a.tolist() for kind, a in zip(KINDS, arrays, strict=True)}
             )
         except OSError:
             pass  # a read-only cache: computed again next time
-    return References(test.name, test.seeds, lqr, bound)
+    return References(test.name, test.seeds, *arrays)

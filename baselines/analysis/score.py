@@ -1,19 +1,25 @@
-r"""One number per policy: where it sits between LQR (0) and the clairvoyant bound (1).
+r"""One number per policy, score v2: where it sits between the passive beam (0) and the
+clairvoyant bound (1).
 
 On each episode i of a published test set (:data:`acld_gym.benchmark.TEST_SETS`: random
 loads, seeds disjoint from training and model selection),
 
 .. math::
 
-    s_i = \frac{ISE_{LQR,i} - ISE_i}{ISE_{LQR,i} - ISE_{bound,i}},
+    s_i = \frac{ISE_{passive,i} - ISE_i}{ISE_{passive,i} - ISE_{bound,i}},
 
-so LQR scores 0 on every episode by construction, the bound 1, a policy better than LQR
-between the two, and one worse than LQR below 0 (passive: about -1 to -10). No causal
-policy reaches 1: the bound knows the whole load in advance. The score is the
-interquartile mean of the :math:`s_i` with a 95 % percentile bootstrap interval
-(:mod:`acld_gym.util.stats`; the episodes are one stratum, the test set's single task).
-The interquartile mean keeps the few episodes where LQR is already within a hair of the
-bound, and the ratio ill-conditioned, from deciding the score.
+so the passive beam (no voltage) scores 0 on every episode, the bound 1, and a policy that
+makes the tip worse than no control at all scores below 0. Both anchors are fixed: neither
+moves when a reference is redesigned, on every level (the bound has the level's actuator
+inside, :func:`baselines.rollout.bound_episode`). No causal policy reaches 1: the bound
+knows the whole load in advance. The score is the interquartile mean of the :math:`s_i`
+with a 95 % percentile bootstrap interval (:mod:`acld_gym.util.stats`; the episodes are one
+stratum, the test set's single task).
+
+Score v1 (before issue 66) anchored 0 on the thesis's LQR, which is a delay-free design:
+under the lab rig's period of delay it limit-cycles, so v1 scores are not comparable with
+these (:data:`SCORE_VERSION`; every table that prints a score names its version). The
+mean ISE relative to the thesis LQR's stays beside the score as the thesis-facing column.
 """
 
 from __future__ import annotations
@@ -30,6 +36,9 @@ from acld_gym.util.stats import iqm_with_ci
 from .references import References, make_env, references
 
 __all__ = [
+    "SCORE_VERSION",
+    "SCORE_NAME",
+    "ScoreUndefined",
     "Score",
     "episode_scores",
     "score_of",
@@ -38,6 +47,17 @@ __all__ = [
     "score_policies",
     "format_scores",
 ]
+
+
+#: Version of the score's definition (module docstring): 2, anchored on passive and bound.
+SCORE_VERSION = 2
+#: How tables and JSON records name it.
+SCORE_NAME = f"score v{SCORE_VERSION}"
+
+
+class ScoreUndefined(ValueError):
+    """The score of an episode whose bound is not strictly below the passive beam's ISE
+    (or of non-finite ISE): it has no anchors there."""
 
 
 @dataclass(frozen=True)
@@ -53,38 +73,60 @@ class Score:
     """Per-episode scores :math:`s_i`."""
     ise: np.ndarray
     """Per-episode ISE of the policy [m^2 s]."""
+    thesis_lqr_ise: np.ndarray | None = None
+    """Per-episode ISE of the thesis LQR on the same episodes [m^2 s] (the references')."""
+
+    @property
+    def ise_rel_thesis_lqr(self) -> float:
+        """The mean ISE over the episodes relative to the thesis LQR's (the thesis-facing
+        column; NaN without the LQR's)."""
+        if self.thesis_lqr_ise is None:
+            return float("nan")
+        return float(np.mean(self.ise) / np.mean(self.thesis_lqr_ise))
 
     def as_dict(self) -> dict:
-        """``{"iqm", "ci_low", "ci_high", "n_episodes", "test_set", "mean_ise"}`` (the mean
-        ISE over the episodes [m^2 s], the ordering of the ISE tables)."""
+        """``{"version", "iqm", "ci_low", "ci_high", "n_episodes", "test_set", "mean_ise",
+        "ise_rel_thesis_lqr"}`` (``version`` :data:`SCORE_VERSION`; the mean ISE over the
+        episodes [m^2 s], the ordering of the ISE tables, and relative to the thesis LQR's;
+        None without it)."""
+        rel = self.ise_rel_thesis_lqr
         return {
+            "version": SCORE_VERSION,
             "iqm": self.iqm,
             "ci_low": self.ci_low,
             "ci_high": self.ci_high,
             "n_episodes": self.n_episodes,
             "test_set": self.test_set,
             "mean_ise": float(np.mean(self.ise)),
+            "ise_rel_thesis_lqr": rel if np.isfinite(rel) else None,
         }
 
 
-def episode_scores(ise, lqr_ise, bound_ise) -> np.ndarray:
-    """:math:`(ISE_{LQR} - ISE) / (ISE_{LQR} - ISE_{bound})` per episode; ``ValueError``
-    unless every bound is strictly below its LQR (else the score is undefined)."""
-    ise, lqr, bound = (np.asarray(a, dtype=float) for a in (ise, lqr_ise, bound_ise))
-    if not ise.shape == lqr.shape == bound.shape or ise.ndim != 1:
+def episode_scores(ise, passive_ise, bound_ise) -> np.ndarray:
+    """:math:`(ISE_{passive} - ISE) / (ISE_{passive} - ISE_{bound})` per episode;
+    ``ValueError`` if the arrays are not 1-D of one length, :class:`ScoreUndefined` unless
+    every ISE is finite and every bound strictly below its passive ISE."""
+    ise, passive, bound = (np.asarray(a, dtype=float) for a in (ise, passive_ise, bound_ise))
+    if not ise.shape == passive.shape == bound.shape or ise.ndim != 1:
         raise ValueError(
-            f"ise, lqr_ise and bound_ise must be 1-D of one length, got "
-            f"{ise.shape}, {lqr.shape}, {bound.shape}"
+            f"ise, passive_ise and bound_ise must be 1-D of one length, got "
+            f"{ise.shape}, {passive.shape}, {bound.shape}"
         )
-    gap = lqr - bound
-    if not np.all(np.isfinite(ise)) or not np.all(gap > 0):
-        raise ValueError("ise must be finite and every bound strictly below LQR's ISE")
-    return (lqr - ise) / gap
+    gap = passive - bound
+    if not (np.all(np.isfinite(ise)) and np.all(np.isfinite(gap))):
+        raise ScoreUndefined("the score needs finite ISE (policy, passive and bound)")
+    if not np.all(gap > 0):
+        bad = int(np.argmin(gap))
+        raise ScoreUndefined(
+            f"the score is undefined where the bound is not below the passive ISE "
+            f"(episode {bad}: passive {passive[bad]:.4g}, bound {bound[bad]:.4g} m^2 s)"
+        )
+    return (passive - ise) / gap
 
 
 def score_of(ise, refs: References, reps: int = 2000, seed: int = 0) -> Score:
     """The score of per-episode ISE ``ise`` against ``refs`` (as many episodes)."""
-    s = episode_scores(ise, refs.lqr_ise, refs.bound_ise)
+    s = episode_scores(ise, refs.passive_ise, refs.bound_ise)
     stats = iqm_with_ci(s, reps=reps, seed=seed)
     return Score(
         iqm=stats["iqm"],
@@ -94,6 +136,7 @@ def score_of(ise, refs: References, reps: int = 2000, seed: int = 0) -> Score:
         test_set=refs.name,
         scores=s,
         ise=np.asarray(ise, dtype=float),
+        thesis_lqr_ise=refs.lqr_ise,
     )
 
 
@@ -104,8 +147,8 @@ def policy_ises(
     progress: Progress | None = None,
     label: str = "",
 ) -> np.ndarray:
-    """The policy's ISE [m^2 s] on each episode of ``test`` (:func:`baselines.evaluate.rollout`)."""
-    from baselines.evaluate import metrics_row, rollout
+    """The policy's ISE [m^2 s] on each episode of ``test`` (:func:`baselines.rollout.rollout`)."""
+    from baselines.rollout import metrics_row, rollout
 
     env = make_env(test, env_kwargs)
     out = np.empty(len(test.seeds))
@@ -148,7 +191,9 @@ def score_policies(
     quiet: bool = True,
 ) -> dict[str, Score]:
     """The score of each policy (name -> ``predict`` object) on the same test episodes, and
-    of the bound itself (``"bound"``, 1 on every episode by construction)."""
+    of the bound itself (``"bound"``, 1 on every episode: its cached ISE are the anchors;
+    tests/baselines/analysis/test_score.py replays its voltages through the env to check
+    that the path that scores a policy gives it 1 too)."""
     test = evaluation_set(env_id)
     if n_episodes is not None:
         test = test.first(n_episodes)
@@ -162,12 +207,12 @@ def score_policies(
 
 
 def format_scores(scores: dict[str, Score], labels: dict | None = None) -> str:
-    """The score table: per policy the IQM, its 95 % interval and the mean ISE over the test
-    set relative to LQR's (the ordering the ISE tables use); a score on fewer episodes than
-    the published test set's says so in the heading."""
+    """The score table (score v2): per policy the IQM, its 95 % interval and the mean ISE
+    over the test set relative to the thesis LQR's (the thesis-facing column, and the
+    ordering the ISE tables use); a score on fewer episodes than the
+    published test set's says so in the heading. ``labels``: a column of what each policy
+    is (its kind, how it was trained)."""
     first = next(iter(scores.values()))
-    ref = scores.get("lqr")
-    lqr_mean = None if ref is None else float(np.mean(ref.ise))
     full = {t.name: len(t.seeds) for t in TEST_SETS.values()}.get(first.test_set)
     reduced = (
         ""
@@ -175,17 +220,20 @@ def format_scores(scores: dict[str, Score], labels: dict | None = None) -> str:
         else f", the first of its {full}: a reduced score, not the published one"
     )
     head = (
-        f"\nscore on {first.test_set} ({first.n_episodes} random loads{reduced}; LQR 0, "
-        "clairvoyant bound 1): IQM of (ISE_LQR - ISE) / (ISE_LQR - ISE_bound), 95 % "
-        "bootstrap CI"
+        f"\n{SCORE_NAME} on {first.test_set} ({first.n_episodes} random loads{reduced}; "
+        "passive 0, clairvoyant bound 1): IQM of (ISE_passive - ISE) / (ISE_passive - "
+        "ISE_bound), 95 % bootstrap CI; the last column is the thesis-facing one"
     )
-    trained = "" if labels is None else f" {'trained':>22}"
+    width = 12 if labels is None else max(12, *(len(str(v)) for v in labels.values()))
+    label_head = "" if labels is None else f" {'what it is':>{width}}"
     out = [
         head,
-        f"{'policy':>12}{trained} {'IQM':>8} {'CI low':>8} {'CI high':>8} {'mean ISE / LQR':>15}",
+        f"{'policy':>12}{label_head} {'IQM':>8} {'CI low':>8} {'CI high':>8} "
+        f"{'mean ISE / thesis LQR':>22}",
     ]
     for name, s in scores.items():
-        rel = "-" if lqr_mean is None else f"{np.mean(s.ise) / lqr_mean:.4f}"
-        label = "" if labels is None else f" {labels.get(name, ''):>22}"
-        out.append(f"{name:>12}{label} {s.iqm:8.4f} {s.ci_low:8.4f} {s.ci_high:8.4f} {rel:>15}")
+        rel = s.ise_rel_thesis_lqr
+        rel = f"{rel:.4f}" if np.isfinite(rel) else "-"
+        label = "" if labels is None else f" {labels.get(name, ''):>{width}}"
+        out.append(f"{name:>12}{label} {s.iqm:8.4f} {s.ci_low:8.4f} {s.ci_high:8.4f} {rel:>22}")
     return "\n".join(out)

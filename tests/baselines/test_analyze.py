@@ -52,12 +52,9 @@ def test_lqr_in_control_terms(tmp_path):
     assert all(d > 0 for d in rec["peak_reduction_db"])  # LQR lowers all three peaks
     assert rec["linear"] and rec["margins"]["closed_loop_stable"]
     assert rec["margins"]["gain_margin_db"] > 0 and rec["margins"]["phase_margin_deg"] > 0
-    assert {k: rec["score"][k] for k in ("iqm", "ci_low", "ci_high", "n_episodes")} == {
-        "iqm": 0.0,
-        "ci_low": 0.0,
-        "ci_high": 0.0,
-        "n_episodes": 3,
-    }
+    sc = rec["score"]  # score v2: the thesis LQR between passive (0) and the bound (1)
+    assert sc["version"] == 2 and sc["n_episodes"] == 3 and 0.5 < sc["iqm"] < 0.9
+    assert sc["ise_rel_thesis_lqr"] == pytest.approx(1.0, rel=1e-12)
     assert (tmp_path / "compliance_lqr.png").stat().st_size > 10_000
 
 
@@ -88,13 +85,22 @@ def test_the_library_takes_any_predict():
     [
         (["bogus"], "POLICY"),
         (["lqr", "--score-episodes", "101"], "--score-episodes"),
-        (["lqr", "--env-id", "ACLDBeam-v9"], "--env-id"),
+        (["lqr", "--env-id", "ACLDBeam-v9"], "--env-id must be one of this package's ids"),
+        (["lqr", "--env-id", "os:system"], "--env-id must be one of this package's ids"),
     ],
 )
 def test_bad_arguments_exit_2_before_computing(argv, word, capsys):
     with pytest.raises(SystemExit) as e:
         main(argv)
     assert e.value.code == 2 and word in capsys.readouterr().err
+
+
+def test_the_oracle_is_analyzed_as_a_dynamic_law_and_scored(tmp_path):
+    rec = _run(tmp_path, "mpc_oracle", "--env-id", "ACLDBeamLab-v1", "--score-episodes", "2")
+    _check_schema(rec)
+    assert rec["policy"] == "mpc_oracle" and not rec["linear"]
+    assert "oracle" in rec["small_signal_law"]
+    assert rec["score"]["version"] == 2 and 0.5 < rec["score"]["iqm"] < 1.0
 
 
 def test_unwritable_json_fails_up_front(tmp_path, capsys):
@@ -158,10 +164,11 @@ def test_the_presets_are_read_with_their_actuator_and_observation(tmp_path):
     _check_schema(lab)
     assert lab["linear"] and not lab["margins"]["closed_loop_stable"]
     assert lab["margins"]["closed_loop_spectral_radius"] > 1.01
-    # LQR against its own cached reference: 0 up to round-off (3e-16 measured on the lab
-    # rig, whose limit cycle carries the last bits of a batched vs a single-env run)
+    # the thesis's delay-free LQR in its limit cycle: score v2 near the passive beam's 0,
+    # its ISE the thesis-facing 1 (against its own cached reference, up to round-off)
     assert lab["score"]["test_set"] == "ACLDBeamLab-v1/test-v1"
-    assert lab["score"]["iqm"] == pytest.approx(0.0, abs=1e-9)
+    assert lab["score"]["version"] == 2 and lab["score"]["iqm"] < 0.4
+    assert lab["score"]["ise_rel_thesis_lqr"] == pytest.approx(1.0, rel=1e-9)
     hard = _run(tmp_path, "smc", "--env-id", "ACLDBeamHard-v1", "--score-episodes", "3")
     _check_schema(hard)
     assert not hard["linear"] and "state" in hard["small_signal_law"]

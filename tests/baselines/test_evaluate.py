@@ -35,18 +35,24 @@ def test_cli_writes_json_with_issue_keys(tmp_path, capsys):
     path = tmp_path / "b.json"
     assert main(["--json", str(path), "--score-episodes", "3"]) == 0
     rows = json.loads(path.read_text())
-    assert len(rows) == 15  # 3 cases x (passive, lqr, smc, mpc, bound)
+    names = ["passive", "lqr", "smc", "mpc", "lqg", "mpc_rig", "mpc_oracle", "bound"]
+    assert [r["policy"] for r in rows] == 3 * names  # per case, the level's references
+    kinds = {r["policy"]: r["kind"] for r in rows}
+    assert kinds["lqr"] == kinds["smc"] == "thesis, delay-free"
+    assert kinds["lqg"] == kinds["mpc_rig"] == "engineer's design"
+    assert kinds["mpc_oracle"] == "plant oracle" and kinds["bound"] == "clairvoyant (1)"
     for r in rows:
         assert KEYS | EFFORT <= set(r)
-        assert r["policy"] in {"passive", "lqr", "smc", "mpc", "bound"}
         assert r["case"] in (1, 2, 3)
         assert np.isfinite(r["ise"]) and r["max_voltage_V"] <= 120.0 + 1e-9
         assert 0 <= r["limit_fraction"] <= 1 and r["rms_voltage_V"] <= 120.0
         assert r["score"]["n_episodes"] == 3
     score = {r["policy"]: r["score"]["iqm"] for r in rows}
-    assert score["lqr"] == 0.0 and score["bound"] == 1.0 and score["passive"] < 0
+    assert score["passive"] == 0.0 and score["bound"] == 1.0 and 0 < score["lqr"] < 1
+    assert {r["score"]["version"] for r in rows} == {2}
     out = capsys.readouterr().out
-    assert "score on ACLDBeam-v1/test-v1 (3 random loads" in out and "TV [kV/s]" in out
+    assert "score v2 on ACLDBeam-v1/test-v1 (3 random loads" in out and "TV [kV/s]" in out
+    assert "lqr, smc = thesis, delay-free" in out and "mpc_oracle = plant oracle" in out
 
 
 @pytest.mark.parametrize(
@@ -57,6 +63,9 @@ def test_cli_writes_json_with_issue_keys(tmp_path, capsys):
         # to fail after evaluating every policy, naming the test set's argument n)
         (["--score-episodes", "101"], "--score-episodes: the test set of ACLDBeam-v1 has 100"),
         (["--env-id", "ACLDBeamHard-v1", "--score-episodes", "101"], "ACLDBeamHard-v1 has"),
+        # an id is checked as data, never imported (issue 65)
+        (["--env-id", "ACLDBeam-v9"], "--env-id must be one of this package's ids"),
+        (["--env-id", "os:system"], "--env-id must be one of this package's ids"),
     ],
 )
 def test_cli_bad_argument_exits_2(argv, word, capsys, monkeypatch):
@@ -71,6 +80,20 @@ def test_cli_bad_argument_exits_2(argv, word, capsys, monkeypatch):
         main(argv)
     assert e.value.code == 2
     assert word in capsys.readouterr().err
+
+
+def test_unwritable_json_fails_before_computing(tmp_path, capsys, monkeypatch):
+    import baselines.evaluate as ev
+
+    def no_computing(*args, **kwargs):
+        raise AssertionError("computed before the arguments were checked")
+
+    monkeypatch.setattr(ev, "ACLDBeamEnv", no_computing)
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    with pytest.raises(SystemExit) as e:
+        main(["--json", str(blocker / "out.json")])
+    assert e.value.code == 2 and "--json" in capsys.readouterr().err
 
 
 def test_thesis_comparison_lists_saturated_lqr_smc_rows_only():
@@ -92,6 +115,9 @@ def test_thesis_comparison_lists_saturated_lqr_smc_rows_only():
 def test_evaluate_takes_any_registered_id(capsys):
     from baselines.evaluate import main
 
-    assert main(["--env-id", "ACLDBeamHard-v1", "--quiet"]) == 0
+    assert main(["--env-id", "ACLDBeamHard-v1", "--score-episodes", "2", "--quiet"]) == 0
     out = capsys.readouterr().out
     assert out.count("load case") == 3 and out.count("bound") >= 3
+    assert "score v2 on ACLDBeamHard-v1/test-v1 (2 random loads" in out
+    for name in ("lqg", "mpc_oracle"):  # the three marks on the hard level too
+        assert sum(line.split()[0] == name for line in out.splitlines() if line.strip()) == 7

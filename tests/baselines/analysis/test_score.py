@@ -1,17 +1,29 @@
-"""The score between LQR (0) and the clairvoyant bound (1), and its cached references."""
+"""Score v2, between the passive beam (0) and the clairvoyant bound (1), and its cached
+references."""
 
 import json
 
 import gymnasium as gym
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import baselines.analysis.references as references_module
-from acld_gym.benchmark import evaluation_set
-from baselines.analysis.references import cache_path, references
-from baselines.analysis.score import episode_scores, score_of, score_policy
-from baselines.evaluate import bound_episode, metrics_row, rollout
-from baselines.policies import LQRPolicy, SMCPolicy
+from acld_gym.benchmark import TEST_SETS, evaluation_set
+from baselines.analysis.references import FORMAT, cache_path, references
+from baselines.analysis.score import (
+    SCORE_VERSION,
+    ScoreUndefined,
+    episode_scores,
+    format_scores,
+    score_of,
+    score_policies,
+    score_policy,
+)
+from baselines.oracle import ClairvoyantReplay
+from baselines.policies import LQRPolicy, PassivePolicy, SMCPolicy
+from baselines.rollout import bound_episode, metrics_row, rollout
 
 TEST = evaluation_set("ACLDBeam-v1")
 
@@ -33,18 +45,41 @@ class Replay:
         return np.array([v], np.float32), state
 
 
-def test_the_bounds_own_episodes_score_one_and_lqr_zero(refs5):
+def test_the_references_own_ise_score_zero_and_one(refs5):
     assert np.all(score_of(refs5.bound_ise, refs5).scores == 1.0)
-    s = score_policy(LQRPolicy(), n_episodes=5, refs=refs5)
+    s = score_policy(PassivePolicy(), n_episodes=5, refs=refs5)
     assert np.all(s.scores == 0.0) and s.iqm == s.ci_low == s.ci_high == 0.0
     assert s.as_dict() == {
+        "version": SCORE_VERSION,
         "iqm": 0.0,
         "ci_low": 0.0,
         "ci_high": 0.0,
         "n_episodes": 5,
         "test_set": "ACLDBeam-v1/test-v1",
-        "mean_ise": pytest.approx(np.mean(refs5.lqr_ise), rel=1e-12),
+        "mean_ise": pytest.approx(np.mean(refs5.passive_ise), rel=1e-12),
+        "ise_rel_thesis_lqr": pytest.approx(np.mean(refs5.passive_ise) / np.mean(refs5.lqr_ise)),
     }
+    lqr = score_policy(LQRPolicy(), n_episodes=5, refs=refs5)
+    assert 0.0 < lqr.iqm < 1.0 and lqr.ise_rel_thesis_lqr == pytest.approx(1.0, rel=1e-12)
+
+
+@pytest.mark.parametrize("env_id", ["ACLDBeam-v1", "ACLDBeamLab-v1", "ACLDBeamHard-v1"])
+def test_passive_scores_zero_and_the_bounds_replay_one_on_every_level(env_id):
+    """Computed through the path that scores a policy (the env, rollout, metrics_row), on
+    each level's own test episodes: the passive beam's rollout and the bound's commands
+    replayed open loop (they reach the amplifier after the level's delay)."""
+    env = gym.make(env_id)
+    scores = score_policies(
+        {"passive": PassivePolicy.for_env(env), "bound_replay": ClairvoyantReplay()},
+        env_id=env_id,
+        n_episodes=3,
+    )
+    assert scores["passive"].test_set == TEST_SETS[env_id].name
+    np.testing.assert_array_equal(scores["passive"].scores, 0.0)
+    # the commands are the env's float32: the tip follows to ~1e-7 of the gap
+    np.testing.assert_allclose(scores["bound_replay"].scores, 1.0, atol=1e-6)
+    text = format_scores(scores)
+    assert f"score v{SCORE_VERSION} on {env_id}/test-v1" in text and "passive 0" in text
 
 
 def test_replaying_the_bounds_voltages_open_loop_scores_one(refs5):
@@ -54,7 +89,7 @@ def test_replaying_the_bounds_voltages_open_loop_scores_one(refs5):
         env.reset(seed=s)
         bound = bound_episode(env)
         ise.append(metrics_row("test", "replay", rollout(Replay(bound.voltage), env, seed=s)).ise)
-    scores = episode_scores(ise, refs5.lqr_ise, refs5.bound_ise)
+    scores = episode_scores(ise, refs5.passive_ise, refs5.bound_ise)
     np.testing.assert_allclose(scores, 1.0, atol=1e-6)  # the voltages are the env's float32
 
 
@@ -66,12 +101,35 @@ def test_the_interval_shrinks_as_episodes_are_added():
     assert widths[0] > widths[1] > widths[2] > 0
 
 
-def test_episode_scores_need_a_bound_below_lqr():
+def test_episode_scores_need_a_bound_below_passive():
     np.testing.assert_allclose(episode_scores([2.0, 1.0], [3.0, 3.0], [1.0, 1.0]), [0.5, 1.0])
-    with pytest.raises(ValueError, match="bound"):
-        episode_scores([1.0], [1.0], [1.0])
+    for bound in (1.0, 1.5):  # equal to passive, above it
+        with pytest.raises(ScoreUndefined, match="bound is not below the passive"):
+            episode_scores([1.0, 1.0], [3.0, 1.0], [1.0, bound])
+    with pytest.raises(ScoreUndefined, match="finite"):
+        episode_scores([np.nan], [3.0], [1.0])
+    with pytest.raises(ScoreUndefined, match="finite"):
+        episode_scores([1.0], [np.inf], [1.0])
+    assert issubclass(ScoreUndefined, ValueError)
     with pytest.raises(ValueError, match="one length"):
         episode_scores([1.0, 2.0], [3.0], [1.0])
+    with pytest.raises(ValueError, match="one length"):
+        episode_scores([[1.0]], [[3.0]], [[1.0]])
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    passive=st.floats(1e-12, 1e-3),
+    frac=st.floats(0.01, 0.99),
+    ise_factor=st.floats(0.0, 3.0),
+)
+def test_episode_scores_are_the_affine_map_with_the_two_anchors(passive, frac, ise_factor):
+    bound = frac * passive
+    ise = ise_factor * passive
+    s0, s1, s = episode_scores([passive, bound, ise], [passive] * 3, [bound] * 3)
+    assert s0 == 0.0 and s1 == pytest.approx(1.0, rel=1e-12)
+    assert s == pytest.approx((1.0 - ise_factor) / (1.0 - frac), rel=1e-9, abs=1e-9)
+    assert (s > 1.0) == (ise < bound) and (s < 0.0) == (ise > passive)
 
 
 # --- the cache ----------------------------------------------------------------------------
@@ -106,7 +164,8 @@ def test_a_cached_file_is_reused_after_one_spot_check(counted, tmp_path):
 
 
 @pytest.mark.parametrize(
-    "damage", ["not json", "bound above lqr", "stale first episode", "other seeds"]
+    "damage",
+    ["not json", "bound above lqr", "stale first episode", "other seeds", "format 1"],
 )
 def test_a_damaged_or_stale_file_is_recomputed(counted, tmp_path, damage, capsys):
     test = TEST.first(3)
@@ -120,15 +179,22 @@ def test_a_damaged_or_stale_file_is_recomputed(counted, tmp_path, damage, capsys
             rec["bound_ise"][1] = 2 * rec["lqr_ise"][1]
         elif damage == "stale first episode":
             rec["lqr_ise"][0] *= 1.001
+        elif damage == "format 1":  # score v1's cache: no passive ISE
+            del rec["passive_ise"]
+            rec["format"] = 1
         else:
             rec["seeds"][2] += 1
         path.write_text(json.dumps(rec))
     counted.clear()
     again = references(test)
     assert len(counted) >= 3  # recomputed
-    assert "recomputing the references" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "recomputing the references" in err and len(err.strip().splitlines()) == 1
+    if damage == "format 1":
+        assert f"need format {FORMAT}" in err
     np.testing.assert_array_equal(again.lqr_ise, good.lqr_ise)
     assert json.loads(path.read_text())["lqr_ise"] == good.lqr_ise.tolist()  # rewritten
+    assert json.loads(path.read_text())["passive_ise"] == good.passive_ise.tolist()
 
 
 def test_other_env_arguments_have_their_own_file(counted, tmp_path):

@@ -41,6 +41,7 @@ __all__ = [
     "preset",
     "check_env_id",
     "episode_steps",
+    "kwargs_steps",
     "register_presets",
 ]
 
@@ -91,11 +92,27 @@ def preset(env_id: str, **changes):
 
 
 def episode_steps(env_id: str) -> int:
-    """The step count of an id's episodes, ``round(episode_length / dt)`` of its settings
-    (EnvConfig's defaults where it sets none, mirrored here to keep this module light:
-    tests/envs/test_conflicts.py checks them against :func:`preset`)."""
-    fields = PRESETS[check_env_id(env_id)]
-    return int(round(fields.get("episode_length", 1.0) / fields.get("dt", 1e-3)))
+    """The step count of an id's episodes (:func:`kwargs_steps` of its settings)."""
+    return kwargs_steps(PRESETS[check_env_id(env_id)])
+
+
+def kwargs_steps(kwargs: dict, limit: int | None = None) -> int | None:
+    """The step count of the episodes of an env made with ``kwargs``: ``round(episode_length
+    / dt)`` of its keywords, else of its ``config``, else EnvConfig's defaults (1 s, 1 ms;
+    mirrored here to keep this module light: tests/envs/test_conflicts.py checks them),
+    shortened to ``kwargs["max_episode_steps"]`` or ``limit`` if given; ``limit`` where the
+    keywords are not numbers (the env refuses them)."""
+    config = kwargs.get("config")
+    length = kwargs.get("episode_length", getattr(config, "episode_length", 1.0))
+    dt = kwargs.get("dt", getattr(config, "dt", 1e-3))
+    try:
+        steps = int(round(length / dt))
+    except (TypeError, ValueError, ZeroDivisionError, OverflowError):
+        return limit
+    for cap in (kwargs.get("max_episode_steps"), limit):
+        if type(cap) is int and cap > 0:
+            steps = min(steps, cap)
+    return steps
 
 
 def register_presets() -> None:
@@ -117,5 +134,4 @@ def register_presets() -> None:
                 entry_point=ENTRY_POINT,
                 vector_entry_point=VECTOR_ENTRY_POINT,
                 kwargs=dict(kwargs),
-                episode_steps=episode_steps(env_id),
             )

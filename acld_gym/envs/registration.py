@@ -2,10 +2,11 @@
 
 Every id registers the step count of its episodes, ``gym.spec(id).max_episode_steps``
 (1000: ``episode_length / dt`` of the id's configuration), for the tools that read the
-registry. The env truncates itself after ``episode_length / dt`` steps, whatever its
-keywords make that (``gym.make(id, episode_length=1.5)``: 1500 steps), so gymnasium's own
-``make`` and ``make_vec`` must not add a ``TimeLimit`` of the registered count: it would
-cut a longer episode at 1000 steps and report 1000 for a shorter one. A
+registry; the spec of a ``make_vec`` env (sync or async) reports the count of the keywords
+it was made with. The env truncates itself after ``episode_length / dt`` steps, whatever
+its keywords make that (``gym.make(id, episode_length=1.5)``: 1500 steps), so gymnasium's
+own ``make`` and ``make_vec`` must not add a ``TimeLimit`` of the registered count: it
+would cut a longer episode at 1000 steps and report 1000 for a shorter one. A
 :class:`RegisteredSpec` therefore gives those two functions no limit (exactly as before
 the count was registered: the same wrappers, the same episodes) and every other reader the
 count. ``gym.make(id, max_episode_steps=n)`` still adds gymnasium's ``TimeLimit`` of n
@@ -34,20 +35,20 @@ _MAKERS = (_gym_registration.make.__code__, _gym_registration.make_vec.__code__)
 
 
 class RegisteredSpec(EnvSpec):
-    """An :class:`gymnasium.envs.registration.EnvSpec` whose ``max_episode_steps`` is
-    ``episode_steps`` for every reader except gymnasium's ``make`` and ``make_vec``, which
+    """An :class:`gymnasium.envs.registration.EnvSpec` whose ``max_episode_steps`` is the
+    step count of the episodes its ``kwargs`` give (:func:`acld_gym.envs.presets.
+    kwargs_steps`: 1000 for a registered id; a ``make_vec`` env's spec carries the keywords
+    it was made with) for every reader except gymnasium's ``make`` and ``make_vec``, which
     see the spec's own limit (None for a registered id: the env truncates itself)."""
-
-    def __init__(self, *, episode_steps: int | None = None, **fields):
-        super().__init__(**fields)
-        self.episode_steps = episode_steps
 
     @property
     def max_episode_steps(self) -> int | None:
         limit = self.__dict__.get("_limit")
-        if sys._getframe(1).f_code in _MAKERS or self.__dict__.get("episode_steps") is None:
+        if sys._getframe(1).f_code in _MAKERS:
             return limit
-        return self.episode_steps
+        from acld_gym.envs.presets import kwargs_steps
+
+        return kwargs_steps(self.kwargs, limit)
 
     @max_episode_steps.setter
     def max_episode_steps(self, value: int | None) -> None:

@@ -24,7 +24,7 @@ import acld_gym  # noqa: F401  (registers the ids)
 from acld_gym.envs.beam_env import ACLDBeamEnv
 from acld_gym.envs.config import PARAM_NOISE_MAX, EnvConfig, make_config
 from acld_gym.envs.conflicts import LOAD_SUBSTEPS, MESH_TIED, check_resolution
-from acld_gym.envs.presets import ENTRY_POINT, PRESETS, episode_steps, preset
+from acld_gym.envs.presets import ENTRY_POINT, PRESETS, episode_steps, kwargs_steps, preset
 from acld_gym.envs.sb3 import SB3VecEnv
 from acld_gym.envs.vector_env import ACLDBeamVectorEnv
 from acld_gym.physics.loads import Harmonic, Pulse, Samples, TipLoad
@@ -69,6 +69,23 @@ def test_the_registry_reports_each_ids_episode_length(env_id):
     venv = gym.make_vec(env_id, num_envs=2).unwrapped
     assert venv.max_episode_steps is None and venv.horizon == 1000
     assert type(venv.spec) is EnvSpec and venv.spec.max_episode_steps == 1000
+
+
+def test_the_mirrored_step_count_is_envconfigs():
+    assert kwargs_steps({}) == EnvConfig().max_steps == 1000
+    cfg = EnvConfig(episode_length=0.3, dt=5e-4)
+    assert kwargs_steps({"config": cfg, "y_ref": 1.0}) == cfg.max_steps == 600
+    assert kwargs_steps({"config": cfg, "dt": 1e-3}) == make_config(cfg, dt=1e-3).max_steps
+    assert kwargs_steps({"episode_length": 2.0, "max_episode_steps": 7}) == 7
+    assert kwargs_steps({"dt": "fast"}) is None  # not numbers: the env refuses them
+
+
+def test_a_sync_vector_envs_spec_reports_its_own_episode():
+    vec = gym.make_vec("ACLDBeam-v1", num_envs=2, vectorization_mode="sync", episode_length=0.02)
+    assert vec.spec.max_episode_steps == 20
+    vec.reset(seed=0)
+    flags = [vec.step(np.zeros((2, 1), np.float32))[3].all() for _ in range(20)]
+    assert flags == [False] * 19 + [True]
 
 
 def test_made_envs_follow_their_keywords_not_the_registered_count():

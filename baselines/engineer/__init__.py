@@ -11,14 +11,14 @@ cannot know (the episode's load, temperature and parameters) stays out.
 * :class:`ActuatorMPCPolicy` (``"mpc_rig"``): the MPC of the env's reward with the delay by
   prediction, the slew limit as a rate constraint and the lag in its model;
 
-:func:`engineer_policies` returns a level's references by name.
+:func:`engineer_policies` returns a level's references by name, with the level's design
+(:data:`DESIGNS`, chosen offline on training episodes: :mod:`baselines.engineer.tuning`).
 """
 
 from __future__ import annotations
 
-from baselines.policies import mpc_available
-
 from .base import RigPolicy
+from .designs import DESIGNS, design_kwargs, engineer_policies
 from .loop import closed_loop, env_plant, spectral_radius
 from .lqg import DelayLQGPolicy
 from .model import RigModel, rig_model
@@ -34,14 +34,6 @@ __all__ = [
     "spectral_radius",
     "env_plant",
     "engineer_policies",
+    "DESIGNS",
+    "design_kwargs",
 ]
-
-
-def engineer_policies(env) -> dict:
-    """The engineer's references of ``env``'s level (any wrapper of an ``ACLDBeamEnv``),
-    name -> policy with SB3's ``predict``: ``"lqg"`` and, where the QP solver osqp is
-    installed, ``"mpc_rig"``."""
-    out = {"lqg": DelayLQGPolicy.for_env(env)}
-    if mpc_available():
-        out["mpc_rig"] = ActuatorMPCPolicy.for_env(env)
-    return out

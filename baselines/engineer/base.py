@@ -76,7 +76,8 @@ class RigPolicy:
         self.model: RigModel = rig_model(nom, config) if model is None else model
         self.obs_mode = config.obs_mode
         self._iy = measurement_index(nom, config.obs_mode)
-        self.model_std = float(config.model_std if model_std is None else model_std)
+        ms = config.model_std if model_std is None else model_std
+        self.model_std = float(ms) if np.ndim(ms) == 0 else np.asarray(ms, dtype=float)
         self.load_std = float(load_std)
         m = self.model
         self.M = kalman_gain(

@@ -109,12 +109,14 @@ class ActuatorMPCPolicy(RigPolicy):
       .. math::
 
           \min_{u} \sum_{j=1}^{H} \hat y_{k+d+j}^2 + \rho \sum_{i=0}^{H-1} (u_{k+i}/120)^2,
-          \qquad \rho = \lambda (y_{ref} / 1\ \mathrm{mm})^2,
+          \qquad \rho = \lambda (y_{ref} / 1\ \mathrm{mm})^2 / w,
           \qquad |u| \le 120\ \mathrm{V},
 
       plus, with a slew limit σ = ``slew_rate * dt``, the rate constraints
       :math:`|u_k - v_{k+d-1}| \le σ`, :math:`|u_{k+i} - u_{k+i-1}| \le σ`.
-      ``state_weight`` adds :class:`MPCPolicy`'s small multiple of the thesis LQR's state
+      w (``weight``) multiplies the deflection term (1: the env's reward), as
+      :class:`~baselines.engineer.lqg.DelayLQGPolicy`'s; ``state_weight`` adds
+      :class:`MPCPolicy`'s small multiple of the thesis LQR's state
       weight (its robustness term; 0: the reward alone).
 
     **Knows**: the nominal beam, the delay, the amplifier's bandwidth and slew rate, the
@@ -130,12 +132,16 @@ class ActuatorMPCPolicy(RigPolicy):
         nom,
         config,
         horizon: int = 60,
+        weight: float = 1.0,
         state_weight: float = 0.0,
         model_std: float | None = None,
         load_std: float = 1.0,
         model=None,
     ):
+        if not weight > 0:
+            raise ValueError(f"weight must be positive, got {weight!r}")
         super().__init__(nom, config, model_std=model_std, load_std=load_std, model=model)
+        self.weight = float(weight)
         m = self.model
         k = nom.design.reduced.order
         W = np.zeros((m.n_plant, m.n_plant))
@@ -144,7 +150,7 @@ class ActuatorMPCPolicy(RigPolicy):
         part = _PlantPart(
             reduced=m.plant, design=_Design(_Reduced(C=m.c[None, :], order=m.n_plant), W)
         )
-        rho = m.lam * (m.y_ref / 1e-3) ** 2
+        rho = m.lam * (m.y_ref / 1e-3) ** 2 / self.weight
         self.mpc = _RateMPC(
             m.plant.dt, horizon, rho=rho, state_weight=state_weight, nom=part, mesh=nom.mesh
         )

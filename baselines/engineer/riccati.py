@@ -60,9 +60,10 @@ def process_noise(
     As = A * d[None, :] / d[:, None]
     es = np.asarray(e, dtype=float).reshape(-1, 1) / d[:, None]
     W = load_std**2 * (es @ es.T)
-    if model_std > 0:
+    mu = np.broadcast_to(np.asarray(model_std, dtype=float), d.shape)
+    if np.any(mu > 0):
         Pi = sla.solve_discrete_lyapunov(As, es @ es.T)
-        W = W + model_std**2 * np.diag(np.diag(Pi))
+        W = W + np.diag(mu**2 * np.diag(Pi))
     return _sym(W)
 
 

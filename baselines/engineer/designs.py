@@ -1,0 +1,78 @@
+"""Each level's engineer's design: the weights and the Kalman noise model, chosen offline
+(:mod:`baselines.engineer.tuning`), and :func:`engineer_policies`.
+
+* ``ACLDBeam-v1``, ``ACLDBeamLab-v1``: one plant (the nominal beam), so the filter's
+  noise model is the load alone (``model_std`` 0: no model error to allow for); the
+  search on training episodes (:data:`~baselines.engineer.tuning.TRAINING_SEEDS`) put it
+  above the package's observer noise (0.1): training score 0.750 against 0.740 on v1,
+  0.745 against 0.732 on the lab rig.
+* ``ACLDBeam-v0``: its own configuration's filter noise (the thesis's setting, 0).
+* ``ACLDBeamHard-v1`` (temperature 18-28 °C and a parameter scatter of 5 % unknown per
+  episode): the design is for the level's distribution of plants, not one plant. On 100
+  training plants the reward's LQG with the package's filter noise is unstable on 12
+  (spectral radius up to 1.009): the loop's third mode (2650 rad/s, near the 3142 rad/s
+  Nyquist frequency of the 1 kHz loop) moves by a few per cent with the plant, a phase
+  error that the one-period delay leaves no room for. The engineer tells the filter so:
+  mode 3's states get a model error of 1 (their whole stationary spread) against 0.03
+  for the others and a load of 3 N -- the filter then follows the measurement at mode 3
+  rather than its uncertain model. Chosen offline as the best training score (IQM
+  0.749 over 40 episodes, against 0.743 for the textbook LQG) among the noise models whose
+  loop is stable on all 100 training plants with a margin (radius at most 0.9972; the
+  detuned alternative, a smaller deflection weight, is stable only below 0.2 and scores
+  0.716). The reward's weights stay.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from baselines.policies import mpc_available
+
+from .lqg import DelayLQGPolicy
+from .model import rig_model
+from .mpc import ActuatorMPCPolicy
+
+__all__ = ["DESIGNS", "design_kwargs", "engineer_policies"]
+
+#: Design parameters by env id: ``weight`` (of the deflection term; 1: the reward),
+#: ``model_std`` (the filter's model error for every state), ``mode_std`` (mode number ->
+#: model error of that mode's two states, overriding it), ``load_std`` [N].
+DESIGNS: dict[str, dict] = {
+    "ACLDBeam-v0": {},
+    "ACLDBeam-v1": {"model_std": 0.0},
+    "ACLDBeamLab-v1": {"model_std": 0.0},
+    "ACLDBeamHard-v1": {"model_std": 0.03, "mode_std": {3: 1.0}, "load_std": 3.0},
+}
+
+
+def design_kwargs(nom, config) -> dict:
+    """The keyword arguments of the level's designs (:data:`DESIGNS` of
+    ``config.env_id``; none for an id without an entry): ``model_std`` as a vector over
+    the plant part's states where ``mode_std`` sets modes (the modal basis: mode i's
+    states are 2i - 2 and 2i - 1)."""
+    d = dict(DESIGNS.get(config.env_id, {}))
+    modes = d.pop("mode_std", None)
+    if modes:
+        if nom.basis != "modal":
+            raise ValueError(f"mode_std needs the modal basis, the design has {nom.basis!r}")
+        m = rig_model(nom, config)
+        mu = np.full(m.n_plant, float(d.get("model_std", config.model_std)))
+        if m.n_plant > nom.design.reduced.order:
+            mu[nom.design.reduced.order :] = 0.0  # the lag's state: no model error
+        for i, v in modes.items():
+            mu[2 * i - 2 : 2 * i] = v
+        d["model_std"] = mu
+    return d
+
+
+def engineer_policies(env) -> dict:
+    """The engineer's references of ``env``'s level (any wrapper of an ``ACLDBeamEnv``),
+    name -> policy with SB3's ``predict``: ``"lqg"`` (:class:`DelayLQGPolicy`) and, where
+    the QP solver osqp is installed, ``"mpc_rig"`` (:class:`ActuatorMPCPolicy`), both with
+    the level's design (:data:`DESIGNS`)."""
+    e = env.unwrapped
+    kw = design_kwargs(e.nom, e.config)
+    out = {"lqg": DelayLQGPolicy(e.nom, e.config, **kw)}
+    if mpc_available():
+        out["mpc_rig"] = ActuatorMPCPolicy(e.nom, e.config, **kw)
+    return out

@@ -25,9 +25,10 @@ import sys
 from pathlib import Path
 
 from acld_gym import ENV_ID
-from acld_gym.util.atomic import check_writable, write_text
+from acld_gym.util.atomic import check_writable
 from acld_gym.util.validate import arg_type
 
+from .agent_files import check_replaceable
 from .config import ALGOS, CONFIG_DIR, parse_load_case, read_config
 
 __all__ = ["main", "build_parser", "configure", "env_id_arg", "RECIPES", "MAX_SEED"]
@@ -173,6 +174,10 @@ def main(argv: list[str] | None = None) -> int:
         check_writable(out / "metadata.json", "--out")
     except ValueError as exc:
         parser.error(str(exc))
+    try:  # the agent replaces the folder whole: it may hold none of the user's files
+        check_replaceable(out)
+    except ValueError as exc:
+        parser.error(f"--out: {exc}")
     from .bench.evaluate import eval_episodes, lqr_ise
     from .bench.trials import run_trial, save_agent
     from .config import TrainConfig
@@ -200,8 +205,7 @@ def main(argv: list[str] | None = None) -> int:
         command=command,
         workers=args.cpus,  # train_algo takes at most one per run
     )
-    save_agent(policy, rec, out)
-    write_text(out / "trial.json", json.dumps(rec) + "\n")
+    save_agent(policy, rec, out, {"trial.json": json.dumps(rec) + "\n"})  # all or none
     episodes = eval_episodes(args.random_episodes)
     lqr = lqr_ise(args.env_id, episodes)
     rel = "  ".join(f"case {c}: {rec['final_ise'][str(c)] / lqr[c]:.3f}" for c in episodes)

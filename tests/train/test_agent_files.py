@@ -326,3 +326,19 @@ def test_a_disk_full_ship_leaves_the_old_agent_loadable_and_intact(tmp_path):
     (run / CURVE_FILE).write_text("timesteps,case,ise\n1000,1,1.0e-08\n")
     assert _ship_under_ulimit(run, agents, kib=1024).returncode == 0  # room now: shipped
     assert TrainedAgent.load(old).metadata["algo"] == "sac"
+
+
+def test_train_refuses_an_out_folder_with_other_files_before_training(tmp_path, capsys):
+    """``python -m train`` writes its agent folder whole (replacing it), so an ``--out``
+    holding the user's files is refused at once, not after the training."""
+    from train.cli import main as train_main
+
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    with pytest.raises(SystemExit) as exit_:
+        train_main(["vrs", "--seed", "0", "--out", str(out)])
+    assert exit_.value.code == 2
+    err = capsys.readouterr().err.splitlines()[-1]
+    assert "--out:" in err and "notes.txt" in err
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]

@@ -140,11 +140,14 @@ def policy_program(policy):
     raise TypeError(f"cannot export a {type(policy).__name__}")
 
 
-def save_agent(policy, rec: dict, directory: str | Path) -> Path:
+def save_agent(
+    policy, rec: dict, directory: str | Path, files: dict[str, str] | None = None
+) -> Path:
     """Save a trial's final policy as an agent directory (``policy.npz``,
     ``metadata.json`` with how it was trained -- ``"from scratch"`` unless the config has
     a teacher or controller knowledge --, the command, config, budget, times and the
-    observation fingerprint of the env it was trained on, and ``learning_curve.csv``)."""
+    observation fingerprint of the env it was trained on, ``learning_curve.csv`` and the
+    text ``files``), the folder written whole (:meth:`train.agent.TrainedAgent.save`)."""
     import gymnasium as gym
 
     from acld_gym.envs.fingerprint import observation_fingerprint
@@ -174,13 +177,12 @@ def save_agent(policy, rec: dict, directory: str | Path) -> Path:
         "observation": observation_fingerprint(probe),
     }
     probe.close()
-    d = TrainedAgent(policy_program(policy), meta, rec["algo"]).save(Path(directory))
     # its learning curve on the thesis cases and the random set, batched evaluations
     lines = ["timesteps,case,ise"] + [
         f"{p['steps']},{c},{ise!r}" for p in rec["curve"] for c, ise in p["ise"].items()
     ]
-    write_text(d / CURVE_FILE, "\n".join(lines) + "\n")
-    return d
+    texts = {CURVE_FILE: "\n".join(lines) + "\n", **(files or {})}
+    return TrainedAgent(policy_program(policy), meta, rec["algo"]).save(Path(directory), texts)
 
 
 def _tune_trainable(config: dict) -> None:  # pragma: no cover - runs inside Ray workers

@@ -30,7 +30,7 @@ import numpy as np
 
 from acld_gym.util.atomic import replace_dir
 
-from .agent_schema import AgentFileError
+from .agent_schema import AgentFileError, parse_metadata
 
 __all__ = [
     "MAX_METADATA_BYTES",
@@ -39,6 +39,8 @@ __all__ = [
     "REPLACEABLE",
     "AgentFolder",
     "read_arrays",
+    "read_metadata",
+    "curve_rows",
     "check_replaceable",
     "write_folder",
 ]
@@ -210,6 +212,39 @@ def read_arrays(data: bytes, needed: Iterable[str], where: str) -> dict[str, np.
         for info in infos:
             out[info.filename[: -len(".npy")]] = _read_member(archive, info, where)
     return out
+
+
+def read_metadata(path: str | Path) -> dict:
+    """The checked ``metadata.json`` of the agent folder ``path``
+    (:func:`train.agent_schema.parse_metadata`), read as :class:`AgentFolder` reads: for a
+    listing that needs the metadata only (which env, which mesh)."""
+    with AgentFolder(path) as folder:
+        data = folder.read("metadata.json", MAX_METADATA_BYTES)
+    return parse_metadata(data, str(Path(path) / "metadata.json"))
+
+
+def curve_rows(text: str, where: str) -> list[dict]:
+    """The rows of a ``learning_curve.csv`` (``timesteps,case,ise``) as
+    ``{"timesteps": int >= 0, "case": str, "ise": float >= 0}``; :class:`AgentFileError`
+    naming ``where`` and the line otherwise."""
+    lines = text.splitlines()
+    if not lines or [c.strip() for c in lines[0].split(",")] != ["timesteps", "case", "ise"]:
+        raise AgentFileError(f"{where}: expected the header 'timesteps,case,ise'")
+    rows = []
+    for i, line in enumerate(lines[1:], start=2):
+        parts = line.split(",")
+        try:
+            steps, case, ise = int(parts[0]), parts[1].strip(), float(parts[2])
+            ok = len(parts) == 3 and steps >= 0 and bool(case) and math.isfinite(ise) and ise >= 0
+        except (ValueError, IndexError):
+            ok = False
+        if not ok:
+            raise AgentFileError(
+                f"{where}: line {i}: expected timesteps (an integer >= 0), a case and an ISE "
+                f"(a finite number >= 0), got {_cut(line)!r}"
+            )
+        rows.append({"timesteps": steps, "case": case, "ise": ise})
+    return rows
 
 
 def _cut(name: str) -> str:

@@ -21,7 +21,7 @@ from pathlib import Path
 from acld_gym.physics.loads import THESIS_CASES
 
 from .agent import CURVE_FILE, TrainedAgent
-from .agent_files import check_replaceable
+from .agent_files import check_replaceable, curve_rows
 from .agent_schema import is_real
 from .compare import AGENTS_DIR
 
@@ -91,6 +91,8 @@ def ship(
     check_name(name)
     agent = TrainedAgent.load(run, check=False)
     curve = agent.learning_curve()
+    if curve is not None:
+        curve_rows(curve, str(Path(run) / CURVE_FILE))
     dst = Path(agents_dir) / name
     if os.path.lexists(dst) and not force:
         raise FileExistsError(

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from train.agent import CURVE_FILE, META_FILE, POLICY_FILE, AgentFileError, TrainedAgent
-from train.agent_files import check_replaceable
+from train.agent_files import check_replaceable, curve_rows, read_metadata
 from train.compare import AGENTS_DIR
 from train.ship import main as ship_main
 from train.ship import ship
@@ -342,3 +342,26 @@ def test_train_refuses_an_out_folder_with_other_files_before_training(tmp_path, 
     err = capsys.readouterr().err.splitlines()[-1]
     assert "--out:" in err and "notes.txt" in err
     assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
+
+
+def test_curves_and_metadata_read_for_listings_are_checked(tmp_path):
+    """``curve_rows`` reads every shipped curve as the csv module does and names a bad
+    line; ``read_metadata`` checks as ``load`` does; ``ship`` refuses a damaged curve."""
+    import csv
+
+    for name in ("ppo", "sac", "vrs"):
+        text = (AGENTS_DIR / name / CURVE_FILE).read_text()
+        rows = curve_rows(text, name)
+        ref = list(csv.DictReader(text.splitlines()))
+        assert [(r["timesteps"], r["case"], r["ise"]) for r in rows] == [
+            (int(r["timesteps"]), r["case"], float(r["ise"])) for r in ref
+        ]
+        assert read_metadata(AGENTS_DIR / name)["algo"] == name
+    d, _ = _evil(tmp_path)
+    with pytest.raises(AgentFileError, match="env.id must be one of"):
+        read_metadata(d)
+    run = _copy("sac", tmp_path / "run")
+    (run / CURVE_FILE).write_text("timesteps,case,ise\n1000,1,1e-8\n1000,2,nan\n")
+    with pytest.raises(AgentFileError, match=rf"{CURVE_FILE}: line 3: expected timesteps"):
+        ship(run, "mine", tmp_path / "agents")
+    assert not (tmp_path / "agents").exists()

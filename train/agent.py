@@ -42,6 +42,7 @@ from .agent_files import (
     MAX_POLICY_BYTES,
     AgentFolder,
     read_arrays,
+    read_files,
     write_folder,
 )
 from .agent_schema import FORMAT, AgentFileError, check_ops, parse_metadata
@@ -331,9 +332,8 @@ class TrainedAgent:
         machine; a mismatch raises :class:`AgentFileError` saying what differs.
         """
         d = Path(directory)
-        with AgentFolder(d) as folder:
-            meta_bytes = folder.read(META_FILE, MAX_METADATA_BYTES)
-            policy_bytes = folder.read(POLICY_FILE, _MAX_ARCHIVE_BYTES)
+        files = read_files(d, {META_FILE: MAX_METADATA_BYTES, POLICY_FILE: _MAX_ARCHIVE_BYTES})
+        meta_bytes, policy_bytes = files[META_FILE], files[POLICY_FILE]
         meta = parse_metadata(meta_bytes, str(d / META_FILE))
         ops = [dict(op) for op in meta["actor"]]
         arrays = read_arrays(policy_bytes, ActorProgram.needed_arrays(ops), str(d / POLICY_FILE))

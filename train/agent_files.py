@@ -38,6 +38,7 @@ __all__ = [
     "MAX_CURVE_BYTES",
     "REPLACEABLE",
     "AgentFolder",
+    "read_files",
     "read_arrays",
     "read_metadata",
     "curve_rows",
@@ -112,6 +113,18 @@ class AgentFolder:
             os.close(self.fd)
             self.fd = None
 
+    def replaced(self) -> bool:
+        """Whether ``path`` no longer names the folder opened (it was swapped or removed
+        since: a ship writing it whole)."""
+        if self.fd is None:
+            return False
+        try:
+            now = os.stat(self.path, follow_symlinks=False)
+        except OSError:
+            return True
+        opened = os.fstat(self.fd)
+        return (now.st_dev, now.st_ino) != (opened.st_dev, opened.st_ino)
+
     def exists(self, name: str) -> bool:
         """Whether the folder has an entry ``name`` (a link counts; :meth:`read` refuses it)."""
         try:
@@ -169,6 +182,21 @@ class AgentFolder:
         if len(data) > now.st_size:
             raise AgentFileError(f"{where}: changed while it was read")
         return data
+
+
+def read_files(path: str | Path, limits: dict[str, int], attempts: int = 3) -> dict[str, bytes]:
+    """The bytes of the files ``limits`` names (name: size limit) of the agent folder
+    ``path``, all from one folder: read through one descriptor of it, and read again
+    from the start if the folder was replaced meanwhile and a file of the old one was
+    gone (a ship swapping in a new agent), so a reader gets the old agent or the new one."""
+    for attempt in range(attempts):
+        with AgentFolder(path) as folder:
+            try:
+                return {name: folder.read(name, limit) for name, limit in limits.items()}
+            except AgentFileError:
+                if attempt + 1 == attempts or not folder.replaced():
+                    raise
+    raise AssertionError("unreachable")  # pragma: no cover
 
 
 def read_arrays(data: bytes, needed: Iterable[str], where: str) -> dict[str, np.ndarray]:

@@ -365,3 +365,37 @@ def test_curves_and_metadata_read_for_listings_are_checked(tmp_path):
     with pytest.raises(AgentFileError, match=rf"{CURVE_FILE}: line 3: expected timesteps"):
         ship(run, "mine", tmp_path / "agents")
     assert not (tmp_path / "agents").exists()
+
+
+def test_a_reader_sees_the_old_agent_or_the_new_one_never_a_mix(tmp_path):
+    """Ships alternate ``vrs`` and ``sac`` onto one name while another thread loads it:
+    every load has the weights of the agent its metadata names, and none fails."""
+    import threading
+
+    runs = {n: _copy(n, tmp_path / n) for n in ("vrs", "sac")}
+    weights = {n: _arrays(d)["W0"] for n, d in runs.items()}
+    agents = tmp_path / "agents"
+    ship(runs["vrs"], "mine", agents)
+    done = threading.Event()
+    seen, errors = [], []
+
+    def read():
+        while not done.is_set():
+            try:
+                agent = TrainedAgent.load(agents / "mine", check=False)
+            except Exception as exc:  # noqa: BLE001 (any failure is the finding)
+                errors.append(exc)
+                continue
+            algo = agent.metadata["algo"]
+            seen.append((algo, np.array_equal(agent.actor.arrays["W0"], weights[algo])))
+
+    reader = threading.Thread(target=read)
+    reader.start()
+    try:
+        for i in range(40):
+            ship(runs["sac" if i % 2 == 0 else "vrs"], "mine", agents, force=True)
+    finally:
+        done.set()
+        reader.join()
+    assert errors == []
+    assert len({algo for algo, _ in seen}) == 2 and all(same for _, same in seen)

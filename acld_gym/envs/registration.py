@@ -36,10 +36,11 @@ _MAKERS = (_gym_registration.make.__code__, _gym_registration.make_vec.__code__)
 
 class RegisteredSpec(EnvSpec):
     """An :class:`gymnasium.envs.registration.EnvSpec` whose ``max_episode_steps`` is the
-    step count of the episodes its ``kwargs`` give (:func:`acld_gym.envs.presets.
-    kwargs_steps`: 1000 for a registered id; a ``make_vec`` env's spec carries the keywords
-    it was made with) for every reader except gymnasium's ``make`` and ``make_vec``, which
-    see the spec's own limit (None for a registered id: the env truncates itself)."""
+    step count of the episodes its ``kwargs`` give
+    (:func:`acld_gym.envs.presets.kwargs_steps`: 1000 for a registered id; a ``make_vec``
+    env's spec carries the keywords it was made with) for every reader except gymnasium's
+    ``make`` and ``make_vec``, which see the spec's own limit (None for a registered id: the
+    env truncates itself)."""
 
     @property
     def max_episode_steps(self) -> int | None:

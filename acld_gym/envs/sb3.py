@@ -172,8 +172,8 @@ class SB3VecEnv(VecEnv):
         """Set an attribute of the (shared) vector env, validated now: ``load_case`` (takes
         effect at the next reset) is the one meant to change; anything else that the env
         validates at construction is refused rather than left to fail later. The vector env
-        checks ``load_case`` as its constructor does (:func:`acld_gym.envs.conflicts.
-        check_case`)."""
+        checks ``load_case`` as its constructor does
+        (:func:`acld_gym.envs.conflicts.check_case`)."""
         idx = self._indices(indices)
         if idx != list(range(self.num_envs)):
             raise ValueError("SB3VecEnv: attributes are shared; set them for all sub-envs")

@@ -357,9 +357,8 @@ def main(argv: list[str] | None = None) -> int:
     if config.mesh == "thesis":
         print(format_thesis_comparison(rows))
     mesh = {} if args.mesh is None else {"mesh": args.mesh}  # (every id has a test set)
-    scores = add_scores(
-        policies, args.score_episodes, mesh, args.quiet, labels=labels, env_id=args.env_id
-    )
+    # (the kinds are the legend's: a column of words would split the table's numbers)
+    scores = add_scores(policies, args.score_episodes, mesh, args.quiet, env_id=args.env_id)
     if args.json:
         write_json(
             args.json,

@@ -18,7 +18,7 @@ tables of :mod:`baselines.evaluate` and :mod:`baselines.analyze` show
 
 from __future__ import annotations
 
-__all__ = ["KINDS", "ENGINEER", "level_references", "mark_labels"]
+__all__ = ["KINDS", "ENGINEER", "level_references", "marks_for", "mark_labels"]
 
 #: What each reference is, by name (the "what it is" column of the tables).
 KINDS = {
@@ -40,15 +40,22 @@ def level_references(env) -> dict:
     designs (:func:`baselines.engineer.engineer_policies`) and, where the QP solver osqp is
     installed, the plant oracle ``mpc_oracle``. The bound is not a policy: the tables add
     it."""
-    from .engineer import engineer_policies
     from .evaluate import policies_for
+
+    return {**policies_for(env), **marks_for(env)}
+
+
+def marks_for(env) -> dict:
+    """The engineer's designs of ``env``'s level and, where osqp is installed, the plant
+    oracle ``mpc_oracle``: the marks :func:`level_references` adds to the thesis's."""
+    from .engineer import engineer_policies
     from .policies import mpc_available
 
-    out = {**policies_for(env), **engineer_policies(env)}
+    out = engineer_policies(env)
     if mpc_available():
         from .oracle import PlantOracleMPC
 
-        out["mpc_oracle"] = PlantOracleMPC()
+        out[PlantOracleMPC.name] = PlantOracleMPC()
     return out
 
 

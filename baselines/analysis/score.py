@@ -220,8 +220,8 @@ def format_scores(scores: dict[str, Score], labels: dict | None = None) -> str:
         else f", the first of its {full}: a reduced score, not the published one"
     )
     head = (
-        f"\n{SCORE_NAME} on {first.test_set} ({first.n_episodes} random loads{reduced}; "
-        "passive 0, clairvoyant bound 1): IQM of (ISE_passive - ISE) / (ISE_passive - "
+        f"\nscore on {first.test_set} ({SCORE_NAME}: {first.n_episodes} random loads"
+        f"{reduced}; passive 0, clairvoyant bound 1): IQM of (ISE_passive - ISE) / (ISE_passive - "
         "ISE_bound), 95 % bootstrap CI; the last column is the thesis-facing one"
     )
     width = 12 if labels is None else max(12, *(len(str(v)) for v in labels.values()))

@@ -51,7 +51,7 @@ def test_cli_writes_json_with_issue_keys(tmp_path, capsys):
     assert score["passive"] == 0.0 and score["bound"] == 1.0 and 0 < score["lqr"] < 1
     assert {r["score"]["version"] for r in rows} == {2}
     out = capsys.readouterr().out
-    assert "score v2 on ACLDBeam-v1/test-v1 (3 random loads" in out and "TV [kV/s]" in out
+    assert "score on ACLDBeam-v1/test-v1 (score v2: 3 random loads" in out and "TV [kV/s]" in out
     assert "lqr, smc = thesis, delay-free" in out and "mpc_oracle = plant oracle" in out
 
 
@@ -118,6 +118,6 @@ def test_evaluate_takes_any_registered_id(capsys):
     assert main(["--env-id", "ACLDBeamHard-v1", "--score-episodes", "2", "--quiet"]) == 0
     out = capsys.readouterr().out
     assert out.count("load case") == 3 and out.count("bound") >= 3
-    assert "score v2 on ACLDBeamHard-v1/test-v1 (2 random loads" in out
+    assert "score on ACLDBeamHard-v1/test-v1 (score v2: 2 random loads" in out
     for name in ("lqg", "mpc_oracle"):  # the three marks on the hard level too
         assert sum(line.split()[0] == name for line in out.splitlines() if line.strip()) == 7

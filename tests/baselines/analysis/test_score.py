@@ -79,7 +79,7 @@ def test_passive_scores_zero_and_the_bounds_replay_one_on_every_level(env_id):
     # the commands are the env's float32: the tip follows to ~1e-7 of the gap
     np.testing.assert_allclose(scores["bound_replay"].scores, 1.0, atol=1e-6)
     text = format_scores(scores)
-    assert f"score v{SCORE_VERSION} on {env_id}/test-v1" in text and "passive 0" in text
+    assert f"score on {env_id}/test-v1 (score v{SCORE_VERSION}:" in text and "passive 0" in text
 
 
 def test_replaying_the_bounds_voltages_open_loop_scores_one(refs5):

@@ -127,16 +127,16 @@ def check_consistent(config) -> None:
 def check_config_keywords(config, kwargs: dict) -> None:
     """``ValueError`` if ``kwargs`` carry a registered id's settings (``env_id`` among
     them, as ``gym.make(id, config=config)`` passes them) that would replace different
-    values of ``config``. Keywords without ``env_id`` replace the config's fields as
-    documented (:func:`acld_gym.envs.config.make_config`)."""
+    values of ``config`` (its ``env_id`` becomes the id's). Keywords without ``env_id``
+    replace the config's fields as documented (:func:`acld_gym.envs.config.make_config`)."""
     if config is None or "env_id" not in kwargs:
         return
     env_id = check_env_id(kwargs["env_id"])
     fields = PRESETS[env_id]
-    replaced = [
+    replaced = [  # env_id itself is the made id's (made_spec): the config takes it
         f
         for f, value in fields.items()
-        if f in kwargs and kwargs[f] == value and getattr(config, f) != value
+        if f != "env_id" and f in kwargs and kwargs[f] == value and getattr(config, f) != value
     ]
     if replaced:
         theirs = ", ".join(f"{f}={getattr(config, f)!r}" for f in replaced)

@@ -1,6 +1,8 @@
 """The registered configurations: every id is a set of :class:`acld_gym.envs.config.EnvConfig`
 fields, registered as the spec's ``kwargs`` (``gym.spec(id).kwargs`` shows them; keyword
-arguments of ``gym.make`` replace them). This module imports nothing heavy, so that
+arguments of ``gym.make`` replace them, and a keyword that one of them would silently
+override is refused: :mod:`acld_gym.envs.conflicts`), with its episode's step count as
+``gym.spec(id).max_episode_steps``. This module imports nothing heavy, so that
 ``import acld_gym`` stays light.
 
 * ``ACLDBeam-v1``: the defaults (the mesh-converged beam).

@@ -213,6 +213,9 @@ def test_a_config_under_a_presets_settings_is_refused_and_a_matching_one_honoure
     assert _makers(HARD)[how](config=cfg, lam=0.2).unwrapped.config == cfg.replace(lam=0.2)
     # outside the registry, keywords still replace a config's fields (documented)
     assert ACLDBeamEnv(config=cfg, actuator_delay=0).config == cfg.replace(actuator_delay=0)
+    # a config that carries the id's settings takes the id it is made as
+    lab = _makers("ACLDBeamLab-v1")[how](config=preset(HARD)).unwrapped.config
+    assert lab == preset(HARD).replace(env_id="ACLDBeamLab-v1")
 
 
 #: Values a user might pass beside a preset's settings (each field's own, valid alone).
@@ -252,8 +255,8 @@ def test_whatever_is_accepted_is_what_was_asked(env_id, user, config, name_it):
     if c.mesh != tied.get("mesh", "converged"):
         assert all(getattr(c, f) != tied[f] for f in MESH_TIED if f in tied)
     if own is not None and "env_id" in fields:
-        for f, value in fields.items():
-            assert f in user or getattr(own, f) == value, f
+        for f, value in fields.items():  # the env_id is the made id's
+            assert f in user or f == "env_id" or getattr(own, f) == value, f
 
 
 # --- loads the integration cannot resolve --------------------------------------------------

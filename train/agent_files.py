@@ -204,6 +204,8 @@ def read_arrays(data: bytes, needed: Iterable[str], where: str) -> dict[str, np.
     actor program's), as float64; checked (module docstring) before any member's data is
     decompressed. :class:`AgentFileError` naming ``where`` and the member otherwise."""
     needed = sorted(set(needed))
+    if data.count(b"PK\x01\x02") > 16 * MAX_MEMBERS:  # before zipfile builds every entry
+        raise AgentFileError(f"{where}: more than {MAX_MEMBERS} members")
     try:
         archive = zipfile.ZipFile(io.BytesIO(data))
         infos = archive.infolist()

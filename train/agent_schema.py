@@ -57,6 +57,8 @@ _FINGERPRINT_ARRAYS = {
     "observer_Lc": 1,
     "observer_Lp": 1,
 }
+#: Longest label text (``algo``, ``training``, ...) a metadata file may hold.
+MAX_TEXT = 200
 #: Optional text entries (the package reads them for labels).
 _TEXT_FIELDS = ("algo", "training", "teacher", "checkpoint")
 
@@ -145,10 +147,14 @@ def check_metadata(meta, where: str = "metadata.json") -> dict:
     _check_env(meta["env"], where)
     _check_observation(meta["observation"], meta["env"]["id"], where)
     check_ops(meta["actor"], where)
-    for key in _TEXT_FIELDS:
+    for key in _TEXT_FIELDS:  # printed in tables: one printable line
         value = meta.get(key)
-        if value is not None and not isinstance(value, str):
-            raise _fail(where, key, f"expected a string or null, got {_short(value)}")
+        if value is not None and not (
+            isinstance(value, str) and value.isprintable() and len(value) <= MAX_TEXT
+        ):
+            raise _fail(
+                where, key, f"expected null or one printable line of text, got {_short(value)}"
+            )
     if meta.get("residual") not in (None, "lqr"):
         raise _fail(where, "residual", f"expected null or 'lqr', got {_short(meta['residual'])}")
     if "action_headroom" in meta:

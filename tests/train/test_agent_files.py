@@ -195,6 +195,15 @@ def test_missing_extra_and_damaged_members_are_named(tmp_path):
         TrainedAgent.load(d, check=False)
 
 
+def test_an_archive_listing_thousands_of_members_is_refused(tmp_path):
+    d = _copy("vrs", tmp_path / "a")
+    with zipfile.ZipFile(d / POLICY_FILE, "a") as z:
+        for i in range(5000):
+            z.writestr(f"m{i}", b"")
+    with pytest.raises(AgentFileError, match=rf"{POLICY_FILE}: more than 256 members"):
+        TrainedAgent.load(d, check=False)
+
+
 # --- malformed metadata: one error naming the file and the field ----------------------------
 def _deep(n: int) -> str:
     return '{"actor": ' + "[" * n + "]" * n + "}"
@@ -231,7 +240,8 @@ MALFORMED = [
     ),
     (lambda m: {**m, "format": 99}, "format: expected an agent format 1 to 2"),
     (lambda m: {**m, "residual": "mpc"}, "residual: expected null or 'lqr'"),
-    (lambda m: {**m, "algo": ["x"]}, "algo: expected a string or null"),
+    (lambda m: {**m, "algo": ["x"]}, "algo: expected null or one printable line"),
+    (lambda m: {**m, "training": "ok\x1b[2J"}, "training: expected null or one printable"),
     (lambda m: json.dumps(m).replace('"seed": 0', '"seed": NaN'), "not valid JSON"),
     (lambda m: json.dumps(m).replace('"seed": 0', '"seed": ' + "9" * 5000), "not valid JSON"),
     (lambda m: {**m, "action_headroom": 10**400}, "action_headroom: expected a number"),

@@ -62,7 +62,7 @@ from .bench.trials import (
     trial_path,
 )
 from .cli import MAX_SEED, env_id_arg
-from .config import CONFIG_DIR, TrainConfig, read_config
+from .config import CONFIG_DIR, TrainConfig, config_path, read_config
 from .config_checks import check_buildable
 
 __all__ = [
@@ -256,15 +256,15 @@ def main(argv: list[str] | None = None) -> int:
         parser.error('Ray Tune is not installed: pip install -e ".[sweep]" (or --backend local)')
     specs = list(args.algos or ([] if args.config else DEFAULT_ALGOS)) + list(args.config)
     try:
-        configs = [read_config(s) for s in specs]
+        configs = [(config_path(s), *read_config(s)) for s in specs]
     except (OSError, ValueError) as exc:
         parser.error(str(exc))
-    names = [name for name, _ in configs]
+    names = [name for _, name, _ in configs]
     if len(set(names)) != len(names):
         parser.error(f"two configs of one name would share their trials: {names}")
     out = Path(args.out)
     planned = []
-    for name, data in configs:
+    for path, name, data in configs:
         data = dict(data)
         if args.timesteps is not None:
             data["timesteps"] = args.timesteps
@@ -273,7 +273,7 @@ def main(argv: list[str] | None = None) -> int:
         try:  # with the command line's overrides, every section, before any computing
             check_buildable(TrainConfig.from_dict(data), args.env_id)
         except (TypeError, ValueError) as exc:
-            parser.error(f"{name}: {exc}")
+            parser.error(f"{path} (with the command line's overrides): {exc}")
         for seed in args.seeds:
             planned.append(
                 {

@@ -29,7 +29,7 @@ from acld_gym.util.atomic import check_writable
 from acld_gym.util.validate import arg_type
 
 from .agent_files import check_replaceable
-from .config import ALGOS, CONFIG_DIR, parse_load_case, read_config
+from .config import ALGOS, CONFIG_DIR, config_path, parse_load_case, read_config
 
 __all__ = ["main", "build_parser", "configure", "env_id_arg", "RECIPES", "MAX_SEED"]
 
@@ -156,7 +156,10 @@ def configure(args: argparse.Namespace) -> tuple[str, dict]:
         cfg = TrainConfig.from_dict(data)
     except ValueError as exc:
         raise ValueError(f"the command line's overrides: {exc}") from None
-    check_buildable(cfg, args.env_id)  # every setting the algorithm reads, before training
+    try:  # every setting the algorithm reads, before training
+        check_buildable(cfg, args.env_id)
+    except ValueError as exc:
+        raise ValueError(f"{config_path(args.config or args.algo)}: {exc}") from None
     return name, data
 
 

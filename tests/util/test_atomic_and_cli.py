@@ -48,9 +48,50 @@ def test_file_size_limit_midway_keeps_the_previous_result(tmp_path):
         preexec_fn=_limit_file_size,
         cwd=ROOT,
     )
-    assert out.returncode != 0  # the JSON (several KB) cannot be written
+    assert out.returncode == 1  # the JSON (several KB) cannot be written
+    lines = out.stderr.strip().splitlines()  # one line naming the file, no traceback
+    assert len(lines) == 1 and lines[0].startswith(f"acld-gym: error: {path}: "), out.stderr
     assert json.loads(path.read_text()) == {"previous": "result"}
     assert sorted(p.name for p in tmp_path.iterdir()) == ["model.json"]
+
+
+def test_run_main_turns_a_failed_file_operation_into_one_line(tmp_path, capsys):
+    """An OSError with its file (an open that fails) and one without (a write to an open
+    file on a full disk, where the writer's ``path`` names it); a damaged input file."""
+    from acld_gym.util.atomic import write_text
+    from acld_gym.util.validate import DataFileError, run_main
+
+    def unreadable():
+        return len((tmp_path / "missing.json").read_text())
+
+    target = tmp_path / "out.md"
+
+    def full_disk():
+        def write(fh):
+            raise OSError(28, "No space left on device")
+
+        return write_atomic(target, write)
+
+    def damaged():
+        raise DataFileError(f"{tmp_path / 'r.json'}: algorithms: expected a mapping")
+
+    assert run_main(unreadable, "cmd") == 1
+    assert (
+        capsys.readouterr().err
+        == f"cmd: error: {tmp_path / 'missing.json'}: No such file or directory\n"
+    )
+    assert run_main(full_disk, "cmd") == 1
+    assert capsys.readouterr().err == f"cmd: error: {target}: No space left on device\n"
+    assert not target.exists() and list(tmp_path.iterdir()) == []
+    assert run_main(damaged, "cmd") == 2
+    assert (
+        capsys.readouterr().err
+        == f"cmd: error: {tmp_path / 'r.json'}: algorithms: expected a mapping\n"
+    )
+    write_text(target, "ok")
+    assert run_main(lambda: 0, "cmd") == 0 and capsys.readouterr().err == ""
+    with pytest.raises(ZeroDivisionError):  # a bug is not an input error: its traceback stays
+        run_main(lambda: 1 / 0, "cmd")
 
 
 @pytest.mark.parametrize(

@@ -118,7 +118,7 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
       in the new state or reward; ``info["terminated_by"]`` says which
       (``"deflection_limit"``, ``"non_finite_state"``; None otherwise).
     * ``truncated``: after ``episode_length`` seconds, ``round(episode_length / dt)``
-      steps (1 s = 1000 steps by default; ``gym.spec(id).max_episode_steps``, and
+      steps (1000 by default, ``gym.spec(id).max_episode_steps``; a made env's count is
       ``env.spec.max_episode_steps``); ``gym.make`` adds no limit of its own, and its
       ``max_episode_steps=n`` only shortens the episode (a longer n is refused).
     * Limits: at most 1,000,000 steps per episode (``config.MAX_EPISODE_STEPS``) and

@@ -46,7 +46,7 @@ import sys
 import time
 from pathlib import Path
 
-from acld_gym.util.atomic import check_directory, check_writable, write_text
+from acld_gym.util.atomic import check_directory, check_writable, write_text, write_texts
 from acld_gym.util.validate import DataFileError, arg_type, run_main
 
 from .bench.evaluate import DEFAULT_ENV_ID
@@ -323,8 +323,10 @@ def main(argv: list[str] | None = None) -> int:
         f"reused); the runs' own wall times (training and "
         f"evaluation) add up to {runs_wall:.0f} s.\n"
     )
-    write_text(out / "results.md", text)
-    write_text(out / "results.json", json.dumps(summary, indent=1) + "\n")
+    # the tables both or neither (a full disk: the previous pair stays), then the figure
+    write_texts(
+        {out / "results.md": text, out / "results.json": json.dumps(summary, indent=1) + "\n"}
+    )
     plot_curves(summary, out / "learning_curves.png")
     print(text)
     print(f"wrote {out}/results.md, results.json, learning_curves.png, trials/")

@@ -15,6 +15,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from acld_gym.util.atomic import check_directory
 from acld_gym.util.validate import arg_type, run_main
 
 from .cli import MAX_SEED, RECIPES
@@ -100,10 +101,8 @@ def build_parser() -> argparse.ArgumentParser:
 def check_args(args: argparse.Namespace) -> None:
     """``ValueError`` naming the argument unless the sweep can run: distinct seeds and
     learning rates, the recipe with every override of the grid valid and buildable
-    (:func:`train.config_checks.check_buildable`), ``--out`` a usable directory. Nothing is
-    computed, Ray not started."""
-    from acld_gym.util.atomic import check_directory
-
+    (:func:`train.config_checks.check_buildable`), ``--out`` not a file (its directory is
+    checked, and made, once Ray is there). Nothing is computed, Ray not started."""
     from .config import TrainConfig, read_config
     from .config_checks import check_buildable
 
@@ -119,7 +118,9 @@ def check_args(args: argparse.Namespace) -> None:
         except ValueError as exc:
             raise ValueError(f"--timesteps / --learning-rates: {exc}") from None
     check_buildable(cfg)
-    check_directory(args.out, "--out")
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"--out: {str(out)!r} exists and is not a directory")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -135,6 +136,10 @@ def main(argv: list[str] | None = None) -> int:
         from train.bench.trials import init_ray
     except ImportError:
         parser.error('Ray Tune is not installed: pip install -e ".[sweep]"')
+    try:
+        check_directory(args.out, "--out")
+    except ValueError as exc:
+        parser.error(str(exc))
     init_ray(args.address, args.num_cpus)
     space = {
         "algo": args.algo,

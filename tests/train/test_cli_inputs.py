@@ -210,3 +210,34 @@ def test_resume_says_a_damaged_record_in_one_line(tmp_path, capsys, no_computing
     said = capsys.readouterr().out.splitlines()
     assert any(str(rec) in line and "not valid JSON" in line and "again" in line for line in said)
     assert rec.read_text() == '{"name": "vrs", "se'  # nothing rewritten by a refused run
+
+
+@pytest.mark.parametrize(
+    "argv, word",
+    [
+        (["vrs", "--learning-rates", "0.1"], "learning_rate"),  # vrs has none
+        (["ppo", "--seeds", "3", "3"], "--seeds"),
+        (["ppo", "--learning-rates", "0.1", "0.1"], "--learning-rates"),
+        (["ppo", "--learning-rates", "nan"], "--learning-rates"),
+        (["ppo", "--learning-rates", "2"], "--learning-rates"),
+        (["ppo", "--seeds", "99999999999"], "--seeds"),
+    ],
+)
+def test_sweep_validates_before_starting_ray(argv, word, capsys, monkeypatch, no_computing):
+    from train.sweep import main as sweep_main
+
+    def forbidden(*args, **kwargs):
+        raise AssertionError("Ray started before the input was validated")
+
+    monkeypatch.setattr(trials, "init_ray", forbidden)
+    _refused(sweep_main, argv, capsys, word)
+
+
+def test_sweep_refuses_an_out_that_is_a_file(tmp_path, capsys, monkeypatch, no_computing):
+    from train.sweep import main as sweep_main
+
+    blocker = tmp_path / "file"
+    blocker.write_text("keep")
+    monkeypatch.setattr(trials, "init_ray", lambda *a: pytest.fail("Ray started"))
+    _refused(sweep_main, ["vrs", "--out", str(blocker)], capsys, "--out")
+    assert blocker.read_text() == "keep"

@@ -45,12 +45,12 @@ DESIGNS: dict[str, dict] = {
 }
 
 
-def design_kwargs(nom, config) -> dict:
-    """The keyword arguments of the level's designs (:data:`DESIGNS` of
+def design_kwargs(nom, config, design: dict | None = None) -> dict:
+    """The keyword arguments of a design (default: the level's, :data:`DESIGNS` of
     ``config.env_id``; none for an id without an entry): ``model_std`` as a vector over
     the plant part's states where ``mode_std`` sets modes (the modal basis: mode i's
     states are 2i - 2 and 2i - 1)."""
-    d = dict(DESIGNS.get(config.env_id, {}))
+    d = dict(DESIGNS.get(config.env_id, {}) if design is None else design)
     modes = d.pop("mode_std", None)
     if modes:
         if nom.basis != "modal":

@@ -25,7 +25,7 @@ from acld_gym.util.stats import iqm
 from .loop import env_plant, spectral_radius
 from .lqg import DelayLQGPolicy
 
-__all__ = ["TRAINING_SEEDS", "RADIUS_MARGIN", "episode_ise", "search"]
+__all__ = ["TRAINING_SEEDS", "RADIUS_MARGIN", "episode_ise", "search", "grid"]
 
 #: The search's episodes: far from the test sets' reserved block and model selection's
 #: seeds (:mod:`acld_gym.benchmark`).
@@ -67,26 +67,34 @@ def _anchors(env, seeds) -> tuple[np.ndarray, np.ndarray]:
     return np.array(pas), np.array(bnd)
 
 
-def search(env, weights, model_stds, load_stds, n_episodes: int = 40, n_plants: int = 100):
-    """Each candidate's training score and worst spectral radius, best admissible first:
-    a list of ``(iqm, radius, {"weight", "model_std", "load_std"})``. ``env`` is the
-    level's env with ``load_case="random"``."""
+def search(env, candidates, n_episodes: int = 40, n_plants: int = 100) -> list:
+    """Each candidate design's training score and worst spectral radius, the admissible
+    ones first, best first: a list of ``(iqm, radius, design)``. ``env`` is the level's
+    env with ``load_case="random"``; a design is a dict of :data:`~baselines.engineer.
+    designs.DESIGNS`' form."""
+    from .designs import design_kwargs
+
     e = env.unwrapped
     seeds = list(TRAINING_SEEDS)[:n_episodes]
     pas, bnd = _anchors(env, seeds)
     plants = []
-    if e.config.randomized:
-        for s in list(TRAINING_SEEDS)[:n_plants]:
-            env.reset(seed=s)
-            plants.append(env_plant(env))
-    else:
-        env.reset(seed=seeds[0])
+    for s in list(TRAINING_SEEDS)[: n_plants if e.config.randomized else 1]:
+        env.reset(seed=s)
         plants.append(env_plant(env))
     out = []
-    for w, ms, ls in itertools.product(weights, model_stds, load_stds):
-        design = {"weight": w, "model_std": ms, "load_std": ls}
-        pol = DelayLQGPolicy(e.nom, e.config, **design)
+    for design in candidates:
+        pol = DelayLQGPolicy(e.nom, e.config, **design_kwargs(e.nom, e.config, design))
         radius = max(spectral_radius(pol, *p) for p in plants)
         ise = np.array([episode_ise(pol, env, s) for s in seeds])
         out.append((iqm((pas - ise) / (pas - bnd)), radius, design))
     return sorted(out, key=lambda r: (r[1] > RADIUS_MARGIN, -r[0]))
+
+
+def grid(**values) -> list[dict]:
+    """The candidate designs of every combination of ``values`` (name -> list), e.g.
+    ``grid(model_std=[0, 0.03], load_std=[1, 3])``; a None value leaves the key out."""
+    names = list(values)
+    return [
+        {k: v for k, v in zip(names, combo, strict=True) if v is not None}
+        for combo in itertools.product(*(values[k] for k in names))
+    ]

@@ -83,3 +83,33 @@ def test_hard_stable_on_test_set_plants(level_env):
 def test_hard_stable_on_every_test_set_plant(level_env):
     worst = _hard_test_set_radii(level_env, 100)
     assert all(r < 1.0 for r in worst.values()), worst
+
+
+def test_filter_fed_the_voltage_that_reaches_the_amplifier(level_env):
+    """With a slew limit that binds (10 V per period) and a delay of 2, the voltage the
+    policy feeds its filter is the one the env applies, period by period, and the MPC's
+    commands respect the rate constraint."""
+    env = level_env(
+        "ACLDBeamLab-v1",
+        load_case=1,
+        actuator_delay=2,
+        slew_rate=1e4,
+        amplifier_bandwidth=None,
+        sensor_noise=0.0,
+    )
+    step = env.unwrapped.config.slew_step
+    for name, pol in engineer_policies(env).items():
+        obs, _ = env.reset(seed=0)
+        state, start, applied, fed, cmds = None, np.ones(1, bool), [], [], []
+        for _ in range(20):
+            a, state = pol.predict(obs, state=state, episode_start=start)
+            start = np.zeros(1, bool)
+            obs, _, _, _, info = env.step(a)
+            cmds.append(float(a[0]))
+            applied.append(float(info["voltage"]))
+            fed.append(float(state[0, -1]))
+        np.testing.assert_allclose(fed, applied, rtol=1e-12, atol=1e-9)
+        assert np.abs(np.diff(applied)).max() <= step * (1 + 1e-9)
+        assert np.abs(np.diff(applied)).max() > 0.5 * step, name  # the limit binds
+        if name == "mpc_rig":
+            assert np.abs(np.diff(cmds)).max() <= step * (1 + 1e-3) + 1e-3

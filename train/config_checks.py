@@ -94,14 +94,19 @@ def check_buildable(cfg, env_id: str | None = None) -> None:
     :func:`train.vec.make_vec_env`, with the whitening's first-layer check; ``vrs``: its
     settings) and drop it: ``ValueError`` naming the setting a constructor refuses. A
     second or two, no env step; call it before computing anything."""
-    if cfg.algo == "vrs":
-        return  # RandomSearch is built by check_model; its env is the training env's options
     import acld_gym
 
+    env_id = env_id or acld_gym.ENV_ID
+    if cfg.algo == "vrs":  # RandomSearch is built by check_model; here its envs, one each
+        _check_envs(cfg, env_id)
+        return
     from .bench.sb3_train import first_linear, make_model
     from .vec import make_vec_env
 
-    venv = make_vec_env(cfg, 0, env_id or acld_gym.ENV_ID)
+    try:
+        venv = make_vec_env(cfg, 0, env_id)
+    except (TypeError, ValueError) as exc:  # the options on this id (its preset's fields)
+        raise ValueError(f"env_kwargs on {env_id}: {exc}") from None
     try:  # quietly: the run prints SB3's warnings and messages when it builds the model
         with warnings.catch_warnings(), contextlib.redirect_stdout(io.StringIO()):
             warnings.simplefilter("ignore")
@@ -116,3 +121,15 @@ def check_buildable(cfg, env_id: str | None = None) -> None:
         ) from None
     finally:
         venv.close()
+
+
+def _check_envs(cfg, env_id: str) -> None:
+    """Build one env of ``env_id`` per training load case with the config's options (as the
+    run will, on top of the id's preset), and close it; ``ValueError`` naming the options."""
+    import gymnasium as gym
+
+    for case in cfg.load_weights:
+        try:
+            gym.make_vec(env_id, num_envs=1, load_case=case, **cfg.env_kwargs).close()
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"env_kwargs on {env_id}: {exc}") from None

@@ -241,3 +241,21 @@ def test_sweep_refuses_an_out_that_is_a_file(tmp_path, capsys, monkeypatch, no_c
     monkeypatch.setattr(trials, "init_ray", lambda *a: pytest.fail("Ray started"))
     _refused(sweep_main, ["vrs", "--out", str(blocker)], capsys, "--out")
     assert blocker.read_text() == "keep"
+
+
+def test_benchmark_builds_the_training_env_on_the_env_id_first(tmp_path, capsys, no_computing):
+    """The config's env options on top of the id's preset (here a fixed temperature against
+    the hard level's drawn one) are refused before the references, naming the id."""
+    cfg = tmp_path / "hot.yaml"
+    cfg.write_text("base: vrs\nenv_kwargs: {temperature: 35}\n")
+    argv = ["--config", str(cfg), "--env-id", "ACLDBeamHard-v1", "--out", str(tmp_path / "b")]
+    _refused(benchmark_main, argv, capsys, str(cfg), "env_kwargs on ACLDBeamHard-v1")
+
+
+def test_report_names_an_undecodable_page(tmp_path, capsys):
+    from train.bench.report import main
+
+    page = tmp_path / "page.md"
+    page.write_bytes(b"\xff\xfe binary")
+    _refused(main, ["train/benchmark/results-v1.json", "--write", str(page)], capsys, str(page))
+    assert page.read_bytes() == b"\xff\xfe binary"

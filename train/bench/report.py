@@ -520,8 +520,8 @@ def main(argv: list[str] | None = None) -> int:
     for page in args.write:
         try:
             texts[page] = write_blocks(page.read_text(), blocks, str(args.results), str(page))
-        except (OSError, ValueError) as exc:
-            p.error(str(exc))
+        except (OSError, ValueError) as exc:  # an undecodable page: name it
+            p.error(str(exc) if str(page) in str(exc) else f"{page}: {exc}")
     write_texts(texts)  # every page or none (a full disk fails before any is replaced)
     for page in texts:
         print(f"wrote the tables of {args.results} into {page}")

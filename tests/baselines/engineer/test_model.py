@@ -113,3 +113,48 @@ def test_designs_invariant_to_the_model_coordinates(level_env, seed):
         np.testing.assert_allclose(kb[n:], ka[n:], rtol=1e-6)
         ma, mb = _markov(a), _markov(b)
         np.testing.assert_allclose(mb, ma, rtol=1e-6, atol=1e-8 * np.abs(ma).max())
+
+
+def test_reward_weights_are_the_env_step_cost(level_env):
+    """Without delay and lag, z'Qz + 2 z'N u + R u^2 is the env's step cost
+    (y_{k+1}/y_ref)^2 + lam (u/120)^2 for any state and command."""
+    env = level_env("ACLDBeam-v1").unwrapped
+    m = rig_model(env.nom, env.config)
+    A, b = m.augmented()
+    Q, R, N = m.reward_weights()
+    rng = np.random.default_rng(0)
+    for _ in range(5):
+        z, u = rng.normal(size=m.n) * m.scale, rng.uniform(-120, 120)
+        y = m.augmented_output() @ (A @ z + b[:, 0] * u)
+        want = (y / m.y_ref) ** 2 + m.lam * (u / 120.0) ** 2
+        got = z @ Q @ z + 2 * (z @ N[:, 0]) * u + R[0, 0] * u**2
+        assert got == pytest.approx(want, rel=1e-9)
+
+
+def test_kalman_gain_is_the_package_filter(level_env):
+    """The scaled solve gives the package's (unscaled) steady-state Kalman filter for the
+    same noise model on v1's design model."""
+    from acld_gym.design.observer import discrete_kalman
+
+    env = level_env("ACLDBeam-v1").unwrapped
+    pol = DelayLQGPolicy(env.nom, env.config, model_std=0.1, load_std=1.0)
+    sr = env.nom.reduced
+    ref = discrete_kalman(
+        sr.Ad, sr.Bd, sr.Ed, env.nom.design.reduced.C, 1.0, env.config.sensor_noise, 0.1
+    )
+    np.testing.assert_allclose(pol.M, ref.Lc[:, 0], rtol=1e-6)
+
+
+def test_lqr_gain_with_cross_term_is_the_package_lqr(level_env):
+    """The scaled solve with the reward's cross term gives the package's discrete LQR of
+    the equivalent problem without it (A - b R^-1 N', Q - N R^-1 N'), plus R^-1 N'."""
+    from acld_gym.design.feedback import discrete_lqr_gain
+
+    env = level_env("ACLDBeam-v1").unwrapped
+    pol = DelayLQGPolicy(env.nom, env.config)
+    m = pol.model
+    A, b = m.augmented()
+    Q, R, N = m.reward_weights()
+    F = np.linalg.solve(R, N.T)
+    K0, _ = discrete_lqr_gain(A - b @ F, b, Q - N @ F, R)
+    np.testing.assert_allclose(pol.K, (K0 + F)[0], rtol=1e-5)

@@ -42,6 +42,7 @@ __all__ = [
     "read_arrays",
     "read_metadata",
     "curve_rows",
+    "read_curve",
     "check_replaceable",
     "write_folder",
 ]
@@ -275,6 +276,20 @@ def curve_rows(text: str, where: str) -> list[dict]:
             )
         rows.append({"timesteps": steps, "case": case, "ise": ise})
     return rows
+
+
+def read_curve(path: str | Path) -> list[dict] | None:
+    """The rows (:func:`curve_rows`) of the ``learning_curve.csv`` of the agent folder
+    ``path``, read as :class:`AgentFolder` reads; None if it has none."""
+    with AgentFolder(path) as folder:
+        if not folder.exists("learning_curve.csv"):
+            return None
+        data = folder.read("learning_curve.csv", MAX_CURVE_BYTES)
+    where = str(Path(path) / "learning_curve.csv")
+    try:
+        return curve_rows(data.decode("utf-8"), where)
+    except UnicodeDecodeError:
+        raise AgentFileError(f"{where}: not UTF-8 text") from None
 
 
 def _cut(name: str) -> str:

@@ -24,7 +24,6 @@ learning curves.
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 
@@ -72,19 +71,21 @@ AGENTS_DIR = Path(__file__).resolve().parent / "agents"
 
 
 def agent_names(directory: str | Path = AGENTS_DIR, mesh: str = "converged") -> list[str]:
-    """The agent directories under ``directory`` trained on ``mesh`` (sorted)."""
-    from .agent import META_FILE
+    """The agent directories under ``directory`` trained on ``mesh`` (sorted), and each
+    whose metadata does not read (:func:`train.agent_files.read_metadata`): loading it
+    names the fault, it is never skipped in silence."""
+    from .agent import META_FILE, AgentFileError
+    from .agent_files import read_metadata
 
     out = []
     for d in sorted(Path(directory).iterdir()) if Path(directory).is_dir() else []:
-        meta = d / META_FILE
-        if meta.is_file():
+        if (d / META_FILE).exists() or (d / META_FILE).is_symlink():
             try:
-                rec = json.loads(meta.read_text())
-            except json.JSONDecodeError:
-                continue  # TrainedAgent.load reports it when asked for it by name
-            env = rec.get("env", {})
-            default = "thesis" if env.get("id") == "ACLDBeam-v0" else "converged"
+                env = read_metadata(d)["env"]
+            except (AgentFileError, OSError):
+                out.append(d.name)  # TrainedAgent.load reports it
+                continue
+            default = "thesis" if env["id"] == "ACLDBeam-v0" else "converged"
             if env.get("kwargs", {}).get("mesh", default) == mesh:
                 out.append(d.name)
     return out
@@ -237,23 +238,25 @@ def learning_curves_figure(agents: dict):
     steps (SAC's 2M to the random search's 100M) and fall from the passive level (~3.7x)
     to within a few per cent of one another. The untrained point (step 0) has no place on
     a log axis and is left out. ``None`` if no agent has a curve."""
-    import csv
-
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from .agent import CURVE_FILE
+    from .agent import AgentFileError
+    from .agent_files import read_curve
     from .bench.evaluate import lqr_ise
     from .bench.report import ratio_log_axis
 
     curves = {}
-    for name, agent in agents.items():
-        path = None if agent.directory is None else agent.directory / CURVE_FILE
-        if path is not None and path.is_file():
-            with path.open() as fh:
-                curves[name] = list(csv.DictReader(fh))
+    for name, agent in agents.items():  # read as the agent was: no link, rows checked
+        try:
+            rows = None if agent.directory is None else read_curve(agent.directory)
+        except AgentFileError as exc:  # one line; the comparison stands
+            print(f"{name}: no learning curve ({exc})", file=sys.stderr)
+            rows = None
+        if rows:
+            curves[name] = rows
     if not curves:
         return None
     lqr = lqr_ise(episodes={c: (0,) for c in (1, 2, 3)})

@@ -409,3 +409,24 @@ def test_a_reader_sees_the_old_agent_or_the_new_one_never_a_mix(tmp_path):
         reader.join()
     assert errors == []
     assert len({algo for algo, _ in seen}) == 2 and all(same for _, same in seen)
+
+
+def test_compare_lists_a_broken_agent_to_name_it_and_reads_curves_as_load_does(tmp_path, capsys):
+    """``train.compare``'s listing keeps a folder whose metadata does not read (so that
+    loading it names the fault: no silent skip, no traceback), and a learning curve that
+    is a link is left out with one line."""
+    from train.compare import agent_names, learning_curves_figure, load_agents
+
+    agents = tmp_path / "agents"
+    _copy("vrs", agents / "good")
+    _set_meta(_copy("vrs", agents / "deep"), _deep(200_000))
+    _set_meta(_copy("vrs", agents / "listed"), "[]")
+    assert agent_names(agents) == ["deep", "good", "listed"]
+    with pytest.raises(AgentFileError, match="deep/metadata.json: nested deeper"):
+        load_agents(agents)
+    secret = tmp_path / "secret.csv"
+    secret.write_text("timesteps,case,ise\n1000,1,1e-8\n")
+    (agents / "good" / CURVE_FILE).unlink()
+    (agents / "good" / CURVE_FILE).symlink_to(secret)
+    assert learning_curves_figure(load_agents(agents, ["good"])) is None
+    assert "good: no learning curve" in capsys.readouterr().err

@@ -85,11 +85,12 @@ def ship(
     ``python -m train.benchmark`` one per trial in ``<out>/agents/<config>-s<seed>``: the
     run's final policy, ``policy.npz`` + ``metadata.json``, nothing pickled) and its
     learning curve to ``agents_dir/name``, the folder written whole (module docstring);
-    returns that directory. The agent is read and validated as
-    :meth:`train.agent.TrainedAgent.load` does before anything is written;
-    ``FileExistsError`` if ``agents_dir/name`` exists and not ``force``."""
+    returns that directory. The agent is read and validated by
+    :meth:`train.agent.TrainedAgent.load` (its observation fingerprint included: a shipped
+    agent loads) before anything is written; ``FileExistsError`` if ``agents_dir/name``
+    exists and not ``force``."""
     check_name(name)
-    agent = TrainedAgent.load(run, check=False)
+    agent = TrainedAgent.load(run)  # checked against its env: a shipped agent loads
     curve = agent.learning_curve()
     if curve is not None:
         curve_rows(curve, str(Path(run) / CURVE_FILE))

@@ -281,6 +281,22 @@ def test_ship_refuses_an_existing_name_without_force(tmp_path, capsys):
     assert [p.name for p in agents.iterdir()] == ["mine"]  # no temporary left
 
 
+def test_ship_refuses_an_agent_that_would_not_load(tmp_path):
+    """Shipping checks the fingerprint as loading does: an agent whose env settings the
+    env refuses, or whose observation differs from its env's, is not shipped."""
+    run = _copy("sac", tmp_path / "run")
+    meta = _meta(run)
+    meta["env"]["kwargs"] = {"mesh": "thesis"}
+    _set_meta(run, meta)
+    with pytest.raises(AgentFileError, match="trained on another observation"):
+        ship(run, "mine", tmp_path / "agents")
+    meta["env"]["kwargs"] = {"sensor_noise": -1.0}
+    _set_meta(run, meta)
+    with pytest.raises(AgentFileError, match=rf"{META_FILE}: env: sensor_noise"):
+        ship(run, "mine", tmp_path / "agents")
+    assert not (tmp_path / "agents").exists()
+
+
 def test_ship_never_copies_a_linked_learning_curve(tmp_path):
     secret = tmp_path / "secret.txt"
     secret.write_text("a file elsewhere on the machine\n")

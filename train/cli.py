@@ -88,7 +88,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--n-envs",
-        type=_positive_int,
+        type=arg_type(int, 1, 2**16),
         default=None,
         help="sub-envs of the batched env (default: the config's)",
     )

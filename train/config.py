@@ -326,8 +326,8 @@ class TrainConfig:
     def __post_init__(self):
         if self.algo not in ALGOS:
             raise ValueError(f"algo must be one of {list(ALGOS)}, got {self.algo!r}")
-        for name in ("timesteps", "n_envs", "eval_points"):
-            check_int(name, getattr(self, name), 1, 10**12)
+        for name, most in (("timesteps", 10**12), ("n_envs", 2**16), ("eval_points", 10**4)):
+            check_int(name, getattr(self, name), 1, most)  # most: what memory allows
         check_int("restarts", self.restarts, 1, 64)
         if self.restart_above is not None:
             if isinstance(self.restart_above, str):

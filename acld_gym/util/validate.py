@@ -22,6 +22,7 @@ __all__ = [
     "arg_type",
     "closed_pipe_is_fine",
     "os_error_line",
+    "check_figure_path",
     "run_main",
 ]
 
@@ -99,6 +100,10 @@ def arg_type(kind: type, low=None, high=None, *, low_open: bool = False):
     def parse(text: str):
         try:
             value = int(text) if kind is int else float(text)
+        except ValueError:
+            expected = "an integer" if kind is int else "a real number"
+            raise argparse.ArgumentTypeError(f"expected {expected}, got {text!r}") from None
+        try:
             if kind is int:
                 return check_int("value", value, low, high)
             return check_real("value", value, low, high, low_open=low_open)
@@ -126,6 +131,23 @@ class closed_pipe_is_fine:  # noqa: N801 (a context manager used like a function
             os.dup2(devnull, sys.stdout.fileno())
             return True
         return False
+
+
+def check_figure_path(path, what: str = "--plot"):
+    """``path`` if a figure can be written there: a format matplotlib writes by itself (from
+    the suffix; none: PNG) and a writable place (:func:`acld_gym.util.atomic.check_writable`); else
+    ``ValueError`` naming ``what``. Call it before computing the figure."""
+    from matplotlib.figure import Figure
+
+    from acld_gym.util.atomic import check_writable
+
+    formats = set(Figure().canvas.get_supported_filetypes()) - {"pgf"}  # pgf needs LaTeX
+    suffix = os.path.splitext(os.fspath(path))[1].lstrip(".").lower() or "png"  # save_figure's
+    if suffix not in formats:
+        raise ValueError(
+            f"{what}: cannot draw {os.fspath(path)!r}: expected a suffix of {sorted(formats)}"
+        )
+    return check_writable(path, what)
 
 
 def _os_error_file(exc: OSError):

@@ -183,3 +183,28 @@ def test_closed_pipe_is_quiet():
         env={**os.environ, "PYTHONUNBUFFERED": "1"},
     )
     assert res.stdout.startswith("| field") and "Traceback" not in res.stderr
+
+
+def test_check_figure_path_wants_a_format_matplotlib_writes(tmp_path):
+    from acld_gym.util.validate import check_figure_path
+
+    assert check_figure_path(tmp_path / "fig.svg") == tmp_path / "fig.svg"
+    assert check_figure_path(tmp_path / "fig") == tmp_path / "fig"  # no suffix: PNG
+    for bad in ("fig.xyz", "fig.pgf"):  # unknown; pgf needs LaTeX
+        with pytest.raises(ValueError, match="--plot: cannot draw .*expected a suffix"):
+            check_figure_path(tmp_path / bad)
+    (tmp_path / "d.png").mkdir()
+    with pytest.raises(ValueError, match="is a directory"):
+        check_figure_path(tmp_path / "d.png")
+
+
+def test_arg_type_says_what_it_expected():
+    import argparse
+
+    from acld_gym.util.validate import arg_type
+
+    for kind, text, word in ((int, "1e9", "an integer"), (float, "abc", "a real number")):
+        with pytest.raises(argparse.ArgumentTypeError, match=f"expected {word}, got '{text}'"):
+            arg_type(kind, 1)(text)
+    with pytest.raises(argparse.ArgumentTypeError, match=r"expected an integer in \[1, 5\]"):
+        arg_type(int, 1, 5)("6")

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
-from acld_gym.util.atomic import check_writable, save_figure, write_texts
-from acld_gym.util.validate import os_error_line, run_main
+from acld_gym.util.atomic import save_figure, write_texts
+from acld_gym.util.validate import check_figure_path, os_error_line, run_main
 
 from .evaluate import CASES, OBJECTIVE_LOADS
 from .records import DataFileError, read_results
@@ -507,7 +507,7 @@ def main(argv: list[str] | None = None) -> int:
     blocks = render_blocks(summary)
     if args.plot is not None:
         try:
-            check_writable(args.plot, "--plot")
+            check_figure_path(args.plot, "--plot")
         except (OSError, ValueError) as exc:
             p.error(str(exc))
         plot_curves(summary, args.plot)

@@ -155,7 +155,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--resume",
         action="store_true",
-        help="reuse trials already in OUT/trials with the same config and env id",
+        help="reuse trials already in OUT/trials with the same config and env id (a damaged "
+        "record, or one whose agent no longer loads, is trained again, said in one line; a "
+        "damaged references file is computed again)",
     )
     p.add_argument(
         "--no-train",

@@ -59,9 +59,20 @@ def test_the_oracle_needs_its_episode_and_one_env():
     oracle.start_episode(env)
     with pytest.raises(ValueError, match="one env"):
         oracle.predict(np.zeros((2, obs.size), np.float32))
-    for bad in ({"horizon": 0}, {"rho": 0.0}, {"load_std": -1.0}, {"horizon": True}):
+    bad_args = ({"horizon": 0}, {"rho": 0.0}, {"load_std": -1.0}, {"horizon": True})
+    for bad in (*bad_args, {"load_tau": 0.0}):
         with pytest.raises(ValueError):
             PlantOracleMPC(**bad)
+
+
+def test_a_load_with_memory_is_one_more_state_of_the_filter_and_the_plan():
+    env = gym.make("ACLDBeamLab-v1", load_case=1, max_episode_steps=60)
+    white, colored = PlantOracleMPC(), PlantOracleMPC(load_tau=2e-3)
+    ep_w, ep_c = rollout(white, env, seed=0), rollout(colored, env, seed=0)
+    n = env.unwrapped.episode_plant.Ad.shape[0]
+    assert white._m.n == n and colored._m.n == n + 1
+    assert colored._m.A[n, n] == pytest.approx(np.exp(-1e-3 / 2e-3))
+    assert np.all(np.isfinite(ep_c.y)) and not np.array_equal(ep_w.voltage, ep_c.voltage)
 
 
 def test_a_slew_limit_that_binds_is_a_rate_constraint():

@@ -149,6 +149,8 @@ def test_deep_nesting_and_binary_files_are_refused(tmp_path):
     for path in (deep, binary):
         with pytest.raises(DataFileError, match=str(path)):
             read_json(path)
+    with pytest.raises(DataFileError, match="larger than 1000 bytes"):
+        read_json(ROOT / "train/benchmark/results-v1.json", max_bytes=1000)
 
 
 # --- configs -------------------------------------------------------------------------------

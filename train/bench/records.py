@@ -34,15 +34,20 @@ __all__ = [
 
 #: The statistics of an interquartile mean (:func:`train.bench.stats.iqm_with_ci`).
 STAT_KEYS = ("iqm", "ci_low", "ci_high")
+#: The largest file :func:`read_json` reads (a results table of 25 seeds is ~30 kB).
+MAX_BYTES = 64 * 2**20
 #: The references every cache holds (the bound is optional: ``--no-bound``).
 REFERENCE_NAMES = ("passive", "lqr", "smc", "mpc")
 
 
-def read_json(path: str | Path) -> Any:
+def read_json(path: str | Path, max_bytes: int = MAX_BYTES) -> Any:
     """The JSON value of the file ``path``; :class:`DataFileError` naming it if it is not
-    UTF-8 JSON (a truncated file, a binary one, nesting too deep for the parser). A missing
-    or unreadable file is the ``OSError`` of reading it."""
-    data = Path(path).read_bytes()
+    UTF-8 JSON (a truncated file, a binary one, nesting too deep for the parser) or holds
+    more than ``max_bytes``. A missing or unreadable file is the ``OSError`` of reading it."""
+    with open(path, "rb") as fh:
+        data = fh.read(max_bytes + 1)
+    if len(data) > max_bytes:
+        raise file_error(path, None, f"larger than {max_bytes} bytes: not a file of the benchmark")
     try:
         return json.loads(data.decode("utf-8"))
     except UnicodeDecodeError as exc:

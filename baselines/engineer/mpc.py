@@ -6,10 +6,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from acld_gym.design.feedback import THESIS_LQR_WEIGHT
 from acld_gym.physics.actuator import V_LIMIT
 from baselines.policies import MPCPolicy
 
 from .base import RigPolicy
+from .riccati import lqr
 
 __all__ = ["ActuatorMPCPolicy"]
 
@@ -46,6 +48,40 @@ class _RateMPC(MPCPolicy):
     120 V; σ the slew per period), besides the box."""
 
     slew = None  # per period, units of 120 V; None: the box alone
+    terminal = None  # (Gamma_H, A^H, S): the tail's cost x_H^T S x_H (None: none)
+
+    def set_terminal(self, S: np.ndarray, A: np.ndarray, b: np.ndarray) -> None:
+        r"""Add the terminal cost :math:`x_{k+H}^T S x_{k+H}`, with
+        :math:`x_{k+H} = A^H x + \Gamma_H u` (u in units of 120 V), to the QP."""
+        import scipy.sparse as sp
+
+        H = self._setup[2]
+        gam = np.empty((A.shape[0], H))
+        Aj = np.eye(A.shape[0])
+        for i in range(H - 1, -1, -1):
+            gam[:, i] = Aj @ b * V_LIMIT
+            Aj = A @ Aj
+        self.terminal = (gam, Aj, S)
+        self._hessian = self._hessian + gam.T @ S @ gam
+        self._setup = (sp.csc_matrix(np.triu(2.0 * self._hessian)), self._setup[1], H)
+        self._solvers.clear()
+
+    def _linear_term(self, x: np.ndarray) -> np.ndarray:
+        q = super()._linear_term(x)
+        if self.terminal is not None:
+            gam, AH, S = self.terminal
+            q = q + 2.0 * (gam.T @ (S @ (AH @ x)))
+        return q
+
+    def small_signal_gain(self) -> np.ndarray:
+        """:meth:`MPCPolicy.small_signal_gain` with the terminal cost."""
+        G = self.Theta.T @ self.Psi
+        if self._Lx is not None:
+            G = G + self._Lx[0].T @ self._Lx[1]
+        if self.terminal is not None:
+            gam, AH, S = self.terminal
+            G = G + gam.T @ S @ AH
+        return V_LIMIT * np.linalg.solve(self._hessian, G)[0]
 
     def _solver(self, i: int):
         if self.slew is None:
@@ -118,6 +154,12 @@ class ActuatorMPCPolicy(RigPolicy):
       :class:`~baselines.engineer.lqg.DelayLQGPolicy`'s; ``state_weight`` adds
       :class:`MPCPolicy`'s small multiple of the thesis LQR's state
       weight (its robustness term; 0: the reward alone).
+    * **The tail** (``terminal``, default): the cost beyond the horizon is the LQR's
+      cost-to-go :math:`\hat x_{k+d+H}^T S\, \hat x_{k+d+H}` of the same stage cost
+      (:func:`baselines.engineer.riccati.lqr`), so where no constraint is active the MPC
+      is the infinite-horizon LQR -- the LQG's law
+      (:class:`~baselines.engineer.lqg.DelayLQGPolicy`) -- and where the voltage limit is
+      active it plans the saturated stretch and the linear tail together.
 
     **Knows**: the nominal beam, the delay, the amplifier's bandwidth and slew rate, the
     sensor's noise, the reward. **Does not know**: the episode's load, temperature and
@@ -134,6 +176,7 @@ class ActuatorMPCPolicy(RigPolicy):
         horizon: int = 60,
         weight: float = 1.0,
         state_weight: float = 0.0,
+        terminal: bool = True,
         model_std: float | None = None,
         load_std: float = 1.0,
         model=None,
@@ -156,6 +199,15 @@ class ActuatorMPCPolicy(RigPolicy):
         )
         self.mpc.slew = None if m.slew_step is None else m.slew_step / V_LIMIT
         self.horizon = horizon
+        if terminal:
+            # the tail's stage cost on (x_i, u_i): |c (A x + b u)|^2 / (1 mm)^2 + the state
+            # weight of x_{i+1}, and rho (u / 120)^2 -- the QP's own stage, in volts
+            A, b = m.plant.Ad, m.plant.Bd
+            Qy = np.outer(m.c, m.c) / 1e-6 + state_weight * THESIS_LQR_WEIGHT * W / V_LIMIT**2
+            Q, N = A.T @ Qy @ A, A.T @ Qy @ b
+            R = b.T @ Qy @ b + rho / V_LIMIT**2
+            _, S = lqr(A, b, Q, R, N, m.scale)
+            self.mpc.set_terminal(S, A, b[:, 0])
 
     def _ahead(self, z: np.ndarray, held: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(x̂_{k+d|k}, v_{k+d-1})``: the plant's estimate carried over the commands in

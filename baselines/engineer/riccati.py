@@ -17,7 +17,7 @@ import scipy.linalg as sla
 
 from acld_gym.physics.actuator import V_LIMIT
 
-__all__ = ["lqr_gain", "kalman_gain", "process_noise"]
+__all__ = ["lqr", "lqr_gain", "kalman_gain", "process_noise"]
 
 
 def _sym(X: np.ndarray) -> np.ndarray:
@@ -27,7 +27,15 @@ def _sym(X: np.ndarray) -> np.ndarray:
 def lqr_gain(
     A: np.ndarray, b: np.ndarray, Q: np.ndarray, R: np.ndarray, N: np.ndarray, scale: np.ndarray
 ) -> np.ndarray:
-    r"""The discrete LQR gain K (1, n), :math:`u = -K z`, for the cost
+    """The discrete LQR gain K (1, n) of :func:`lqr`."""
+    return lqr(A, b, Q, R, N, scale)[0]
+
+
+def lqr(
+    A: np.ndarray, b: np.ndarray, Q: np.ndarray, R: np.ndarray, N: np.ndarray, scale: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    r"""``(K, X)``: the discrete LQR gain K (1, n), :math:`u = -K z`, and the cost-to-go
+    :math:`z^T X z` (X in the model's units), for the cost
     :math:`\sum_k z_k^T Q z_k + 2 z_k^T N u_k + u_k^T R u_k`:
 
     .. math:: K = (R + b^T X b)^{-1} (b^T X A + N^T),
@@ -35,7 +43,8 @@ def lqr_gain(
     X the stabilizing solution of the DARE with the cross term, solved on
     :math:`\tilde A = D^{-1} A D`, :math:`\tilde b = D^{-1} b\,u_s`,
     :math:`\tilde Q = D Q D`, :math:`\tilde N = D N u_s`, :math:`\tilde R = u_s^2 R`
-    (``scale`` = diag D, :math:`u_s` = 120 V), and :math:`K = u_s \tilde K D^{-1}`."""
+    (``scale`` = diag D, :math:`u_s` = 120 V), and :math:`K = u_s \tilde K D^{-1}`,
+    :math:`X = D^{-1} \tilde X D^{-1}`."""
     d, us = np.asarray(scale, dtype=float), V_LIMIT
     As = A * d[None, :] / d[:, None]
     bs = b / d[:, None] * us
@@ -44,7 +53,7 @@ def lqr_gain(
     Rs = np.atleast_2d(R) * us**2
     X = _sym(sla.solve_discrete_are(As, bs, Qs, Rs, s=Ns))
     Ks = np.linalg.solve(Rs + bs.T @ X @ bs, bs.T @ X @ As + Ns.T)
-    return us * Ks / d[None, :]
+    return us * Ks / d[None, :], _sym(X / d[:, None] / d[None, :])
 
 
 def process_noise(

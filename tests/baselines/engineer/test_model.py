@@ -158,3 +158,18 @@ def test_lqr_gain_with_cross_term_is_the_package_lqr(level_env):
     F = np.linalg.solve(R, N.T)
     K0, _ = discrete_lqr_gain(A - b @ F, b, Q - N @ F, R)
     np.testing.assert_allclose(pol.K, (K0 + F)[0], rtol=1e-5)
+
+
+@pytest.mark.parametrize("env_id", ["ACLDBeam-v1", "ACLDBeamLab-v1", "ACLDBeamHard-v1"])
+def test_mpc_with_its_tail_is_the_lqg_about_rest(level_env, env_id):
+    """Unconstrained, the MPC with the LQR's cost-to-go as its tail is the infinite-horizon
+    law: its gain on the augmented estimate (the delay by prediction) is the LQG's on the
+    augmented model (the shift register) -- two routes to one law."""
+    env = level_env(env_id).unwrapped
+    for w in (0.3, 1.0):
+        lqg = DelayLQGPolicy(env.nom, env.config, weight=w)
+        mpc = ActuatorMPCPolicy(env.nom, env.config, weight=w, horizon=20)
+        k = lqg.small_signal_gain()
+        np.testing.assert_allclose(mpc.small_signal_gain(), k, rtol=1e-6, atol=1e-9 * abs(k).max())
+    short = ActuatorMPCPolicy(env.nom, env.config, horizon=20, terminal=False)  # w = 1
+    assert np.abs(short.small_signal_gain() - k).max() > 1e-3 * np.abs(k).max()

@@ -22,8 +22,10 @@ import numpy as np
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from train.agent import META_FILE, POLICY_FILE, AgentFileError, TrainedAgent
+from train.agent import CURVE_FILE, META_FILE, POLICY_FILE, AgentFileError, TrainedAgent
+from train.agent_files import curve_rows, read_curve
 from train.compare import AGENTS_DIR
+from train.ship import ship
 
 ROOT = Path(__file__).resolve().parents[2]
 #: Agents with every operation the shipped ones use: linear; linear, clip, tanh; direction.
@@ -234,3 +236,44 @@ def _loads(d: Path) -> bool:
     except AgentFileError:
         return False
     return True
+
+
+@st.composite
+def curve_texts(draw):
+    """A shipped learning curve with a line deleted, a field retyped, or cut short."""
+    lines = (SOURCES[0] / CURVE_FILE).read_text().splitlines()
+    i = draw(st.integers(0, len(lines) - 1))
+    kind = draw(st.sampled_from(["delete", "retype", "truncate"]))
+    if kind == "delete":
+        del lines[i]
+    elif kind == "retype":
+        fields = lines[i].split(",")
+        j = draw(st.integers(0, len(fields) - 1))
+        fields[j] = draw(st.sampled_from(["", "x", "-1", "nan", "inf", "1e999", "0", "1,2"]))
+        lines[i] = ",".join(fields)
+    text = "\n".join(lines) + "\n"
+    if kind == "truncate":
+        text = text[: draw(st.integers(0, len(text)))]
+    return text
+
+
+@given(curve_texts())
+@settings(FUZZ, max_examples=60)  # each example ships (fsyncs) and loads three times
+def test_a_mutated_learning_curve_ships_whole_or_is_an_agent_file_error(text):
+    """Shipping copies a curve whose every row reads, byte for byte, with the agent (which
+    then loads as it was); any other curve is an AgentFileError and nothing is written."""
+    with tempfile.TemporaryDirectory() as tmp:
+        run, agents = Path(tmp) / "run", Path(tmp) / "agents"
+        _write(run, SOURCES[0])
+        (run / CURVE_FILE).write_text(text)
+        try:
+            dst = ship(run, "mine", agents)
+        except AgentFileError:
+            assert not agents.exists()
+            return
+        assert (dst / CURVE_FILE).read_text() == text
+        assert curve_rows(text, "x") == read_curve(dst)
+        shipped, original = TrainedAgent.load(dst), TrainedAgent.load(run)
+        assert shipped.actor.ops == original.actor.ops
+        for key, value in original.actor.arrays.items():
+            assert np.array_equal(shipped.actor.arrays[key], value)

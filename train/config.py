@@ -569,13 +569,20 @@ def config_path(spec: str | Path) -> Path:
 
 def _read_yaml(path: Path) -> dict:
     """The mapping of one YAML file; :class:`DataFileError` naming the file and the place."""
+    from .config_checks import MAX_BYTES, check_size
+
     try:
+        if path.stat().st_size > MAX_BYTES:
+            raise DataFileError(f"{path}: larger than {MAX_BYTES} bytes: not a config")
         data = yaml.safe_load(path.read_text(encoding="utf-8")) or {}
+        check_size(data, path)
     except (yaml.YAMLError, UnicodeDecodeError, RecursionError) as exc:
         where = getattr(exc, "problem_mark", None)
         at = f" (line {where.line + 1}, column {where.column + 1})" if where else ""
         why = getattr(exc, "problem", None) or type(exc).__name__
         raise DataFileError(f"{path}: not valid YAML{at}: {why}") from None
+    except ValueError as exc:
+        raise DataFileError(str(exc)) from None
     if not isinstance(data, dict):
         raise DataFileError(f"{path}: expected a mapping of settings, got {type(data).__name__}")
     return data

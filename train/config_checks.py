@@ -16,7 +16,12 @@ from dataclasses import fields
 
 from acld_gym.util.validate import check_int, check_real
 
-__all__ = ["check_model", "check_buildable"]
+__all__ = ["check_model", "check_buildable", "check_size", "MAX_VALUES", "MAX_BYTES"]
+
+#: The most values (every list item and mapping entry, YAML aliases counted each time they
+#: are used) and bytes a config file may hold; a recipe has under 100 values and 3 kB.
+MAX_VALUES = 10_000
+MAX_BYTES = 2**20
 
 #: Smallest value of the SB3 integer arguments that may be below 1 (-1: "as many as").
 _INT_MIN = {
@@ -133,3 +138,19 @@ def _check_envs(cfg, env_id: str) -> None:
             gym.make_vec(env_id, num_envs=1, load_case=case, **cfg.env_kwargs).close()
         except (TypeError, ValueError) as exc:
             raise ValueError(f"env_kwargs on {env_id}: {exc}") from None
+
+
+def check_size(data, path) -> None:
+    """``ValueError`` naming ``path`` if the parsed config ``data`` holds more than
+    :data:`MAX_VALUES` values, YAML aliases expanded (a few lines of nested aliases can
+    stand for billions of values, which comparing or recording the config would build)."""
+    stack, count = [data], 0
+    while stack:
+        value = stack.pop()
+        count += 1
+        if count > MAX_VALUES:
+            raise ValueError(f"{path}: more than {MAX_VALUES} values (aliases expanded)")
+        if isinstance(value, dict):
+            stack += [*value.keys(), *value.values()]
+        elif isinstance(value, list):
+            stack += value

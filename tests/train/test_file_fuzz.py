@@ -341,3 +341,14 @@ def test_a_damaged_references_file_is_computed_again(tmp_path, monkeypatch, caps
     assert calls == [None] and json.loads(path.read_text()) == REFS  # replaced whole
     assert resumed_references("ACLDBeam-v1", tmp_path, 2, True) == REFS
     assert calls == [None, path] and capsys.readouterr().out == ""  # intact: the cache
+
+
+def test_a_config_of_nested_aliases_is_refused_before_it_is_expanded(tmp_path):
+    """Nine lines of YAML aliases standing for 9**9 values (a "billion laughs")."""
+    lines = ["a: &a [x, x, x, x, x, x, x, x, x]"]
+    for prev, name in zip("abcdefgh", "bcdefghi", strict=True):
+        lines.append(f"{name}: &{name} [{', '.join([f'*{prev}'] * 9)}]")
+    path = tmp_path / "laughs.yaml"
+    path.write_text("\n".join([*lines, "algo: vrs", "timesteps: 10"]) + "\n")
+    with pytest.raises(DataFileError, match="more than 10000 values"):
+        read_config(path)

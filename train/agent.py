@@ -377,7 +377,7 @@ class TrainedAgent:
         try:
             env_id = check_env_id(env_meta["id"], "env.id")
             env = gym.make(env_id, **env_meta.get("kwargs", {}))
-        except (TypeError, ValueError, gym.error.Error) as exc:
+        except (TypeError, ValueError, OverflowError, gym.error.Error) as exc:
             raise AgentFileError(f"{meta_file}: env: {exc}") from None
         try:
             diff = fingerprint_differences(

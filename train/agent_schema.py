@@ -181,6 +181,8 @@ def _check_env(env, where: str) -> None:
         raise _fail(where, "env", f"expected an object with 'id' and 'kwargs', got {_short(env)}")
     if "id" not in env:
         raise _fail(where, "env.id", "missing (the id of the env the agent was trained on)")
+    if not isinstance(env["id"], str) or len(env["id"]) > MAX_TEXT:  # (not echoed in full)
+        raise _fail(where, "env.id", f"expected one of this package's ids, got {_short(env['id'])}")
     try:
         check_env_id(env["id"], "env.id")
     except ValueError as exc:

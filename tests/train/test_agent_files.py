@@ -215,7 +215,16 @@ MALFORMED = [
     (lambda m: {**m, "env": {"id": "ACLDBeam-v1", "kwargs": []}}, "env.kwargs: expected an"),
     (lambda m: {**m, "env": {"id": "ACLDBeam-v9"}}, "env.id must be one of"),
     (lambda m: {**m, "env": {"id": "CartPole-v1"}}, "env.id must be one of"),
-    (lambda m: {**m, "env": {"id": ["ACLDBeam-v1"]}}, "env.id must be one of"),
+    (lambda m: {**m, "env": {"id": ["ACLDBeam-v1"]}}, "env.id: expected one of this"),
+    (lambda m: {**m, "env": {"id": "x" * 10**5}}, r"env.id: expected one of .*x\.\.\.$"),
+    (
+        lambda m: {**m, "env": {"id": "ACLDBeam-v1", "kwargs": {"dt": 10**400}}},
+        "env: int too large",
+    ),
+    (
+        lambda m: {**m, "env": {"id": "ACLDBeam-v1", "kwargs": {"mesh": ["x"]}}},
+        "env: mesh must be one of",
+    ),
     (
         lambda m: {**m, "env": {"id": "ACLDBeam-v1", "kwargs": {"max_episode_steps": 5}}},
         r"env.kwargs: \['max_episode_steps'\] are not env settings",

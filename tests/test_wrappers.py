@@ -1,4 +1,5 @@
-"""acld_gym.wrappers: Gymnasium's checker passes, and the maps are exact."""
+"""acld_gym.wrappers: Gymnasium's checker passes, and the maps are exact (and the same for
+the single and the vector wrappers: tests/envs/test_vector_wrappers.py steps them)."""
 
 from __future__ import annotations
 
@@ -6,11 +7,14 @@ import gymnasium as gym
 import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import acld_gym  # noqa: F401
 from acld_gym.envs.beam_env import ACLDBeamEnv
 from acld_gym.envs.step import estimate_slots
 from acld_gym.wrappers import ObserveModes, UnitAction, WhitenObservation, whitening
+from acld_gym.wrappers.transforms import LinearMap, ModeSlots, UnitMap
 
 
 def test_unit_action_round_trip_is_exact():
@@ -174,3 +178,55 @@ def test_wrapped_made_envs_keep_a_recreatable_spec():
         ObserveModes(UnitAction(gym.make("ACLDBeam-v1", episode_length=0.05)), modes=1),
         skip_render_check=True,
     )
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.integers(1, 12),
+    st.integers(0, 3),
+    st.integers(1, 70),
+    st.integers(0, 2**32 - 1),
+)
+def test_the_shared_maps_map_a_batch_row_by_row_exactly(d, passthrough, rows, seed):
+    """The maps of the single and the vector wrappers (acld_gym.wrappers.transforms): a row
+    of a batch maps bit for bit as the row alone, whatever the batch's size (the linear map
+    sums in a fixed order, not by BLAS), so a vector env's sub-env sees what a single
+    env sees."""
+    rng = np.random.default_rng(seed)
+    n = d + passthrough
+    T = rng.normal(size=(d, d)) * 10.0 ** rng.integers(-3, 4, size=(d, d))
+    z = (rng.normal(size=(rows, n)) * 10.0 ** rng.integers(-6, 3, size=(rows, n))).astype(
+        np.float32
+    )
+    maps = [
+        LinearMap((n,), T, passthrough),
+        UnitMap(gym.spaces.Box(-120, 120, (1,), np.float32), 1.0 + rng.integers(0, 5)),
+    ]
+    for f, x in ((maps[0], z), (maps[0].mix, z), (maps[1], z[:, :1])):
+        batch = f(x)
+        assert batch.shape[:-1] == x.shape[:-1]
+        for i in range(rows):
+            assert np.array_equal(batch[i], f(x[i]))  # float64 before the cast, too
+    want = np.concatenate([z[:, :d].astype(np.float64) @ T, z[:, d:]], axis=1)
+    np.testing.assert_allclose(maps[0](z), want.astype(np.float32), rtol=1e-5, atol=1e-30)
+    slots = ModeSlots(ACLDBeamEnv(load_case=1).config, (9,), 1 + seed % 4)
+    big = rng.normal(size=(rows, 9)).astype(np.float32)
+    assert np.array_equal(slots(big), big[:, slots.slots])
+
+
+def test_single_and_vector_wrappers_share_one_map():
+    """One implementation of each transform: the single-env and the vector wrapper hold
+    the same map class, built from the same arguments."""
+    from acld_gym.wrappers import vector
+
+    T = np.eye(5)
+    single = WhitenObservation(ObserveModes(UnitAction(ACLDBeamEnv(), 2.0), 2), T)
+    envs = vector.WhitenObservation(
+        vector.ObserveModes(vector.UnitAction(gym.make_vec("ACLDBeam-v1", 2), 2.0), 2), T
+    )
+    s, v = single, envs
+    for cls in (LinearMap, ModeSlots, UnitMap):
+        assert type(s.map) is type(v.map) is cls
+        s, v = s.env, v.env
+    assert single.env.slots.tolist() == envs.env.slots.tolist() == [0, 1, 2, 3, 8]
+    assert single.env.env.headroom == envs.env.env.headroom == 2.0

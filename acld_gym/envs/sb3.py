@@ -1,31 +1,46 @@
 """Stable-Baselines3 adapter for :class:`acld_gym.envs.vector_env.ACLDBeamVectorEnv`.
 
 SB3 does not take a :class:`gymnasium.vector.VectorEnv`; :class:`SB3VecEnv` is
-an SB3 ``VecEnv`` over the native batched env. It converts the gymnasium
-``NEXT_STEP`` autoreset to SB3's same-step autoreset: a sub-env that ends is
-reset at once (the vector env's ``reset`` path for that sub-env) and its
-final observation is in ``infos[i]["terminal_observation"]``;
+an SB3 ``VecEnv`` over the native batched env, optionally in Gymnasium vector wrappers
+(the package's :mod:`acld_gym.wrappers.vector`, or Gymnasium's action and observation
+wrappers). It converts the gymnasium ``NEXT_STEP`` autoreset to SB3's same-step
+autoreset: a sub-env that ends is reset at once (the vector env's ``reset`` path for that
+sub-env), its reset observation passed through the observation wrappers, and its final
+observation (wrapped) is in ``infos[i]["terminal_observation"]``;
 ``infos[i]["TimeLimit.truncated"]`` is ``truncated and not terminated``.
 
 Example::
 
+    import gymnasium as gym
     from stable_baselines3 import PPO
     from acld_gym.envs import SB3VecEnv
+    from acld_gym.wrappers import vector
 
-    venv = SB3VecEnv(num_envs=16, load_case="random")
+    venv = SB3VecEnv(num_envs=16, load_case="random", wrappers=[vector.UnitAction])
     PPO("MlpPolicy", venv).learn(100_000)
 
-Actions are volts (+/-120); wrap with ``VecNormalize`` as usual, and rescale
-the policy output yourself if you want [-1, 1] actions.
+    # the same: a wrapped vector env of gym.make_vec, adapted
+    envs = vector.UnitAction(gym.make_vec("ACLDBeam-v1", num_envs=16, load_case="random"))
+    venv = SB3VecEnv(venv=envs)
+
+Without wrappers the actions are volts (+/-120); ``VecNormalize`` goes outside, as usual.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import fields
 from typing import Any
 
+import gymnasium as gym
 import numpy as np
+from gymnasium.vector import (
+    VectorActionWrapper,
+    VectorEnv,
+    VectorObservationWrapper,
+    VectorRewardWrapper,
+    VectorWrapper,
+)
 from stable_baselines3.common.vec_env import VecEnv
 
 from acld_gym.envs.config import EnvConfig
@@ -65,44 +80,144 @@ def _per_env(values) -> list:
     return [_scalar(x) for x in values]
 
 
-class SB3VecEnv(VecEnv):
-    """SB3 ``VecEnv`` over :class:`ACLDBeamVectorEnv` (``num_envs`` and the env's
-    configuration -- ``config=`` and/or its fields as keywords --, or an existing
-    ``venv=``).
+def apply_wrappers(env: VectorEnv, wrappers) -> VectorEnv:
+    """``env`` in ``wrappers`` (callables taking and returning a Gymnasium vector env, the
+    first innermost: :mod:`acld_gym.wrappers.vector`'s classes, ``functools.partial`` of
+    them, Gymnasium's vector wrappers); one line naming ``wrappers`` for anything else."""
+    if wrappers is None:
+        return env
+    if not isinstance(wrappers, (list, tuple)):
+        raise ValueError(
+            f"wrappers: expected a list of vector wrappers (callables taking and returning a "
+            f"gymnasium VectorEnv), got {type(wrappers).__name__}"
+        )
+    for w in wrappers:
+        cls = getattr(w, "func", w)  # a functools.partial's class
+        name = getattr(cls, "__name__", repr(cls))
+        if isinstance(cls, type) and issubclass(cls, gym.Wrapper):
+            raise ValueError(
+                f"wrappers: {name} is a single-env wrapper; use its vector version "
+                f"(acld_gym.wrappers.vector.{name}, gymnasium.wrappers.vector.{name})"
+            )
+        if not callable(w):
+            raise ValueError(f"wrappers: expected callables, got {w!r}")
+        out = w(env)
+        if not isinstance(out, VectorEnv):
+            raise ValueError(
+                f"wrappers: {name} returned {type(out).__name__}, not a gymnasium VectorEnv"
+            )
+        env = out
+    return env
 
-    ``seed_group`` (default 1): :meth:`seed` gives each run of ``seed_group`` consecutive
-    sub-envs one seed, so they draw the same episodes (loads, sensor noise) as long as
-    they end together: common random numbers, e.g. for antithetic exploration in pairs
-    (``seed_group=2``). An episode that leaves the deflection limit early puts its group
-    out of step from then on. It must divide the number of sub-envs."""
+
+def wrapper_chain(env: VectorEnv) -> tuple[ACLDBeamVectorEnv, list[VectorWrapper]]:
+    """The native env under ``env`` and the vector wrappers over it, innermost first.
+
+    The same-step autoreset resets a sub-env under the wrappers and passes its reset
+    observation through the observation wrappers alone; so the wrappers must be action,
+    observation or reward wrappers (``VectorActionWrapper``, ``VectorObservationWrapper``,
+    ``VectorRewardWrapper``), whose maps work row by row. Anything else (episode statistics,
+    reward normalization, which follow gymnasium's next-step autoreset) is refused with one
+    line naming ``venv``: use SB3's ``VecMonitor``/``VecNormalize`` outside the adapter."""
+    chain: list[VectorWrapper] = []
+    inner = env
+    while isinstance(inner, VectorWrapper):
+        if not isinstance(
+            inner, (VectorActionWrapper, VectorObservationWrapper, VectorRewardWrapper)
+        ):
+            raise ValueError(
+                f"venv: SB3VecEnv takes action, observation and reward wrappers, got "
+                f"{type(inner).__name__} (use SB3's VecMonitor/VecNormalize outside the adapter)"
+            )
+        chain.append(inner)
+        inner = inner.env
+    if not isinstance(inner, ACLDBeamVectorEnv):
+        raise ValueError(
+            f"venv: expected an ACLDBeamVectorEnv (gym.make_vec of an acld_gym id), possibly "
+            f"in vector wrappers, got {type(inner).__name__} (for single envs use SB3's "
+            f"DummyVecEnv or SubprocVecEnv)"
+        )
+    return inner, chain[::-1]
+
+
+class SB3VecEnv(VecEnv):
+    """SB3 ``VecEnv`` over :class:`ACLDBeamVectorEnv`, optionally in Gymnasium vector
+    wrappers: the fast path (one matrix product per step for all sub-envs) with the
+    package's wrappers (:mod:`acld_gym.wrappers.vector`).
+
+    Parameters
+    ----------
+    num_envs : int
+        Number of sub-envs, when the adapter builds the env (ignored with ``venv=``).
+    venv : gymnasium.vector.VectorEnv, optional
+        An existing env: an :class:`ACLDBeamVectorEnv` (``gym.make_vec`` of an acld_gym
+        id), bare or in vector action, observation and reward wrappers (e.g.
+        ``vector.ObserveModes(vector.UnitAction(gym.make_vec(...)))``; see
+        :func:`wrapper_chain`). Not together with ``config`` or the env's keywords.
+    config : acld_gym.envs.config.EnvConfig, optional
+        The env's configuration, with or instead of its fields as keywords (``**env_kwargs``).
+    seed_group : int
+        (default 1) :meth:`seed` gives each run of ``seed_group`` consecutive sub-envs one
+        seed, so they draw the same episodes (loads, sensor noise) as long as they end
+        together: common random numbers, e.g. for antithetic exploration in pairs
+        (``seed_group=2``). An episode that leaves the deflection limit early puts its group
+        out of step from then on. It must divide the number of sub-envs.
+    wrappers : list of callable, optional
+        Vector wrappers applied to the env (built or ``venv=``), the first innermost, e.g.
+        ``[vector.UnitAction, functools.partial(vector.ObserveModes, modes=2)]`` with
+        ``from acld_gym.wrappers import vector``: actions then in [-1, 1] (not volts
+        [V]) and the observation the first two modes and the tip, as for
+        ``ObserveModes(UnitAction(gym.make(...)), 2)``.
+
+    Attributes
+    ----------
+    venv : ACLDBeamVectorEnv
+        The native env (unwrapped): ``get_attr``, ``set_attr`` and ``env_method`` reach it.
+    vector_env : gymnasium.vector.VectorEnv
+        The env this adapter steps: ``venv`` in the wrappers (``venv`` itself without).
+
+    Notes
+    -----
+    The spaces are the outermost wrapper's. A sub-env that ends is reset at once under the
+    wrappers (:meth:`ACLDBeamVectorEnv.reset_done`) and its reset observation passed through
+    the observation wrappers' ``observations`` (those rows only), so sub-env i sees what
+    a single env in the single-env wrappers, reset after each episode, sees.
+    ``env_is_wrapped(cls)`` is True where a wrapper of class ``cls`` is in the chain.
+    """
 
     def __init__(
         self,
         num_envs: int = 1,
-        venv: ACLDBeamVectorEnv | None = None,
+        venv: VectorEnv | None = None,
         config: EnvConfig | None = None,
         seed_group: int = 1,
+        wrappers: Sequence[Callable[[VectorEnv], VectorEnv]] | None = None,
         **env_kwargs,
     ):
         if venv is None:
             venv = ACLDBeamVectorEnv(num_envs=num_envs, config=config, **env_kwargs)
         elif env_kwargs or config is not None:
             raise ValueError("pass either venv= or the env's configuration, not both")
-        check_int("seed_group", seed_group, 1, venv.num_envs)
-        if venv.num_envs % seed_group:
+        base, _ = wrapper_chain(venv)  # checked before the wrappers are applied
+        check_int("seed_group", seed_group, 1, base.num_envs)
+        if base.num_envs % seed_group:
             raise ValueError(
-                f"seed_group: expected a divisor of the {venv.num_envs} sub-envs, got {seed_group}"
+                f"seed_group: expected a divisor of the {base.num_envs} sub-envs, got {seed_group}"
             )
+        outer = apply_wrappers(venv, wrappers)
+        base, self._chain = wrapper_chain(outer)
+        self._observers = [w for w in self._chain if isinstance(w, VectorObservationWrapper)]
         self.seed_group = seed_group
-        self.venv = venv
-        super().__init__(venv.num_envs, venv.single_observation_space, venv.single_action_space)
-        self.render_mode = venv.render_mode
+        self.venv = base
+        self.vector_env = outer
+        super().__init__(base.num_envs, outer.single_observation_space, outer.single_action_space)
+        self.render_mode = base.render_mode
         self._actions: np.ndarray | None = None
         self._seed: int | list[int] | None = None
         self._reset_options: dict = {}
 
     def reset(self) -> np.ndarray:
-        obs, _ = self.venv.reset(seed=self._seed, options=self._reset_options or None)
+        obs, _ = self.vector_env.reset(seed=self._seed, options=self._reset_options or None)
         self._seed = None
         self._reset_options = {}
         self.reset_infos = [{} for _ in range(self.num_envs)]
@@ -113,11 +228,24 @@ class SB3VecEnv(VecEnv):
             raise RuntimeError("SB3VecEnv: call reset() before step()")
         self._actions = np.asarray(actions)
 
+    def _reset_ended(self, obs: np.ndarray, ended: np.ndarray) -> np.ndarray:
+        """The batch's observation with the sub-envs ``ended`` reset now: the native env's
+        (unwrapped) without observation wrappers, else ``obs`` with those rows replaced by
+        their reset observations through the observation wrappers, innermost first."""
+        raw = self.venv.reset_done(ended)
+        if not self._observers:
+            return raw
+        rows = raw[ended]
+        for w in self._observers:
+            rows = w.observations(rows)
+        obs = np.array(obs)
+        obs[ended] = rows
+        return obs
+
     def step_wait(self):
         if self._actions is None:
             raise RuntimeError("step_wait() called without step_async()")
-        v = self.venv
-        obs, rewards, terminated, truncated, info = v.step(self._actions)
+        obs, rewards, terminated, truncated, info = self.vector_env.step(self._actions)
         self._actions = None
         done = terminated | truncated
         keys = INFO_KEYS + (("reward_scale",) if "reward_scale" in info else ())
@@ -130,11 +258,11 @@ class SB3VecEnv(VecEnv):
             for i in ended:
                 infos[i]["terminal_observation"] = obs[i].copy()
                 infos[i]["TimeLimit.truncated"] = bool(truncated[i] and not terminated[i])
-            obs = v.reset_done(ended)
+            obs = self._reset_ended(obs, ended)
         return obs, rewards.astype(np.float32), done, infos
 
     def close(self) -> None:
-        self.venv.close()
+        self.vector_env.close()
 
     def seed(self, seed: int | None = None) -> Sequence[None | int]:
         """Seeds the next ``reset()``: sub-env i gets ``seed + i // seed_group`` (``seed +
@@ -153,7 +281,7 @@ class SB3VecEnv(VecEnv):
         self._reset_options = dict(options or {})
 
     def get_images(self) -> Sequence[np.ndarray | None]:
-        frame = self.venv.render() if self.render_mode == "rgb_array" else None
+        frame = self.vector_env.render() if self.render_mode == "rgb_array" else None
         return [frame] + [None] * (self.num_envs - 1)
 
     def _indices(self, indices) -> list[int]:
@@ -191,4 +319,7 @@ class SB3VecEnv(VecEnv):
         return [method(*method_args, **method_kwargs) for _ in self._indices(indices)]
 
     def env_is_wrapped(self, wrapper_class, indices=None) -> list[bool]:
-        return [False for _ in self._indices(indices)]
+        """True for every index if a vector wrapper of class ``wrapper_class`` is in the
+        chain (the wrappers are shared by all sub-envs)."""
+        wrapped = any(isinstance(w, wrapper_class) for w in self._chain)
+        return [wrapped for _ in self._indices(indices)]

@@ -347,7 +347,7 @@ def main(argv: list[str] | None = None) -> int:
     if "mpc" not in policies:
         from .policies import MPC_MISSING
 
-        print(f"mpc and mpc_oracle skipped: {MPC_MISSING}")
+        print(f"mpc skipped (and mpc_rig, mpc_oracle): {MPC_MISSING}")
     labels = mark_labels(policies)
     rows = evaluate(
         policies, seed=args.seed, env_kwargs={"config": config}, episodes=episodes, quiet=args.quiet

@@ -230,3 +230,24 @@ def test_single_and_vector_wrappers_share_one_map():
         s, v = s.env, v.env
     assert single.env.slots.tolist() == envs.env.slots.tolist() == [0, 1, 2, 3, 8]
     assert single.env.env.headroom == envs.env.env.headroom == 2.0
+
+
+@pytest.mark.parametrize(
+    "wrap",
+    [
+        UnitAction,
+        ObserveModes,
+        lambda env: WhitenObservation(env, np.eye(9)),
+    ],
+)
+def test_single_env_wrappers_name_their_vector_version(wrap):
+    """A vector env given to a single-env wrapper: one line pointing at the vector
+    version (acld_gym.wrappers.vector), not gymnasium's assertion."""
+    with pytest.raises(
+        ValueError,
+        match=r"^env: \w+ wraps a single env; for a vector env use "
+        r"acld_gym\.wrappers\.vector\.\w+$",
+    ):
+        wrap(gym.make_vec("ACLDBeam-v1", num_envs=2))
+    with pytest.raises(ValueError, match=r"^env: \w+ wraps a gymnasium.Env, got str$"):
+        wrap("ACLDBeam-v1")

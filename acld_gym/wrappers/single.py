@@ -11,6 +11,18 @@ from acld_gym.wrappers.transforms import LinearMap, ModeSlots, UnitMap
 __all__ = ["UnitAction", "ObserveModes", "WhitenObservation"]
 
 
+def _check_single(env, owner: str) -> None:
+    """One line naming ``env`` if it is not a single Gymnasium env (a vector env has its
+    own version of the wrapper)."""
+    if isinstance(env, gym.vector.VectorEnv):
+        raise ValueError(
+            f"env: {owner} wraps a single env; for a vector env use "
+            f"acld_gym.wrappers.vector.{owner}"
+        )
+    if not isinstance(env, gym.Env):
+        raise ValueError(f"env: {owner} wraps a gymnasium.Env, got {type(env).__name__}")
+
+
 class UnitAction(gym.ActionWrapper, gym.utils.RecordConstructorArgs):
     r"""Actions ``a`` in [-1, 1] for an env whose action is a voltage in [-v_max, v_max]:
     ``V = k v_max a`` [V] with the ``headroom`` k (default 1), computed in float64, so the
@@ -43,6 +55,7 @@ class UnitAction(gym.ActionWrapper, gym.utils.RecordConstructorArgs):
 
     def __init__(self, env: gym.Env, headroom: float = 1.0):
         gym.utils.RecordConstructorArgs.__init__(self, headroom=headroom)
+        _check_single(env, "UnitAction")
         gym.ActionWrapper.__init__(self, env)
         self.map = UnitMap(env.action_space, headroom, "UnitAction")
         self.headroom, self.v_max = self.map.headroom, self.map.v_max
@@ -90,6 +103,7 @@ class ObserveModes(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
 
     def __init__(self, env: gym.Env, modes: int = 2):
         gym.utils.RecordConstructorArgs.__init__(self, modes=modes)
+        _check_single(env, "ObserveModes")
         gym.ObservationWrapper.__init__(self, env)
         config = getattr(env.unwrapped, "config", None)
         self.map = ModeSlots(config, env.observation_space.shape, modes, "ObserveModes")
@@ -123,6 +137,7 @@ class WhitenObservation(gym.ObservationWrapper, gym.utils.RecordConstructorArgs)
 
     def __init__(self, env: gym.Env, transform, passthrough: int = 0):
         gym.utils.RecordConstructorArgs.__init__(self, transform=transform, passthrough=passthrough)
+        _check_single(env, "WhitenObservation")
         gym.ObservationWrapper.__init__(self, env)
         self.map = LinearMap(env.observation_space.shape, transform, passthrough)
         self.transform, self.passthrough = self.map.transform, self.map.passthrough

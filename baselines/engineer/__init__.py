@@ -9,7 +9,12 @@ cannot know (the episode's load, temperature and parameters) stays out.
   augmented with the commands in flight and the amplifier's lag, its Kalman filter fed the
   voltage that reaches the amplifier;
 * :class:`ActuatorMPCPolicy` (``"mpc_rig"``): the MPC of the env's reward with the delay by
-  prediction, the slew limit as a rate constraint and the lag in its model;
+  prediction, the slew limit as a rate constraint, the lag in its model and the LQR's
+  cost-to-go as its tail (about rest it is the LQG's law; saturated it plans the limit);
+
+Both keep their own filter on the tip measurement (SB3's ``state``): the ``"estimate"``
+observation's tip or the ``"measurement"`` observation's newest sample. Their small-signal
+loop on a plant: :func:`spectral_radius` (:mod:`baselines.engineer.loop`).
 
 :func:`engineer_policies` returns a level's references by name, with the level's design
 (:data:`DESIGNS`, chosen offline on training episodes: :mod:`baselines.engineer.tuning`).

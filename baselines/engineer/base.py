@@ -92,9 +92,13 @@ class RigPolicy:
 
     @classmethod
     def for_env(cls, env, **kwargs):
-        """The policy for ``env`` (any wrapper): its nominal design and configuration."""
+        """The policy for ``env`` (any wrapper): its nominal design and configuration, with
+        the level's design parameters (:data:`baselines.engineer.designs.DESIGNS`;
+        ``kwargs`` replace them)."""
+        from .designs import design_kwargs
+
         e = env.unwrapped
-        return cls(e.nom, e.config, **kwargs)
+        return cls(e.nom, e.config, **(design_kwargs(e.nom, e.config) | kwargs))
 
     @property
     def observation_fingerprint(self) -> dict:

@@ -74,9 +74,7 @@ def engineer_policies(env) -> dict:
     name -> policy with SB3's ``predict``: ``"lqg"`` (:class:`DelayLQGPolicy`) and, where
     the QP solver osqp is installed, ``"mpc_rig"`` (:class:`ActuatorMPCPolicy`), both with
     the level's design (:data:`DESIGNS`)."""
-    e = env.unwrapped
-    kw = design_kwargs(e.nom, e.config)
-    out = {"lqg": DelayLQGPolicy(e.nom, e.config, **kw)}
+    out = {"lqg": DelayLQGPolicy.for_env(env)}
     if mpc_available():
-        out["mpc_rig"] = ActuatorMPCPolicy(e.nom, e.config, **kw)
+        out["mpc_rig"] = ActuatorMPCPolicy.for_env(env)
     return out

@@ -34,15 +34,20 @@ class DelayLQGPolicy(RigPolicy):
     **The Kalman filter** (:mod:`baselines.engineer.base`) estimates the plant part from
     the tip measurement, fed the voltage that actually reaches the amplifier (the commands
     in flight are known exactly); its process noise is the load (``load_std`` [N], white
-    across periods) and the model's error (``model_std``, as
-    :func:`acld_gym.design.observer.discrete_kalman`), its sensor noise the level's
-    ``sensor_noise``. Equivalent to applying the delay-free gain to the prediction
-    :math:`\hat x_{k+d|k}`.
+    across periods) and the model's error (``model_std``: one value, or one per state of
+    the plant part; as :func:`acld_gym.design.observer.discrete_kalman`), its sensor noise
+    the level's ``sensor_noise``. Equivalent to applying the delay-free gain to the
+    prediction :math:`\hat x_{k+d|k}`. ``for_env`` (and
+    :func:`~baselines.engineer.designs.engineer_policies`) take the level's noise model
+    from :data:`~baselines.engineer.designs.DESIGNS`, chosen offline on training episodes;
+    on ``ACLDBeamHard-v1`` it is the design for the level's distribution of plants.
 
     **Knows**: the nominal beam (20 °C, nominal parameters), the delay, the amplifier's
-    bandwidth and slew rate, the sensor's noise, the reward's weights. **Does not know**:
-    the episode's load, temperature and parameters. On ``ACLDBeam-v1`` (no actuator) it
-    is the plain output-feedback LQG on the reward's weights.
+    bandwidth and slew rate, the sensor's noise, the reward's weights and, on the Hard
+    level, the range of temperature and the parameter scatter (through the offline
+    choice of its noise model). **Does not know**: the episode's load, temperature and
+    parameters. On ``ACLDBeam-v1`` (no actuator) it is the plain output-feedback LQG on
+    the reward's weights.
     """
 
     name = "lqg"

@@ -13,6 +13,7 @@ from contextlib import contextmanager
 import numpy as np
 import torch
 import torch.nn as nn
+from stable_baselines3.common.logger import Logger
 from stable_baselines3.common.vec_env import VecNormalize
 
 import acld_gym  # noqa: F401  (registers the env ids)
@@ -180,7 +181,11 @@ def make_model(cfg: TrainConfig, venv, seed: int, **kwargs):
     model_kwargs.setdefault("verbose", 0)
     cls = algo_class(cfg.algo)
     model_kwargs = _flat_n_step_buffer(cls, venv, {**model_kwargs, **kwargs})
-    return cls(policy, venv, seed=seed, device="cpu", **model_kwargs)
+    model = cls(policy, venv, seed=seed, device="cpu", **model_kwargs)
+    if not model_kwargs.get("verbose") and model_kwargs.get("tensorboard_log") is None:
+        # SB3's default logger makes an empty /tmp/SB3-<date> folder per model: log nowhere.
+        model.set_logger(Logger(folder=None, output_formats=[]))
+    return model
 
 
 def _flat_n_step_buffer(cls, venv, model_kwargs: dict) -> dict:

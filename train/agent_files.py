@@ -22,7 +22,9 @@ import json
 import math
 import os
 import stat
+import struct
 import zipfile
+import zlib
 from collections.abc import Iterable
 from pathlib import Path
 
@@ -68,6 +70,19 @@ REPLACEABLE = frozenset(
         "model.zip",
         "vecnormalize.pkl",
     }
+)
+#: What zipfile, zlib and numpy's header reader raise on damaged bytes (zipfile's
+#: NotImplementedError for an unknown zip version, struct.error for a short record).
+_ZIP_ERRORS = (
+    zipfile.BadZipFile,
+    zipfile.LargeZipFile,
+    OSError,
+    ValueError,
+    EOFError,
+    NotImplementedError,
+    RuntimeError,
+    struct.error,
+    zlib.error,
 )
 _NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
 _FLAGS = os.O_RDONLY | _NOFOLLOW | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)
@@ -210,8 +225,8 @@ def read_arrays(data: bytes, needed: Iterable[str], where: str) -> dict[str, np.
     try:
         archive = zipfile.ZipFile(io.BytesIO(data))
         infos = archive.infolist()
-    except (zipfile.BadZipFile, zipfile.LargeZipFile, OSError, ValueError, EOFError) as exc:
-        raise AgentFileError(f"{where}: not a readable numpy archive ({exc})") from None
+    except _ZIP_ERRORS as exc:
+        raise AgentFileError(f"{where}: not a readable numpy archive ({_cut(str(exc))})") from None
     if len(infos) > MAX_MEMBERS:
         raise AgentFileError(f"{where}: {len(infos)} members, more than {MAX_MEMBERS}")
     names = [i.filename for i in infos]
@@ -326,7 +341,7 @@ def _read_member(archive: zipfile.ZipFile, info: zipfile.ZipInfo, where: str) ->
                 raise ValueError("its data do not match its header")
     except AgentFileError:
         raise
-    except (zipfile.BadZipFile, OSError, ValueError, EOFError, TypeError) as exc:
+    except (*_ZIP_ERRORS, TypeError) as exc:
         raise AgentFileError(f"{where}: array {key!r} is damaged ({_cut(str(exc))})") from None
     arr = np.frombuffer(raw, dtype=dtype).reshape(shape, order="F" if fortran else "C")
     return arr.astype(np.float64)

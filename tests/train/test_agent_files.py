@@ -195,6 +195,18 @@ def test_missing_extra_and_damaged_members_are_named(tmp_path):
         TrainedAgent.load(d, check=False)
 
 
+def test_an_archive_needing_an_unknown_zip_version_is_named(tmp_path):
+    """Found by the fuzz: zipfile raises NotImplementedError for a member whose central
+    record asks for zip version 8.4."""
+    d = _copy("vrs", tmp_path / "a")
+    data = bytearray((d / POLICY_FILE).read_bytes())
+    record = data.rindex(b"PK\x01\x02")
+    data[record + 6] = 84  # "version needed to extract"
+    (d / POLICY_FILE).write_bytes(bytes(data))
+    with pytest.raises(AgentFileError, match=rf"{POLICY_FILE}: not a readable numpy archive"):
+        TrainedAgent.load(d, check=False)
+
+
 def test_an_archive_listing_thousands_of_members_is_refused(tmp_path):
     d = _copy("vrs", tmp_path / "a")
     with zipfile.ZipFile(d / POLICY_FILE, "a") as z:

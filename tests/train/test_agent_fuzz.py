@@ -51,6 +51,9 @@ VALUES = [
     {"op": "clip"},
     {"a": 1},
 ]
+#: Keys an insertion adds: env settings, operation parameters, top-level fields, junk.
+KEYS = ["mesh", "dt", "sensor_noise", "temperature", "obs_mode", "layer", "low", "high"]
+KEYS += ["clip", "eps", "id", "kwargs", "format", "residual", "action_headroom", "junk"]
 FUZZ = settings(
     max_examples=300,
     deadline=None,
@@ -69,9 +72,15 @@ def _paths(obj, prefix=()):
         yield from _paths(value, (*prefix, key))
 
 
+def _node(meta, path):
+    for key in path:
+        meta = meta[key]
+    return meta
+
+
 def _mutate(meta, path, action, value):
     """``meta`` with the node at ``path`` deleted (``action`` "delete") or set to
-    ``value``."""
+    ``value`` (added, for a new key)."""
     *parents, last = path
     node = meta
     for key in parents:
@@ -120,9 +129,14 @@ def metadata_texts(draw):
         paths = list(_paths(meta))
         if not paths:
             break
-        path = draw(st.sampled_from(paths))
-        action = draw(st.sampled_from(["delete", "retype"]))
-        meta = _mutate(meta, path, action, draw(st.sampled_from(VALUES)))
+        action = draw(st.sampled_from(["delete", "retype", "insert"]))
+        value = draw(st.sampled_from(VALUES))
+        if action == "insert":  # a new key in an object: the root, env.kwargs, an op, ...
+            objects = [()] + [p for p in paths if isinstance(_node(meta, p), dict)]
+            path = (*draw(st.sampled_from(objects)), draw(st.sampled_from(KEYS)))
+        else:
+            path = draw(st.sampled_from(paths))
+        meta = _mutate(meta, path, action, value)
     text = json.dumps(meta)
     if draw(st.booleans()):
         text = text[: draw(st.integers(0, len(text)))]

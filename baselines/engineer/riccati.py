@@ -7,7 +7,7 @@ RigModel.scale`: each reduced state's peak in the passive response to thesis cas
 for a voltage), the input in units of 120 V and the measurement in units of the sensor's
 noise. The gains are mapped back exactly; a similarity transform of the model (another sign
 or basis of its states, with D transformed alike) gives the same law
-(tests/baselines/engineer/test_design.py).
+(tests/baselines/engineer/test_model.py).
 """
 
 from __future__ import annotations

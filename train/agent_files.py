@@ -326,7 +326,7 @@ def _read_member(archive: zipfile.ZipFile, info: zipfile.ZipInfo, where: str) ->
                 raise AgentFileError(
                     f"{where}: array {key!r} holds {dtype.str!r} values, expected real numbers"
                 )
-            if not 1 <= len(shape) <= 2:
+            if not 1 <= len(shape) <= 2 or any(n < 0 for n in shape):
                 raise AgentFileError(
                     f"{where}: array {key!r} has shape {shape}, expected a vector or a matrix"
                 )

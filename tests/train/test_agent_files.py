@@ -5,6 +5,7 @@ old one, and needs ``--force`` to replace one."""
 
 from __future__ import annotations
 
+import io
 import json
 import os
 import shutil
@@ -205,6 +206,35 @@ def test_an_archive_needing_an_unknown_zip_version_is_named(tmp_path):
     (d / POLICY_FILE).write_bytes(bytes(data))
     with pytest.raises(AgentFileError, match=rf"{POLICY_FILE}: not a readable numpy archive"):
         TrainedAgent.load(d, check=False)
+
+
+def _npy(header: bytes) -> bytes:
+    """A .npy member of format 1.0 with this header dict and 8 bytes of data."""
+    pad = b" " * ((64 - (len(header) + 11) % 64) % 64) + b"\n"
+    return b"\x93NUMPY\x01\x00" + (len(header) + len(pad)).to_bytes(2, "little") + header + pad
+
+
+@pytest.mark.parametrize(
+    "shape, descr, match",
+    [
+        (b"(-1,)", b"'<f8'", r"has shape \(-1,\), expected a vector"),
+        (b"(" * 3000 + b")" * 3000, b"'<f8'", "is damaged"),
+        (b"(1,)", b"__import__('os').system('touch PWNED')", "is damaged"),
+        (b"(1,)", b"[('a', '<f8')]", "holds '|V8' values"),
+    ],
+)
+def test_a_hostile_npy_header_is_refused_without_evaluating_it(tmp_path, shape, descr, match):
+    d = _copy("vrs", tmp_path / "a")
+    header = b"{'descr': " + descr + b", 'fortran_order': False, 'shape': " + shape + b", }"
+    arrays = _arrays(d)
+    with zipfile.ZipFile(d / POLICY_FILE, "w") as z:
+        z.writestr("W0.npy", _npy(header) + bytes(8))
+        buf = io.BytesIO()
+        np.save(buf, arrays["b0"])
+        z.writestr("b0.npy", buf.getvalue())
+    with pytest.raises(AgentFileError, match=rf"{POLICY_FILE}: array 'W0' {match}"):
+        TrainedAgent.load(d, check=False)
+    assert not (tmp_path / "PWNED").exists() and not Path("PWNED").exists()
 
 
 def test_an_archive_listing_thousands_of_members_is_refused(tmp_path):

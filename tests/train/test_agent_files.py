@@ -348,6 +348,20 @@ def test_ship_refuses_an_agent_that_would_not_load(tmp_path):
     assert not (tmp_path / "agents").exists()
 
 
+def test_ship_onto_a_linked_name_replaces_the_link_not_its_target(tmp_path):
+    elsewhere = _copy("vrs", tmp_path / "elsewhere")
+    before = {p.name: p.read_bytes() for p in elsewhere.iterdir()}
+    agents = tmp_path / "agents"
+    agents.mkdir()
+    (agents / "mine").symlink_to(elsewhere)
+    with pytest.raises(FileExistsError, match="pass --force"):
+        ship(_copy("sac", tmp_path / "run"), "mine", agents)
+    ship(tmp_path / "run", "mine", agents, force=True)
+    assert not (agents / "mine").is_symlink()
+    assert TrainedAgent.load(agents / "mine").metadata["algo"] == "sac"
+    assert {p.name: p.read_bytes() for p in elsewhere.iterdir()} == before
+
+
 def test_ship_never_copies_a_linked_learning_curve(tmp_path):
     secret = tmp_path / "secret.txt"
     secret.write_text("a file elsewhere on the machine\n")

@@ -63,13 +63,21 @@ def test_a_module_env_id_imports_nothing(tmp_path, monkeypatch):
     assert not marker.exists() and "evil_agent" not in sys.modules
 
 
-def test_analyze_from_the_parent_folder_runs_nothing(tmp_path):
-    """The probe's case: ``python -m baselines.analyze evil_agent`` run from the folder
-    holding it (so that the agent is importable) exits with one line and runs nothing."""
+@pytest.mark.parametrize(
+    "command",
+    [
+        ["baselines.analyze", "evil_agent", "--quiet"],
+        ["train.compare", "--agents", ".", "--only", "evil_agent", "--quiet"],
+    ],
+)
+def test_the_commands_run_nothing_from_the_agents_parent_folder(tmp_path, command):
+    """The probe's case: ``python -m baselines.analyze evil_agent`` (or ``train.compare``)
+    run from the folder holding it (so that the agent is importable) exits with one line
+    and runs nothing."""
     _, marker = _evil(tmp_path)
     env = dict(os.environ, PYTHONPATH=str(ROOT), OMP_NUM_THREADS="1")
     run = subprocess.run(
-        [sys.executable, "-m", "baselines.analyze", "evil_agent", "--quiet"],
+        [sys.executable, "-m", *command],
         cwd=tmp_path,
         env=env,
         capture_output=True,

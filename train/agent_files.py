@@ -349,8 +349,9 @@ def _read_member(archive: zipfile.ZipFile, info: zipfile.ZipInfo, where: str) ->
 
 def check_replaceable(path: str | Path) -> Path:
     """``path`` (absolute) if :func:`write_folder` may put an agent there: it does not
-    exist, or is an agent's or a run's folder (only :data:`REPLACEABLE` files), and is not
-    the working directory or one holding it. ``ValueError`` naming it otherwise: call it
+    exist, or is an agent's or a run's folder (only :data:`REPLACEABLE` files and hidden
+    ones, such as a desktop's ``.DS_Store``; no folder), and is not the working directory
+    or one holding it. ``ValueError`` naming it otherwise: call it
     before computing anything."""
     path = Path(os.path.abspath(path))
     if not path.name or path == Path(path.anchor):
@@ -366,7 +367,10 @@ def check_replaceable(path: str | Path) -> Path:
         raise ValueError(f"{str(path)!r} holds the working directory; it cannot be replaced")
     with os.scandir(path) as entries:
         other = sorted(
-            e.name for e in entries if e.name not in REPLACEABLE or e.is_dir(follow_symlinks=False)
+            e.name
+            for e in entries
+            if e.is_dir(follow_symlinks=False)
+            or not (e.name in REPLACEABLE or e.name.startswith("."))
         )
     if other:
         raise ValueError(

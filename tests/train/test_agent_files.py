@@ -383,6 +383,8 @@ def test_ship_never_copies_a_linked_learning_curve(tmp_path):
 
 def test_a_folder_with_other_files_or_the_working_directory_is_not_replaced(tmp_path, monkeypatch):
     d = _copy("vrs", tmp_path / "a")
+    (d / ".DS_Store").write_bytes(b"a desktop's")  # hidden files go with the folder
+    assert check_replaceable(d) == d
     (d / "notes.txt").write_text("mine")
     agent = TrainedAgent.load(d)
     with pytest.raises(ValueError, match=r"holds \['notes.txt'\] besides an agent's files"):

@@ -49,6 +49,7 @@ from pathlib import Path
 from acld_gym.util.atomic import check_directory, check_writable, write_text, write_texts
 from acld_gym.util.validate import DataFileError, arg_type, run_main
 
+from .agent_files import check_replaceable
 from .bench.evaluate import DEFAULT_ENV_ID
 from .bench.records import check_references, check_trial, read_json
 from .bench.report import markdown, plot_curves, summarize
@@ -191,6 +192,10 @@ def check_outputs(out: Path, trials: list[dict], backend: str, env_id: str) -> N
     for t in trials:
         names.append(str(trial_path(Path(), t["name"], t["seed"])))
         check_directory(agent_dir(out, t["name"], t["seed"]).parent, "--out")
+        try:  # each agent folder is replaced whole: it may hold no one else's files
+            check_replaceable(agent_dir(out, t["name"], t["seed"]))
+        except ValueError as exc:
+            raise ValueError(f"--out: {exc}") from None
     if backend == "ray":
         check_directory(out / "ray", "--out")
     for name in dict.fromkeys(names):

@@ -521,3 +521,19 @@ def test_compare_lists_a_broken_agent_to_name_it_and_reads_curves_as_load_does(t
     (agents / "good" / CURVE_FILE).symlink_to(secret)
     assert learning_curves_figure(load_agents(agents, ["good"])) is None
     assert "good: no learning curve" in capsys.readouterr().err
+
+
+def test_benchmark_refuses_an_agent_folder_with_other_files_before_computing(tmp_path, capsys):
+    """``python -m train.benchmark`` replaces each trial's agent folder whole: a folder in
+    the way holding the user's files is refused at once, before the references."""
+    from train.benchmark import main as benchmark_main
+
+    folder = tmp_path / "out" / "agents" / "vrs-s0"
+    folder.mkdir(parents=True)
+    (folder / "notes.txt").write_text("mine")
+    with pytest.raises(SystemExit) as exit_:
+        benchmark_main(["--algos", "vrs", "--seeds", "0", "--out", str(tmp_path / "out")])
+    assert exit_.value.code == 2
+    err = capsys.readouterr().err.splitlines()[-1]
+    assert "--out:" in err and "notes.txt" in err
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["agents"]

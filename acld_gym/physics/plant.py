@@ -19,7 +19,10 @@ Two meshes (``mesh=``):
       \mathcal V = \operatorname{span}\{(K + sC + s^2 M)^{-1} [P_c, F_d]\}
       \quad (\text{real and imaginary parts}),
 
-  18 vectors for the default 1 ms period, 36 states. Interpolating at the
+  18 vectors for the default 1 ms period, 36 states (directions below 1e-10 of the
+  largest singular value are rounding and dropped:
+  :func:`acld_gym.physics.krylov.subspace_basis`; 78 states at 0.1 ms). The modes are
+  enumerated on the fine mesh itself (:mod:`acld_gym.physics.spectrum`). Interpolating at the
   resonances makes the projection match the fine mesh's frequency responses to
   about 1e-5 (relative H-infinity) in the band.
 
@@ -41,7 +44,9 @@ Galerkin projection.
 The coordinates are canonical (the same on every machine): for ``"thesis"`` the
 FE DOFs; for ``"converged"`` the Ritz vectors of the subspace (eigenvectors of the
 projected undamped pencil, mass-normalized, ordered by Ritz value, each signed so
-that its participation in :math:`P_c / \|P_c\| + F_d / \|F_d\|` is positive).
+that its participation in :math:`P_c / \|P_c\| + F_d / \|F_d\|` is positive, or its
+largest entry where that participation is below 1e-8 of the largest:
+:func:`acld_gym.physics.krylov.ritz_signs`).
 """
 
 from __future__ import annotations

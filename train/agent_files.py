@@ -386,12 +386,15 @@ def write_folder(
     """Put an agent folder at ``path`` whole (module docstring): ``policy.npz`` with
     ``arrays``, ``metadata.json`` with ``meta`` (non-finite numbers as null) and each text
     file of ``texts``; the folder's previous content is gone, or, if anything fails, left
-    as it was. ``ValueError`` if :func:`check_replaceable` refuses ``path``."""
+    as it was. ``ValueError`` if :func:`check_replaceable` refuses ``path``; an
+    :class:`AgentFileError` if ``meta`` would not load (:func:`parse_metadata`), before
+    anything is written."""
     path = check_replaceable(path)
     for name in texts:
         if name in ("policy.npz", "metadata.json") or Path(name).name != name:
             raise ValueError(f"{name!r} is not an extra file name of an agent folder")
     meta_text = json.dumps(_finite(meta), indent=2, allow_nan=False) + "\n"
+    parse_metadata(meta_text.encode(), str(path / "metadata.json"))  # write only what loads
 
     def fill(tmp: Path) -> None:
         with open(tmp / "policy.npz", "wb") as fh:

@@ -389,6 +389,10 @@ def test_a_folder_with_other_files_or_the_working_directory_is_not_replaced(tmp_
     agent = TrainedAgent.load(d)
     with pytest.raises(ValueError, match=r"holds \['notes.txt'\] besides an agent's files"):
         agent.save(d)
+    agent.metadata["env"] = {"id": "evil_agent:ACLDBeam-v1"}  # never written: it would not load
+    with pytest.raises(AgentFileError, match="env.id must be one of"):
+        agent.save(tmp_path / "b")
+    assert not (tmp_path / "b").exists()
     assert (d / "notes.txt").read_text() == "mine"
     (d / "notes.txt").unlink()
     monkeypatch.chdir(d)

@@ -4,7 +4,7 @@ VENV    := .venv
 BIN     := $(VENV)/bin
 STAMP   := $(VENV)/.installed-stamp
 # The Python sources ruff lints and formats.
-PYSRC   := acld_gym baselines train tests benchmarks setup.py .ci
+PYSRC   := acld_gym baselines train tests benchmarks studies setup.py .ci
 
 .PHONY: install run studies test test-slow docs wheel-check lint format bench agents clean
 

@@ -1,6 +1,7 @@
 """The one training configuration: a YAML file per recipe under ``train/benchmark/``
-(``ppo.yaml``, ``sac.yaml``, ``vrs.yaml``, the ablations -- ``base: ppo`` and what they
-change (:func:`read_config`) --, the opt-in DAgger starts), validated into a
+(``ppo.yaml``, ``sac.yaml``, ``vrs.yaml``, the opt-in DAgger starts; a file of your own may
+be ``base: ppo`` and what it changes, :func:`read_config`; the research record's variants
+are in ``studies/ablations/``, not packaged), validated into a
 :class:`TrainConfig`. ``python -m train`` and ``python -m train.benchmark`` read the same
 files, build the same env (:func:`train.vec.make_vec_env`), train with the same function
 (:func:`train.bench.algos.train_algo`) and evaluate with the same evaluator
@@ -284,19 +285,15 @@ class TrainConfig:
         from it, :func:`train.bench.algos.restart_seeds`); the trial returns the run whose
         chosen check has the lowest validation cost (the same validation loads for all).
         The budget is ``restarts * timesteps`` (:attr:`budget`). Default 1: one run.
-    restart_above : str, float or None
+    restart_above : float, "lqr" or None
         With ``restarts`` > 1: a run is followed by the next only if its chosen check's
-        validation cost (:func:`train.bench.evaluate.validation_cost`) is above this:
-        ``"<ratio> * <reference>"`` (e.g. ``"1.03 * lqg"``; a reference alone: ratio 1),
-        the ratio times the reference's cost on the same validation loads of the level
-        the run trains on (``lqg``, the level's engineer's LQG; ``lqr``, the thesis LQR;
-        ``passive``), resolved before the first run
-        (:class:`train.bench.threshold.RestartRule`), so one recipe carries over to every
-        level; a bare number: an absolute cost of ``ACLDBeam-v1``, the level such numbers
-        were calibrated on, refused on any other. The first run at or below it is
-        returned, and if none is, the lowest; every retry is said, with its reason. Seeds
-        then train ``timesteps`` to :attr:`budget` env steps, by one rule. None (default):
-        every run, the lowest returned.
+        validation cost is above this (:func:`train.bench.evaluate.validation_cost`, the
+        passive beam's 1 on every load, so 1.0 retries a run that controls worse than no
+        control at all); ``"lqr"``: above LQR's cost on the same validation loads
+        (:func:`train.bench.evaluate.lqr_validation_cost`), so a run that does not beat
+        LQR there is retried. The first run at or below it is returned, and if none is,
+        the lowest. Seeds then train ``timesteps`` to :attr:`budget` env steps, by one
+        rule. None (default): every run, the lowest returned.
     """
 
     algo: str
@@ -334,9 +331,14 @@ class TrainConfig:
             check_int(name, getattr(self, name), 1, most)  # most: what memory allows
         check_int("restarts", self.restarts, 1, 64)
         if self.restart_above is not None:
-            from .bench.threshold import RestartRule
-
-            RestartRule.parse(self.restart_above)
+            if isinstance(self.restart_above, str):
+                if self.restart_above != "lqr":
+                    raise ValueError(
+                        "restart_above must be a positive number, 'lqr' or null, "
+                        f"got {self.restart_above!r}"
+                    )
+            else:
+                check_real("restart_above", self.restart_above, 0.0, None, low_open=True)
             if self.restarts < 2:
                 raise ValueError(
                     f"restart_above needs restarts >= 2 (runs to choose from), "
@@ -598,16 +600,19 @@ def _merged(base: dict, changes: dict) -> dict:
 
 
 def _resolve(path: Path, seen: tuple[Path, ...] = ()) -> dict:
-    """The mapping of a config file with its ``base:`` (a recipe name or a YAML path, itself
-    resolved) applied: the base's settings, then the file's own on top of them."""
+    """The mapping of a config file with its ``base:`` (a config name or a YAML path, itself
+    resolved) applied: the base's settings, then the file's own on top of them. A name is
+    the file ``<name>.yaml`` beside ``path`` if there is one (a chain of configs kept in one
+    folder, e.g. ``studies/ablations/``), else a recipe's."""
     data = _read_yaml(path)
     if "base" not in data:
         return data
     base = data.pop("base")
     if not isinstance(base, str):
         raise DataFileError(f"{path}: base: expected a config name or path, got {base!r}")
+    sibling = path.parent / f"{base}.yaml"
     try:
-        base_path = config_path(base)
+        base_path = sibling if not Path(base).suffix and sibling.is_file() else config_path(base)
     except FileNotFoundError as exc:
         raise DataFileError(f"{path}: base: {exc}") from None
     if base_path.resolve() in seen:
@@ -617,10 +622,11 @@ def _resolve(path: Path, seen: tuple[Path, ...] = ()) -> dict:
 
 def read_config(spec: str | Path) -> tuple[str, dict]:
     """``(name, mapping)`` of a config (:func:`config_path`), validated; the mapping is the
-    file's own with its ``base:`` applied, if it names one (an ablation is ``base: ppo`` and
-    the settings it changes; nested mappings such as ``model`` merge key by key). It is what
-    a trial records and ``--resume`` compares. ``ValueError`` naming the file and the key on
-    a malformed file or a bad value (a :class:`acld_gym.util.validate.DataFileError`)."""
+    file's own with its ``base:`` applied, if it names one (a variant of a recipe is
+    ``base: ppo`` and the settings it changes; nested mappings such as ``model`` merge key
+    by key). It is what a trial records and ``--resume`` compares. ``ValueError`` naming
+    the file and the key on a malformed file or a bad value (a
+    :class:`acld_gym.util.validate.DataFileError`)."""
     path = config_path(spec)
     data = _resolve(path)
     try:

@@ -19,12 +19,13 @@ the law towards the least-norm law of the flat valley. With ``--eps 1e-5 --lr-sc
 (SB3's Adam) that is the only change to the recipe (``--weight-decay 0`` gave the recipe's
 seed 0 to the printed digits: validation cost 0.5147, ISE / LQR 0.834 on case 1)::
 
-    python benchmarks/actor_steps.py --seeds 0 1 2 3 4 --eps 1e-5 --lr-scale 1 --weight-decay 0.03
+    python studies/probes/actor_steps.py --seeds 0 1 2 3 4 --eps 1e-5 --lr-scale 1 \\
+        --weight-decay 0.03
 
-It prints one JSON line per seed (``benchmarks/probe.py``). Not a test; about half a
+It prints one JSON line per seed (``studies/probes/probe.py``). Not a test; about half a
 minute per seed on two cores; the isotropic steps::
 
-    python benchmarks/actor_steps.py --seeds 0 1 2 3 4
+    python studies/probes/actor_steps.py --seeds 0 1 2 3 4
 
 Its numbers are in docs/training.md ("Reinforcement learning from scratch", the probes
 table).
@@ -35,7 +36,7 @@ from __future__ import annotations
 import sys
 
 import torch
-from probe import one_run, run_recipe, seeds_main  # benchmarks/probe.py, beside this script
+from probe import one_run, run_recipe, seeds_main  # studies/probes/probe.py, beside this script
 
 from acld_gym.util.validate import check_real
 from train.bench.sb3_policies import AsymmetricCriticPolicy

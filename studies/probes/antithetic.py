@@ -14,16 +14,16 @@ steps), and gives the pair opposite gain noise, ``E`` and ``-E``, per rollout
 (``antithetic_noise`` of :class:`train.bench.sb3_policies.SplitCriticPolicy`). To first
 order the pair's policy-gradient terms add up to ``(A+ - A-) (E u) u / sigma^2``: what the
 load does to both advantages cancels, as in the random search's difference of returns.
-Everything else is the recipe's, one run per seed (``train/benchmark/
+Everything else is the recipe's, one run per seed (``studies/ablations/
 ablation_ppo_antithetic*.yaml`` are the same settings with the recipe's retry).
 
 It prints one JSON line per seed: the run's validation cost and ISE / LQR on cases 1, 2, 3
-and the held-out random loads (``benchmarks/probe.py``). Not a test; about 1 min per seed
+and the held-out random loads (``studies/probes/probe.py``). Not a test; about 1 min per seed
 on one core::
 
-    python benchmarks/antithetic.py --seeds 0 1 2 3 4
-    python benchmarks/antithetic.py --seeds 0 1 2 3 4 --no-pairs      # the noise only
-    python benchmarks/antithetic.py --seeds 0 1 2 3 4 --no-antithetic # the loads only
+    python studies/probes/antithetic.py --seeds 0 1 2 3 4
+    python studies/probes/antithetic.py --seeds 0 1 2 3 4 --no-pairs      # the noise only
+    python studies/probes/antithetic.py --seeds 0 1 2 3 4 --no-antithetic # the loads only
 
 Its numbers are in docs/training.md ("Reinforcement learning from scratch", the probes
 table).
@@ -34,7 +34,7 @@ from __future__ import annotations
 import dataclasses
 import sys
 
-from probe import one_run, run_recipe, seeds_main  # benchmarks/probe.py, beside this script
+from probe import one_run, run_recipe, seeds_main  # studies/probes/probe.py, beside this script
 
 from train.bench.sb3_policies import AsymmetricCriticPolicy
 

@@ -13,11 +13,11 @@ has no counterpart of gSDE's noise on the gains. Everything else is the recipe's
 load, entropy bonus, schedule), one run per seed.
 
 It prints one JSON line per seed: the run's validation cost and ISE / LQR on cases 1, 2, 3
-and the held-out random loads (``benchmarks/probe.py``). Not a test; about 1 min per seed
+and the held-out random loads (``studies/probes/probe.py``). Not a test; about 1 min per seed
 on one core::
 
-    python benchmarks/beta_actor.py --seeds 0 1 2 3 4
-    python benchmarks/beta_actor.py --seeds 0 1 2 3 4 --ent-coef 0
+    python studies/probes/beta_actor.py --seeds 0 1 2 3 4
+    python studies/probes/beta_actor.py --seeds 0 1 2 3 4 --ent-coef 0
 
 Its numbers are in docs/training.md ("Reinforcement learning from scratch", the probes
 table). The actor is not exported as an agent (:class:`train.agent.ActorProgram` has no
@@ -34,7 +34,7 @@ from functools import partial
 import torch
 import torch.nn as nn
 import torch.nn.functional as F
-from probe import one_run, run_recipe, seeds_main  # benchmarks/probe.py, beside this script
+from probe import one_run, run_recipe, seeds_main  # studies/probes/probe.py, beside this script
 from stable_baselines3.common.distributions import Distribution
 
 from train.bench.sb3_policies import AsymmetricCriticPolicy

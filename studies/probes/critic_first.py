@@ -15,11 +15,11 @@ paired loads, antithetic gain noise and entropy coefficient 0.05 of
 ``ablation_ppo_antithetic_ent_05.yaml``).
 
 It prints one JSON line per seed: the run's validation cost and ISE / LQR on cases 1, 2, 3
-and the held-out random loads (``benchmarks/probe.py``). Not a test; about 0.5-1 min per
+and the held-out random loads (``studies/probes/probe.py``). Not a test; about 0.5-1 min per
 seed on one core::
 
-    python benchmarks/critic_first.py --seeds 0 1 2 3 4
-    python benchmarks/critic_first.py --seeds 0 1 2 3 4 --candidate
+    python studies/probes/critic_first.py --seeds 0 1 2 3 4
+    python studies/probes/critic_first.py --seeds 0 1 2 3 4 --candidate
 
 Its numbers are in docs/training.md ("Reinforcement learning from scratch", the probes
 table).
@@ -30,7 +30,7 @@ from __future__ import annotations
 import dataclasses
 import sys
 
-from probe import one_run, run_recipe, seeds_main  # benchmarks/probe.py, beside this script
+from probe import one_run, run_recipe, seeds_main  # studies/probes/probe.py, beside this script
 
 from train.bench.sb3_policies import AsymmetricCriticPolicy
 

@@ -11,12 +11,12 @@ episode runs its 1000 steps unless it leaves the deflection limit, so the probe 
 everything else is the recipe's, one run per seed.
 
 It prints one JSON line per seed: the run's validation cost and ISE / LQR on cases 1, 2, 3
-and the held-out random loads (``benchmarks/probe.py``). Not a test; about 1 min per seed
+and the held-out random loads (``studies/probes/probe.py``). Not a test; about 1 min per seed
 on one core::
 
-    python benchmarks/episode_noise.py --seeds 0 1 2 3 4
-    python benchmarks/episode_noise.py --seeds 0 1 2 3 4 --hold 128
-    python benchmarks/episode_noise.py --seeds 0 1 2 3 4 --recipe ppo   # on 0.15.0's recipe
+    python studies/probes/episode_noise.py --seeds 0 1 2 3 4
+    python studies/probes/episode_noise.py --seeds 0 1 2 3 4 --hold 128
+    python studies/probes/episode_noise.py --seeds 0 1 2 3 4 --recipe ppo   # on 0.15.0's recipe
 
 Its numbers are in docs/training.md ("Reinforcement learning from scratch", the probes
 table).
@@ -27,7 +27,7 @@ from __future__ import annotations
 import sys
 
 import torch
-from probe import (  # benchmarks/probe.py
+from probe import (  # studies/probes/probe.py
     BASE,
     EPISODE_STEPS,
     RECIPES,

@@ -13,7 +13,7 @@ the agents were trained on, the benchmark's evaluation:
 :func:`train.bench.evaluate.batched_ise`). Not a test, and not a training recipe: an
 analysis of runs already made; a few seconds::
 
-    python benchmarks/law_average.py DIR [DIR ...] [--algo ppo] --k 10
+    python studies/probes/law_average.py DIR [DIR ...] [--algo ppo] --k 10
 
 Its numbers are in docs/training.md ("Reinforcement learning from scratch", "Case 1 does
 not follow the objective").

@@ -26,7 +26,7 @@ and its ISE / LQR on cases 1, 2, 3 and the held-out random loads
 (:func:`train.bench.evaluate.ise_rel_lqr`). Not a test, and not an agent; about 30 s per
 MPC on 256 loads::
 
-    python benchmarks/objective_headroom.py --agents train/agents/vrs train/agents/ppo
+    python studies/probes/objective_headroom.py --agents train/agents/vrs train/agents/ppo
 
 Its numbers are in docs/training.md ("Reinforcement learning from scratch", "What the
 objective leaves beyond a linear law").

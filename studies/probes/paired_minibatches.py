@@ -10,10 +10,10 @@ the cancellation then happens over an epoch's four gradient steps, not within ea
 of the same step side by side), so every minibatch holds whole pairs. Everything else is
 the recipe's, one run per seed.
 
-It prints one JSON line per seed (``benchmarks/probe.py``). Not a test; about half a
+It prints one JSON line per seed (``studies/probes/probe.py``). Not a test; about half a
 minute per seed on two cores::
 
-    python benchmarks/paired_minibatches.py --seeds 0 1 2 3 4
+    python studies/probes/paired_minibatches.py --seeds 0 1 2 3 4
 
 Its numbers are in docs/training.md ("Reinforcement learning from scratch", the probes
 table).
@@ -24,7 +24,7 @@ from __future__ import annotations
 import sys
 
 import numpy as np
-from probe import one_run, run_recipe, seeds_main  # benchmarks/probe.py, beside this script
+from probe import one_run, run_recipe, seeds_main  # studies/probes/probe.py, beside this script
 from stable_baselines3.common.buffers import RolloutBuffer
 
 #: The recipe's rollout fields, flattened to (sub-env, step) order before the minibatches.

@@ -17,10 +17,10 @@ advantages, it subtracts their mean and divides them by the RMS of the last :dat
 rollouts' standard deviations (16 rollouts of 64 steps: one 1000-step episode), and the
 model's own normalization is off. Everything else is the recipe's, one run per seed.
 
-It prints one JSON line per seed (``benchmarks/probe.py``). Not a test; about half a
+It prints one JSON line per seed (``studies/probes/probe.py``). Not a test; about half a
 minute per seed on two cores::
 
-    python benchmarks/phase_weights.py --seeds 0 1 2 3 4
+    python studies/probes/phase_weights.py --seeds 0 1 2 3 4
 
 Its numbers are in docs/training.md ("Reinforcement learning from scratch", the probes
 table).
@@ -32,7 +32,7 @@ import sys
 from collections import deque
 
 import numpy as np
-from probe import one_run, run_recipe, seeds_main  # benchmarks/probe.py, beside this script
+from probe import one_run, run_recipe, seeds_main  # studies/probes/probe.py, beside this script
 from stable_baselines3.common.buffers import RolloutBuffer
 
 #: Rollouts in the RMS: one 1000-step episode of the recipe's 64-step rollouts.

@@ -1,4 +1,4 @@
-"""What the PPO probes of ``benchmarks/`` share (``residual_actor.py``, ``episode_noise.py``,
+"""What the PPO probes of ``studies/probes/`` share (``residual_actor.py``, ``episode_noise.py``,
 ``beta_actor.py``, ``time_critic.py``, ``antithetic.py``, ``paired_minibatches.py``,
 ``actor_steps.py``, ``phase_weights.py``): the PPO recipe they were measured against,
 acld-gym 0.8.0-0.14.0's (:data:`BASE`; the recipe since 0.15.0 is ``antithetic.py``'s
@@ -21,17 +21,30 @@ import dataclasses
 import json
 import time
 from collections.abc import Callable, Iterable
+from pathlib import Path
 
 #: Env steps per episode of ACLDBeam-v1 (1 s at 1 ms).
 EPISODE_STEPS = 1000
 
 #: The config the probes change: acld-gym 0.8.0-0.14.0's PPO recipe
-#: (``train/benchmark/ablation_ppo_independent.yaml``), on which their numbers were measured.
+#: (``studies/ablations/ablation_ppo_independent.yaml``), on which their numbers were measured.
 BASE = "ablation_ppo_independent"
 
 #: The configs a probe's ``--recipe`` may change: :data:`BASE`, or ``"ppo"``, acld-gym
 #: 0.15.0's recipe (``train/benchmark/ppo.yaml``).
 RECIPES = (BASE, "ppo")
+
+#: The ablation configs: ``studies/ablations/``.
+ABLATIONS = Path(__file__).resolve().parents[1] / "ablations"
+
+
+def load_study_config(name: str):
+    """The :class:`train.config.TrainConfig` of ``name``: ``studies/ablations/<name>.yaml``
+    if there is one, else a recipe name or a YAML path (:func:`train.config.load_config`)."""
+    from train.config import load_config
+
+    path = ABLATIONS / f"{name}.yaml"
+    return load_config(path if path.is_file() else name)
 
 
 def one_run(
@@ -45,9 +58,7 @@ def one_run(
     ``policy_kwargs`` added to the base's) and one run per seed, its failures reported
     rather than retried; the keys in ``drop`` are removed from the base's model and policy
     keyword arguments, and ``model`` replaces model keyword arguments."""
-    from train.config import load_config
-
-    cfg = load_config(base)
+    cfg = load_study_config(base)
     drop = set(drop)
     kept = {k: v for k, v in cfg.model.items() if k not in drop}
     kwargs = {k: v for k, v in kept.get("policy_kwargs", {}).items() if k not in drop}

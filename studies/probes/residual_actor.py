@@ -10,12 +10,12 @@ latent, ``[u, h]``, as it does on the recipe's ``u`` (``--noise latent``), or on
 law's gains alone, the correction deterministic (``--noise linear``).
 
 It prints one JSON line per seed: the run's validation cost and ISE / LQR on cases 1, 2, 3
-and the held-out random loads (``benchmarks/probe.py``). Not a test; about 1 min per seed
+and the held-out random loads (``studies/probes/probe.py``). Not a test; about 1 min per seed
 on one core::
 
-    python benchmarks/residual_actor.py --seeds 0 1 2 3 4
-    python benchmarks/residual_actor.py --seeds 0 1 2 3 4 --noise linear
-    python benchmarks/residual_actor.py --seeds 0 1 2 3 4 --recipe ppo   # on 0.15.0's recipe
+    python studies/probes/residual_actor.py --seeds 0 1 2 3 4
+    python studies/probes/residual_actor.py --seeds 0 1 2 3 4 --noise linear
+    python studies/probes/residual_actor.py --seeds 0 1 2 3 4 --recipe ppo   # on 0.15.0's recipe
 
 Its numbers are in docs/training.md ("Reinforcement learning from scratch", the probes
 table). The actor is not exported as an agent (:class:`train.agent.ActorProgram` has no
@@ -30,7 +30,7 @@ import sys
 import numpy as np
 import torch
 import torch.nn as nn
-from probe import (  # benchmarks/probe.py, beside this script
+from probe import (  # studies/probes/probe.py, beside this script
     BASE,
     RECIPES,
     one_run,

@@ -6,7 +6,7 @@ cost :math:`J_\\sigma(W) = E_\\epsilon J(W + T \\epsilon)`, not the cost :math:`
 deterministic law it is evaluated with. This script trains a PPO recipe (``--config``: by
 default ``ablation_ppo_independent``, acld-gym 0.8.0-0.14.0's, on which its numbers in
 docs/training.md were measured, the run of ``python -m train ppo --config
-train/benchmark/ablation_ppo_independent.yaml --seed S``; ``ppo`` for today's), reads its final
+studies/ablations/ablation_ppo_independent.yaml --seed S``; ``ppo`` for today's), reads its final
 ``sigma`` and whitening ``T``, and prints :math:`J_\\sigma` of the trained law and of the
 shipped random-search law (``train/agents/vrs``) at fractions of that ``sigma``, on the same
 validation loads and the same noise draws for both (common random numbers; one gain draw per
@@ -17,7 +17,7 @@ expected action, ``E[clip(mu + eps)]`` at the trained ``sigma`` (:class:`_MeanAc
 other deterministic version of a clipped-Gaussian policy than the clipped mean the agents act
 with. Not a test; takes about 2 min::
 
-    python benchmarks/smoothed_objective.py --seed 0
+    python studies/probes/smoothed_objective.py --seed 0
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ import argparse
 import sys
 
 import numpy as np
-from probe import BASE  # benchmarks/probe.py: the recipe the probes were measured on
+from probe import BASE, load_study_config  # studies/probes/probe.py
 
 
 def linear_law(actor) -> tuple[np.ndarray, float]:
@@ -106,7 +106,8 @@ def main(argv=None) -> int:
     p.add_argument(
         "--config",
         default=BASE,
-        help="the PPO recipe (train/benchmark/NAME.yaml; default 0.8.0-0.14.0's)",
+        help="the PPO recipe (studies/ablations/NAME.yaml or train/benchmark/NAME.yaml; "
+        "default 0.8.0-0.14.0's)",
     )
     p.add_argument("--loads", type=int, default=256, help="validation loads")
     p.add_argument("--draws", type=int, default=4, help="noise draws per load")
@@ -121,9 +122,8 @@ def main(argv=None) -> int:
     from train.agent import TrainedAgent, export_sb3
     from train.bench.evaluate import validation_cost, validation_seeds
     from train.bench.sb3_train import train_sb3
-    from train.config import load_config
 
-    pol, record = train_sb3(load_config(args.config), args.seed, "ACLDBeam-v1")
+    pol, record = train_sb3(load_study_config(args.config), args.seed, "ACLDBeam-v1")
     T = np.asarray(record["transform"], float)
     sigma = np.exp(pol.model.policy.log_std.detach().numpy().ravel())
     laws = {

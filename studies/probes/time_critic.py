@@ -21,11 +21,11 @@ limit adds nothing and the training objective is the finite episode's discounted
 Everything else is the recipe's (``--gamma``, default the recipe's 0.999; one run per seed).
 
 It prints one JSON line per seed: the run's validation cost and ISE / LQR on cases 1, 2, 3
-and the held-out random loads (``benchmarks/probe.py``). Not a test; about 1 min per seed
+and the held-out random loads (``studies/probes/probe.py``). Not a test; about 1 min per seed
 on one core::
 
-    python benchmarks/time_critic.py --seeds 0 1 2 3 4
-    python benchmarks/time_critic.py --seeds 0 1 2 3 4 --gamma 1.0
+    python studies/probes/time_critic.py --seeds 0 1 2 3 4
+    python studies/probes/time_critic.py --seeds 0 1 2 3 4 --gamma 1.0
 
 Its numbers are in docs/training.md ("Reinforcement learning from scratch", the probes
 table).
@@ -39,7 +39,7 @@ import sys
 import numpy as np
 import torch
 from gymnasium import spaces
-from probe import EPISODE_STEPS, one_run, run_recipe, seeds_main  # benchmarks/probe.py
+from probe import EPISODE_STEPS, one_run, run_recipe, seeds_main  # studies/probes/probe.py
 from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 from stable_baselines3.common.vec_env import VecEnvWrapper, VecNormalize
 

@@ -1,4 +1,4 @@
-"""``benchmarks/actor_steps.py``: the linear law's parameters are a param group of their own
+"""``studies/probes/actor_steps.py``: the linear law's parameters are a param group of their own
 with the probe's eps, step scale and decoupled weight decay, whose steps are Adam's (AdamW's
 with a decay) with the learning rate times that scale; every other parameter keeps the
 recipe's Adam; bad values are named."""
@@ -6,9 +6,9 @@ recipe's Adam; bad values are named."""
 import pytest
 import torch
 
-from tests.benchmark_scripts import load_script, tiny_model
+from studies.tests.probe_scripts import load_probe, tiny_model
 
-acs = load_script("actor_steps")
+acs = load_probe("actor_steps")
 
 
 def test_scaled_adam_steps_a_group_as_adam_with_its_learning_rate_scaled():

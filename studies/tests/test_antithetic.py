@@ -1,4 +1,4 @@
-"""``benchmarks/antithetic.py``: the probe is the recipe with the package's paired loads
+"""``studies/probes/antithetic.py``: the probe is the recipe with the package's paired loads
 and antithetic gain noise (each switchable), one run per seed, and its training env and
 policy pair the sub-envs as it says."""
 
@@ -7,15 +7,16 @@ import dataclasses
 import numpy as np
 import torch
 
-from tests.benchmark_scripts import load_script, tiny_model
+from studies.tests.probe_scripts import load_probe, tiny_model
 
-an = load_script("antithetic")
+an = load_probe("antithetic")
 
 
 def test_the_probe_is_the_recipe_with_pairs_and_antithetic_noise():
     from train.config import load_config
 
-    base, cfg = load_config("ablation_ppo_independent"), an.config()  # 0.8.0-0.14.0's recipe
+    load_study_config = load_probe("probe").load_study_config
+    base, cfg = load_study_config("ablation_ppo_independent"), an.config()  # 0.8.0-0.14.0's recipe
     assert cfg.paired_loads and cfg.model["policy_kwargs"]["antithetic_noise"] is True
     assert cfg.restarts == 1 and not base.paired_loads
     assert cfg.env_kwargs == base.env_kwargs and cfg.model["ent_coef"] == base.model["ent_coef"]
@@ -30,7 +31,7 @@ def test_the_probe_is_the_recipe_with_pairs_and_antithetic_noise():
         "policy_kwargs": pk,
     } == recipe.model
     assert (adopted.restarts, adopted.restart_above) == (1, None)
-    bench = load_config("ablation_ppo_antithetic")  # the same with the recipe's retry
+    bench = load_study_config("ablation_ppo_antithetic")  # the same with the recipe's retry
     assert bench.paired_loads and bench.model["policy_kwargs"] == cfg.model["policy_kwargs"]
     off = an.config(pairs=False, antithetic=False, reward_scale="lqr", ent_coef=0.05)
     assert not off.paired_loads and off.model["policy_kwargs"]["antithetic_noise"] is False

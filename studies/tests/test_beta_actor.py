@@ -1,4 +1,4 @@
-"""``benchmarks/beta_actor.py``: the Beta policy's actions lie in [-1, 1] with the density
+"""``studies/probes/beta_actor.py``: the Beta policy's actions lie in [-1, 1] with the density
 of ``2 x - 1``, ``x ~ Beta(alpha, beta)``, its deterministic action is that mean, its
 parameters are linear in the observation, and folding the whitening keeps the law."""
 
@@ -6,10 +6,10 @@ import numpy as np
 import torch
 
 import train.bench.sb3_train as sb3_train
-from tests.benchmark_scripts import load_script, tiny_model
+from studies.tests.probe_scripts import load_probe, tiny_model
 from train.bench.sb3_policies import SB3Policy
 
-ba = load_script("beta_actor")
+ba = load_probe("beta_actor")
 
 
 def _dist(params):

@@ -1,4 +1,4 @@
-"""``benchmarks/critic_first.py``: the actor (the linear law's gains and gSDE's log std)
+"""``studies/probes/critic_first.py``: the actor (the linear law's gains and gSDE's log std)
 takes no step in the updates of the first ``frozen_rollouts`` rollouts while the critic
 trains, then trains as in the recipe; a bad count is named."""
 
@@ -6,10 +6,10 @@ import pytest
 import torch
 from stable_baselines3 import PPO
 
-from tests.benchmark_scripts import load_script
+from studies.tests.probe_scripts import load_probe
 from tests.train.tiny_sb3 import shrink_ppo
 
-cf = load_script("critic_first")
+cf = load_probe("critic_first")
 
 
 def tiny(cfg):
@@ -44,7 +44,7 @@ def test_the_actor_waits_for_its_rollouts_while_the_critic_trains(monkeypatch, f
 
 @pytest.mark.parametrize("bad", [-1, 1.5, "3"])
 def test_a_bad_count_is_named(bad):
-    from tests.benchmark_scripts import tiny_model
+    from studies.tests.probe_scripts import tiny_model
 
     with pytest.raises(ValueError, match="frozen_rollouts: a whole number >= 0"):
         tiny_model(cf.config(bad))

@@ -1,13 +1,13 @@
-"""``benchmarks/episode_noise.py``: gSDE's standard-normal draw is held per sub-env for a
+"""``studies/probes/episode_noise.py``: gSDE's standard-normal draw is held per sub-env for a
 whole episode, across SB3's per-rollout noise requests, scaled by the current sigma, and
 redrawn when the episode's steps are done."""
 
 import numpy as np
 import torch
 
-from tests.benchmark_scripts import load_script, tiny_model
+from studies.tests.probe_scripts import load_probe, tiny_model
 
-en = load_script("episode_noise")
+en = load_probe("episode_noise")
 
 
 def _policy():

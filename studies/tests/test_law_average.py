@@ -1,4 +1,4 @@
-"""``benchmarks/law_average.py``: the mean of saturated linear laws is the law of the mean
+"""``studies/probes/law_average.py``: the mean of saturated linear laws is the law of the mean
 gains, exactly; laws that do not act on the same observation alike, and anything but a
 saturated linear law, are named; agents load in seed order; the script's figures for the
 mean of identical laws are the law's own."""
@@ -8,10 +8,10 @@ import json
 import numpy as np
 import pytest
 
-from tests.benchmark_scripts import load_script
+from studies.tests.probe_scripts import load_probe
 from train.agent import TrainedAgent, linear_program
 
-la = load_script("law_average")
+la = load_probe("law_average")
 SHIPPED = TrainedAgent.load("train/agents/ppo")
 
 

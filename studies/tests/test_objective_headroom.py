@@ -1,4 +1,4 @@
-"""``benchmarks/objective_headroom.py``: the certainty-equivalent MPC of the env's reward
+"""``studies/probes/objective_headroom.py``: the certainty-equivalent MPC of the env's reward
 tends to the passive beam as its voltage weight grows (validation cost 1, by the passive
 scale's construction), beats LQR on the env's own objective at the env's weight, and bad
 arguments are named."""
@@ -11,10 +11,10 @@ import pytest
 
 import acld_gym
 from baselines.policies import LQRPolicy
-from tests.benchmark_scripts import load_script
+from studies.tests.probe_scripts import load_probe
 from train.bench.evaluate import validation_cost, validation_seeds
 
-oh = load_script("objective_headroom")
+oh = load_probe("objective_headroom")
 SEEDS = validation_seeds(4)
 
 

@@ -1,14 +1,14 @@
-"""``benchmarks/paired_minibatches.py``: the rollout's samples are dealt in a random order of
+"""``studies/probes/paired_minibatches.py``: the rollout's samples are dealt in a random order of
 antithetic pairs, so every minibatch holds whole pairs (sub-envs 2i and 2i + 1 at the same
 step), every sample once per epoch; an odd count is named."""
 
 import numpy as np
 import pytest
 
-from tests.benchmark_scripts import load_script, tiny_model
+from studies.tests.probe_scripts import load_probe, tiny_model
 from tests.train.tiny_sb3 import shrink_ppo
 
-pm = load_script("paired_minibatches")
+pm = load_probe("paired_minibatches")
 
 
 def test_the_order_is_a_permutation_of_whole_pairs():

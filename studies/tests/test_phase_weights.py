@@ -1,4 +1,4 @@
-"""``benchmarks/phase_weights.py``: each rollout's advantages are centred and divided by the
+"""``studies/probes/phase_weights.py``: each rollout's advantages are centred and divided by the
 RMS of the last episode's rollouts' standard deviations, so rollouts keep their ratios;
 SB3's per-minibatch normalization is off and everything else is the recipe's."""
 
@@ -6,11 +6,11 @@ import numpy as np
 import torch
 from stable_baselines3.common.buffers import RolloutBuffer
 
-from tests.benchmark_scripts import load_script, tiny_model
+from studies.tests.probe_scripts import load_probe, tiny_model
 from tests.train.tiny_sb3 import shrink_ppo
 from train.config import load_config
 
-pw = load_script("phase_weights")
+pw = load_probe("phase_weights")
 
 
 def rollouts(buf, scales, rng):

@@ -1,4 +1,4 @@
-"""``benchmarks/probe.py``: the PPO probes' command line prints one JSON line per seed with
+"""``studies/probes/probe.py``: the PPO probes' command line prints one JSON line per seed with
 the probe's own arguments, and a run's line carries its settings, validation cost and ISE /
 LQR per case as the benchmark's evaluation returns them."""
 
@@ -8,9 +8,9 @@ import pytest
 
 import train.bench.evaluate as evaluate
 import train.bench.sb3_train as sb3_train
-from tests.benchmark_scripts import load_script
+from studies.tests.probe_scripts import load_probe
 
-probe = load_script("probe")
+probe = load_probe("probe")
 
 
 def test_one_json_line_per_seed_with_the_probes_own_arguments(capsys):

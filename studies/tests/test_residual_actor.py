@@ -1,4 +1,4 @@
-"""``benchmarks/residual_actor.py``: the residual actor's latent is ``[u, h(u)]`` (its mean is
+"""``studies/probes/residual_actor.py``: the residual actor's latent is ``[u, h(u)]`` (its mean is
 the linear law plus a nonlinear correction), folding the whitening into it keeps the law on
 the raw observation (the package's fold calls the policy's own), gSDE's noise acts on
 the whole latent or on the linear gains alone, and a bad ``hidden`` or ``noise`` is refused
@@ -12,10 +12,10 @@ import pytest
 import torch
 
 import train.bench.sb3_train as sb3_train
-from tests.benchmark_scripts import load_script, tiny_model
+from studies.tests.probe_scripts import load_probe, tiny_model
 from train.bench.sb3_policies import SB3Policy
 
-ra = load_script("residual_actor")
+ra = load_probe("residual_actor")
 
 
 def _model(noise: str = "latent"):

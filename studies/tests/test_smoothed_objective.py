@@ -1,4 +1,4 @@
-"""``benchmarks/smoothed_objective.py``: its per-episode linear law is the shipped agent's
+"""``studies/probes/smoothed_objective.py``: its per-episode linear law is the shipped agent's
 (the same validation cost with no gain noise), the gain perturbation is per episode (an
 episode whose gains are zeroed costs the passive beam's 1 on its load), and agents that are not
 one linear law, or perturbations of the wrong shape, are refused."""
@@ -8,13 +8,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.benchmark_scripts import load_script
+from studies.tests.probe_scripts import load_probe
 from train.agent import TrainedAgent
 from train.bench.evaluate import validation_cost, validation_seeds
 
-so = load_script("smoothed_objective")
+so = load_probe("smoothed_objective")
 
-AGENTS = Path(__file__).resolve().parents[1] / "train" / "agents"
+AGENTS = Path(__file__).resolve().parents[2] / "train" / "agents"
 
 
 @pytest.mark.parametrize("name", ["vrs", "ppo"])

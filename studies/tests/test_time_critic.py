@@ -1,4 +1,4 @@
-"""``benchmarks/time_critic.py``: the training env appends the episode's remaining time
+"""``studies/probes/time_critic.py``: the training env appends the episode's remaining time
 (1 at the start, 0 in the final observation of an episode that ran its steps), and the
 critic's value vanishes when no time is left, is invariant to the load's scale as the
 recipe's is, and is never read by the actor."""
@@ -6,9 +6,9 @@ recipe's is, and is never read by the actor."""
 import numpy as np
 import torch
 
-from tests.benchmark_scripts import load_script, tiny_model
+from studies.tests.probe_scripts import load_probe, tiny_model
 
-tc = load_script("time_critic")
+tc = load_probe("time_critic")
 
 
 def test_the_remaining_time_is_appended_and_zero_at_the_time_limit():

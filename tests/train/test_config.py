@@ -1,5 +1,6 @@
 """train.config: the one training configuration (the recipes under train/benchmark/) and
-its validation."""
+its validation. The research record's variants (``studies/ablations/``) are checked by
+``studies/tests/test_ablations.py``, outside the default run."""
 
 import pytest
 
@@ -148,71 +149,7 @@ def test_parse_load_case_names_the_choices(value):
 
 def test_base_applies_the_recipe_under_a_files_own_settings(tmp_path):
     """``base:`` names a recipe; the file's settings go on top, nested mappings key by key."""
-    _, ppo = read_config("ablation_ppo_v015")  # acld-gym 0.15.0-0.17.1's recipe, whole
-    _, independent = read_config("ablation_ppo_independent")  # acld-gym 0.8.0-0.14.0's, whole
-    pk = {
-        k: v
-        for k, v in ppo["model"]["policy_kwargs"].items()
-        if k not in ("antithetic_noise", "critic_features")
-    }
-    assert independent == {
-        **{k: v for k, v in ppo.items() if k != "paired_loads"},
-        "model": {**ppo["model"], "ent_coef": 0.03, "policy_kwargs": pk},
-    }
-    _, paired = read_config("ablation_ppo_antithetic_ent_05")  # chained on it: two changes
-    assert paired == {
-        **independent,
-        "paired_loads": True,
-        "model": {
-            **independent["model"],
-            "ent_coef": 0.05,
-            "policy_kwargs": {**pk, "antithetic_noise": True},
-        },
-    }
-    _, negative = read_config("ablation_ppo_negative_critic")  # on it: the critic alone
-    assert negative == {
-        **independent,
-        "model": {
-            **independent["model"],
-            "policy_kwargs": {**pk, "critic_features": "negative_scaled_quadratic"},
-        },
-    }
-    # acld-gym 0.15.0's recipe: the two together
-    assert ppo == {
-        **paired,
-        "model": {
-            **paired["model"],
-            "policy_kwargs": {
-                **paired["model"]["policy_kwargs"],
-                "critic_features": "negative_scaled_quadratic",
-            },
-        },
-    }
-    # today's (0.18.0): a run retried above 0.520 on validation, not above LQR's cost
-    _, today = read_config("ppo")
-    assert today == {**ppo, "restart_above": 0.52}
-    assert read_config("ablation_ppo_retry_above_0520")[1] == today
-    assert read_config("ablation_ppo_lowest_of_5")[1] == {
-        **ppo,
-        "restarts": 5,
-        "restart_above": None,
-    }
-    _, one_run = read_config("ablation_ppo_one_run")  # acld-gym 0.7.0's recipe: one run
-    assert one_run == {**independent, "restarts": 1, "restart_above": None, "select": None}
-    _, old = read_config("ablation_ppo_ent_01")  # 0.6.0's: chained on 0.7.0's, one change
-    assert old == {**one_run, "model": {**one_run["model"], "ent_coef": 0.01}}
-    _, ablation = read_config("ablation_ppo_lambda_095")  # chained: on 0.6.0's recipe
-    assert ablation == {**old, "model": {**old["model"], "gae_lambda": 0.95}}
-    _, sac = read_config("sac")
-    _, three_runs = read_config("ablation_sac_three_runs")  # acld-gym 0.9.0's SAC recipe
-    assert three_runs == {**sac, "restarts": 3, "restart_above": None}
-    _, two_runs = read_config("ablation_sac_two_runs")  # 0.8.0's: chained on 0.9.0's
-    assert two_runs == {**three_runs, "restarts": 2}
-    _, lqr_scale = read_config("ablation_sac_lqr_scale")  # measured against 0.8.0's
-    assert lqr_scale == {
-        **two_runs,
-        "env_kwargs": {**two_runs["env_kwargs"], "reward_scale": "lqr"},
-    }
+    _, ppo = read_config("ppo")
     (tmp_path / "a.yaml").write_text(
         "base: ppo\ntimesteps: 10\nmodel: {policy_kwargs: {log_std_init: -2.0}}\n"
     )
@@ -223,6 +160,26 @@ def test_base_applies_the_recipe_under_a_files_own_settings(tmp_path):
     (tmp_path / "b.yaml").write_text(f"base: {tmp_path / 'a.yaml'}\nn_envs: 8\n")
     _, chained = read_config(tmp_path / "b.yaml")
     assert chained == {**data, "n_envs": 8}
+
+
+def test_a_base_name_is_first_a_file_beside_the_config(tmp_path):
+    """``base: NAME`` is ``NAME.yaml`` in the config's own folder if there is one (a chain
+    kept together, as ``studies/ablations/``), else the recipe ``NAME``; and a sibling
+    named like a recipe takes precedence over the recipe for that folder only."""
+    (tmp_path / "first.yaml").write_text("base: ppo\ntimesteps: 10\n")
+    (tmp_path / "second.yaml").write_text("base: first\nn_envs: 8\n")
+    _, ppo = read_config("ppo")
+    assert read_config(tmp_path / "second.yaml") == (
+        "second",
+        {**ppo, "timesteps": 10, "n_envs": 8},
+    )
+    (tmp_path / "ppo.yaml").write_text("base: sac\n")  # not the recipe ppo, beside first.yaml
+    _, sac = read_config("sac")
+    assert read_config(tmp_path / "first.yaml")[1] == {**sac, "timesteps": 10}
+    assert read_config("ppo")[1] == ppo  # the recipe itself is untouched
+    (tmp_path / "loop.yaml").write_text("base: loop\n")
+    with pytest.raises(ValueError, match="leads back to itself"):
+        read_config(tmp_path / "loop.yaml")
 
 
 @pytest.mark.parametrize(

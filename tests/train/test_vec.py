@@ -134,10 +134,8 @@ def test_make_vec_env_is_seeded_and_normalized():
 def test_make_vec_env_splits_the_loads_and_passes_env_options():
     """Sub-envs per load in proportion to the weights, each with the config's env options
     (here the recipe's reward scale, observed as the last entry)."""
-    # acld-gym 0.8.0-0.14.0's PPO recipe: the sub-envs on their own seeds, any split
-    cfg = load_config("ablation_ppo_independent").with_overrides(
-        n_envs=4, loads={1: 1, "random": 3}
-    )
+    # the PPO recipe with the sub-envs on their own seeds (no pairs), so any split
+    cfg = load_config("ppo").with_overrides(n_envs=4, loads={1: 1, "random": 3}, paired_loads=False)
     venv = make_vec_env(cfg, seed=0)
     obs = venv.reset()
     assert obs.shape == (4, 10)  # 9 + log c (observe_reward_scale)
@@ -150,7 +148,7 @@ def test_make_vec_env_splits_the_loads_and_passes_env_options():
 
 
 def test_subproc_backend_is_the_same_env():
-    cfg = load_config("ablation_ppo_independent").with_overrides(n_envs=2, loads={1: 1})
+    cfg = load_config("ppo").with_overrides(n_envs=2, loads={1: 1}, paired_loads=False)
     native, sub = make_vec_env(cfg, seed=4), make_vec_env(cfg, seed=4, backend="subproc")
     try:
         on, os_ = native.reset(), sub.reset()

@@ -52,12 +52,33 @@ def tiny_sac_recipe(timesteps: int, **fields) -> TrainConfig:
 
 
 def tiny_crossq(**fields) -> TrainConfig:
-    """The CrossQ probe (train/benchmark/ablation_crossq.yaml) shrunk to 1200 env steps on 2
-    sub-envs (learning from 400 on, minibatches of 64, no checkpoint selection), with
-    ``fields`` changed on top."""
-    data = yaml.safe_load(open("train/benchmark/ablation_crossq.yaml"))
-    data.update(timesteps=1200, n_envs=2, eval_points=1, select=None, **fields)
-    data["model"] = {**data["model"], "learning_starts": 400, "batch_size": 64}
+    """sb3-contrib's CrossQ with its own MLP policy on the SAC recipe's env-level pieces
+    (random loads, the reward per load, action headroom 3; the probe
+    ``studies/ablations/ablation_crossq.yaml``) shrunk to 1200 env steps on 2 sub-envs
+    (learning from 400 on, minibatches of 64, no checkpoint selection), with ``fields``
+    changed on top."""
+    data = dict(
+        algo="crossq",
+        timesteps=1200,
+        n_envs=2,
+        loads={"random": 1},
+        features=None,
+        env_kwargs={"reward_scale": "passive"},
+        normalize={"norm_obs": False, "norm_reward": False},
+        eval_points=1,
+        action_headroom=3.0,
+        model={
+            "policy": "MlpPolicy",
+            "buffer_size": 10000,
+            "batch_size": 64,
+            "learning_starts": 400,
+            "gamma": 0.995,
+            "train_freq": 1,
+            "gradient_steps": 3,
+            "policy_kwargs": {"net_arch": {"pi": [256, 256], "qf": [256, 256]}},
+        },
+    )
+    data.update(fields)
     return TrainConfig.from_dict(data)
 
 

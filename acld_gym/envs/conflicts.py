@@ -55,11 +55,18 @@ _SPREAD = 1.05
 _DEFAULT_ID = "ACLDBeam-v1"
 
 
+def substep_nyquist(dt: float) -> float:
+    """The Nyquist frequency of the load sub-step at control period ``dt`` [s]:
+    ``pi * LOAD_SUBSTEPS / dt`` [rad/s], one expression for every check (so a frequency
+    exactly at the limit is refused whichever check sees it)."""
+    return math.pi * LOAD_SUBSTEPS / dt
+
+
 def check_resolution(load: TipLoad, dt: float, name: str = "load_case") -> TipLoad:
     """``load`` if the sampled integration at control period ``dt`` [s] resolves every
     component (module docstring); else ``ValueError`` naming ``name`` and the limit."""
     h = dt / LOAD_SUBSTEPS
-    nyquist = math.pi / h
+    nyquist = substep_nyquist(dt)
     at = f"at dt = {dt:g} s"
     for c in load.components:
         kind = type(c).__name__
@@ -115,7 +122,7 @@ def check_consistent(config) -> None:
         )
     if isinstance(c.load_case, TipLoad):
         check_resolution(c.load_case, c.dt)
-    nyquist = math.pi * LOAD_SUBSTEPS / c.dt
+    nyquist = substep_nyquist(c.dt)
     if c.harmonic_modes is not None and not _SPREAD * max(c.harmonic_modes) < nyquist:
         raise ValueError(
             f"harmonic_modes must be below {nyquist / _SPREAD:.6g} rad/s at dt = {c.dt:g} s "

@@ -312,7 +312,7 @@ class TrainedAgent:
         """Write the agent folder ``directory`` whole: ``policy.npz``, ``metadata.json``
         and the text ``files`` (name: text, e.g. its ``learning_curve.csv``), built in a
         temporary sibling and swapped in with one rename
-        (:func:`train.agent_files.write_folder`): what was there before is replaced, or,
+        (:func:`train.agent_write.write_folder`): what was there before is replaced, or,
         if the write fails, left as it was. ``ValueError`` if ``directory`` holds other
         files than an agent's or a training run's."""
         meta = dict(self.metadata, format=FORMAT, actor=self.actor.ops)

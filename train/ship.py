@@ -19,6 +19,7 @@ import sys
 from pathlib import Path
 
 from acld_gym.physics.loads import THESIS_CASES
+from acld_gym.util.atomic import check_directory
 
 from .agent import CURVE_FILE, TrainedAgent
 from .agent_files import check_replaceable, curve_rows
@@ -124,6 +125,7 @@ def main(argv: list[str] | None = None) -> int:
     args = p.parse_args(argv)
     try:
         check_name(args.name)
+        check_directory(args.agents, "--agents")  # before anything is read or written
     except ValueError as exc:
         p.error(str(exc))
     try:

@@ -340,6 +340,14 @@ def test_ship_refuses_an_existing_name_without_force(tmp_path, capsys):
     assert [p.name for p in agents.iterdir()] == ["mine"]  # no temporary left
 
 
+@pytest.mark.parametrize("agents, match", [("/dev/null", "exists and is not a directory")])
+def test_ship_names_an_unusable_agents_folder(tmp_path, capsys, agents, match):
+    with pytest.raises(SystemExit) as exit_:
+        ship_main([str(AGENTS_DIR / "vrs"), "mine", "--agents", agents])
+    assert exit_.value.code == 2
+    assert f"--agents: '{agents}' {match}" in capsys.readouterr().err.splitlines()[-1]
+
+
 def test_ship_refuses_an_agent_that_would_not_load(tmp_path):
     """Shipping checks the fingerprint as loading does: an agent whose env settings the
     env refuses, or whose observation differs from its env's, is not shipped."""
@@ -541,3 +549,21 @@ def test_benchmark_refuses_an_agent_folder_with_other_files_before_computing(tmp
     err = capsys.readouterr().err.splitlines()[-1]
     assert "--out:" in err and "notes.txt" in err
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["agents"]
+
+
+def test_without_descriptor_reads_links_and_fifos_are_still_refused(tmp_path, monkeypatch):
+    """Where ``open`` takes no folder descriptor or ``O_NOFOLLOW`` (Windows), the reader
+    checks each path without following it: the same refusals, the same agent."""
+    import train.agent_files as agent_files
+
+    monkeypatch.setattr(agent_files, "_BY_FD", False)
+    d = _copy("vrs", tmp_path / "a")
+    assert TrainedAgent.load(d).metadata["algo"] == "vrs"
+    (d / POLICY_FILE).unlink()
+    (d / POLICY_FILE).symlink_to(AGENTS_DIR / "sac" / POLICY_FILE)
+    with pytest.raises(AgentFileError, match=rf"{POLICY_FILE}: is a symbolic link"):
+        TrainedAgent.load(d, check=False)
+    (d / POLICY_FILE).unlink()
+    os.mkfifo(d / POLICY_FILE)
+    with pytest.raises(AgentFileError, match=rf"{POLICY_FILE}: is not a regular file"):
+        TrainedAgent.load(d, check=False)

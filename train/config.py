@@ -25,8 +25,6 @@ __all__ = [
     "CONFIG_DIR",
     "TrainConfig",
     "SelectConfig",
-    "AverageConfig",
-    "StdAnnealConfig",
     "algo_class",
     "config_path",
     "read_config",
@@ -83,73 +81,8 @@ class SelectConfig:
         check_int("select.start", self.start, 0, 10**12)
 
 
-@dataclass(frozen=True)
-class AverageConfig:
-    r"""Weight averaging of the policy (``TrainConfig.average``), as stochastic weight
-    averaging (Izmailov et al. 2018) and the Polyak-averaged iterates of stochastic
-    approximation: from env step ``start`` on, the policy's parameters at the end of
-    every rollout (PPO: each rollout; SAC: each vector step, between its gradient steps)
-    enter a running average :math:`\bar\theta`, uniform
-    (:math:`\bar\theta \mathrel{+}= (\theta - \bar\theta) / n`) or, with ``halflife``
-    :math:`h`, exponential in env steps (:math:`w = 1 - 2^{-\Delta t / h}`). The learning
-    curve, the checks of ``select`` and the returned policy are the averaged one's from
-    ``start`` on. Every floating-point parameter of the SB3 policy is averaged (actor and
-    critic); the agent is its deterministic actor.
-
-    Attributes
-    ----------
-    start : int
-        Env steps before the first parameters enter the average.
-    halflife : int or None
-        Env steps over which an iterate's weight halves; None: the uniform average.
-    """
-
-    start: int
-    halflife: int | None = None
-
-    def __post_init__(self):
-        check_int("average.start", self.start, 0, 10**12)
-        if self.halflife is not None:
-            check_int("average.halflife", self.halflife, 1, 10**12)
-
-
-@dataclass(frozen=True)
-class StdAnnealConfig:
-    r"""An annealed exploration noise (``TrainConfig.anneal_std``; PPO only, whose policy has
-    a state-independent log std, SB3's ``log_std`` parameter, Gaussian or gSDE): from env
-    step ``start`` on, the log std is no longer trained; it is held at its value there,
-    :math:`\log\sigma_0`, and lowered before each rollout to
-    :math:`\log\sigma_0 + \log f`, with f falling linearly in env steps from 1 at
-    ``start`` to ``end`` at the budget's end (gSDE's noise is drawn anew at the new std),
-    as the random search's noise falls over its budget (``vrs``: ``anneal``).
-
-    Attributes
-    ----------
-    start : int
-        Env steps before the annealing (the log std is trained until then).
-    end : float
-        The std's factor at the budget's end, in (0, 1].
-    """
-
-    start: int
-    end: float
-
-    def __post_init__(self):
-        check_int("anneal_std.start", self.start, 0, 10**12)
-        check_real("anneal_std.end", self.end, 0.0, 1.0, low_open=True)
-
-    def factor(self, steps: int, stop: int) -> float:
-        """f at env step ``steps`` of a run whose budget ends at ``stop`` (1 before
-        ``start``, ``end`` from ``stop`` on)."""
-        if steps <= self.start:
-            return 1.0
-        done = min((steps - self.start) / max(stop - self.start, 1), 1.0)
-        return 1.0 - (1.0 - float(self.end)) * done
-
-
 def _section(cls, data: dict, name: str):
-    """The dataclass ``cls`` of a config's mapping ``name`` (``distill``, ``select``,
-    ``average``, ``anneal_std``);
+    """The dataclass ``cls`` of a config's mapping ``name`` (``distill``, ``select``);
     ``ValueError`` naming ``name`` and its unknown or missing keys."""
     known = {f.name for f in fields(cls)}
     required = {
@@ -173,8 +106,6 @@ def _distill_config_class():
 _SECTIONS = {
     "distill": _distill_config_class,
     "select": lambda: SelectConfig,
-    "average": lambda: AverageConfig,
-    "anneal_std": lambda: StdAnnealConfig,
 }
 
 
@@ -229,10 +160,6 @@ class TrainConfig:
         whole episodes (the recipe: 1000 vector steps, one episode per sub-env): estimated
         from the first 64 ms of each episode only, it preconditions the policy gradient
         badly on some seeds (``docs/training.md``).
-    episode_scale : bool
-        PPO only: the advantages of each episode in a rollout are divided by their
-        root mean square (:class:`train.bench.sb3_policies.EpisodeScaledRolloutBuffer`;
-        the critic's targets are unchanged).
     paired_loads : bool
         SB3 algorithms: sub-envs ``2i`` and ``2i + 1`` of each load case get one seed
         (:class:`acld_gym.envs.sb3.SB3VecEnv`'s ``seed_group=2``), so the pair runs the
@@ -272,13 +199,6 @@ class TrainConfig:
         SB3 algorithms: checkpoint selection on validation loads (:class:`SelectConfig`'s
         fields, e.g. ``{episodes: 32, every: 50000, start: 300000}``); None (default): the
         final policy.
-    average : dict or None
-        SB3 algorithms: weight averaging of the policy (:class:`AverageConfig`'s fields,
-        e.g. ``{start: 1000000}``); None (default): the iterates as trained.
-    anneal_std : dict or None
-        PPO: the exploration noise annealed over the end of the budget
-        (:class:`StdAnnealConfig`'s fields, e.g. ``{start: 2500000, end: 0.2}``); None
-        (default): the log std trained throughout.
     restarts : int
         SB3 algorithms with ``select``: independent runs of ``timesteps`` each from fresh
         initialisations (the first with the trial's seed, the others with seeds derived
@@ -305,7 +225,6 @@ class TrainConfig:
     model: dict = field(default_factory=dict)
     eval_points: int = 10
     whiten_steps: int = 0
-    episode_scale: bool = False
     paired_loads: bool = False
     env_kwargs: dict = field(default_factory=dict)
     residual: str | None = None
@@ -313,8 +232,6 @@ class TrainConfig:
     shaping: float | None = None
     distill: dict | None = None
     select: dict | None = None
-    average: dict | None = None
-    anneal_std: dict | None = None
     restarts: int = 1
     restart_above: float | str | None = None
 
@@ -379,11 +296,6 @@ class TrainConfig:
                 "whiten_steps needs features: null and norm_obs: false (the "
                 "trained actor takes the whitening into its first layer)"
             )
-        if not isinstance(self.episode_scale, bool) or (self.episode_scale and self.algo != "ppo"):
-            raise ValueError(
-                f"episode_scale must be true or false, and true for ppo only; "
-                f"got {self.episode_scale!r}"
-            )
         if not isinstance(self.paired_loads, bool) or (self.paired_loads and not sb3):
             raise ValueError(
                 f"paired_loads must be true or false, and true for the SB3 algorithms "
@@ -441,19 +353,9 @@ class TrainConfig:
                 "meet the final observation statistics)"
             )
         if not sb3 and (
-            self.residual
-            or self.shaping is not None
-            or self.distill
-            or self.select is not None
-            or self.average is not None
+            self.residual or self.shaping is not None or self.distill or self.select is not None
         ):
-            raise ValueError(
-                "residual, shaping, distill, select and average are for the SB3 algorithms"
-            )
-        if self.anneal_std is not None and self.algo != "ppo":
-            raise ValueError(
-                f"anneal_std is for ppo only (a state-independent log std), got algo {self.algo!r}"
-            )
+            raise ValueError("residual, shaping, distill and select are for the SB3 algorithms")
         if self.restarts > 1 and self.select is None:
             raise ValueError(
                 f"restarts: {self.restarts} runs need select: (the choice between "
@@ -503,16 +405,6 @@ class TrainConfig:
     def select_config(self) -> SelectConfig | None:
         """The :class:`SelectConfig` of ``select`` (None if off)."""
         return self._section_config("select")
-
-    @property
-    def average_config(self) -> AverageConfig | None:
-        """The :class:`AverageConfig` of ``average`` (None if off)."""
-        return self._section_config("average")
-
-    @property
-    def anneal_std_config(self) -> StdAnnealConfig | None:
-        """The :class:`StdAnnealConfig` of ``anneal_std`` (None if off)."""
-        return self._section_config("anneal_std")
 
     @property
     def teacher(self) -> str | None:

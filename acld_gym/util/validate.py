@@ -27,13 +27,6 @@ __all__ = [
 ]
 
 
-def shown(value, limit: int = 60) -> str:
-    """``repr(value)`` cut to ``limit`` characters (an error message names a value, it does
-    not echo a 400-digit integer or a file's bytes)."""
-    text = repr(value)
-    return text if len(text) <= limit else f"{text[: limit - 3]}..."
-
-
 def check_real(
     name: str,
     value,
@@ -47,12 +40,9 @@ def check_real(
     a string) in [low, high] (``low_open``: (low, high]); else ``ValueError`` naming it."""
     u = f" {unit}" if unit and unit != "-" else ""
     ok = isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
-    try:
-        v = float(value) if ok else math.nan
-    except OverflowError:  # an integer beyond the float range
-        v = math.nan
+    v = float(value) if ok else math.nan
     if not ok or not math.isfinite(v):
-        raise ValueError(f"{name} must be a finite real number{u}, got {shown(value)}")
+        raise ValueError(f"{name} must be a finite real number{u}, got {value!r}")
     if low is not None and (v < low or (low_open and v == low)):
         rel = ">" if low_open else ">="
         raise ValueError(f"{name} must be {rel} {low:g}{u}, got {value!r}")

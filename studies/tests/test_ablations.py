@@ -12,10 +12,32 @@ from train.config import ALGOS, load_config, read_config
 ABLATIONS = Path(__file__).resolve().parents[1] / "ablations"
 NAMES = sorted(p.stem for p in ABLATIONS.glob("ablation_*.yaml"))
 
-#: Ablations that use a training option removed from the package (acld-gym 0.20.0, issue
-#: 68: no shipped recipe used it): the name and the option. Run them with the package
-#: version of their commit (``studies/README.md``).
-STALE: dict[str, str] = {}
+#: Ablations that use a training option removed from the package (``average``,
+#: ``anneal_std``, ``episode_scale``: no shipped recipe used them; issue 68), themselves or
+#: through their base: the name and the option. Run them with the package version of their
+#: commit (``studies/README.md``).
+STALE: dict[str, str] = {
+    "ablation_ppo_60m_small_steps": "anneal_std",
+    "ablation_ppo_anneal_std": "anneal_std",
+    "ablation_ppo_anneal_std_005_v015": "anneal_std",
+    "ablation_ppo_anneal_std_10m": "anneal_std",
+    "ablation_ppo_anneal_std_ent_04_v015": "anneal_std",
+    "ablation_ppo_anneal_std_v015": "anneal_std",
+    "ablation_ppo_average": "average",
+    "ablation_ppo_ent_03_average": "average",
+    "ablation_ppo_ent_04_gamma_9995_anneal_std": "anneal_std",
+    "ablation_ppo_episode_returns": "anneal_std",
+    "ablation_ppo_episode_returns_32envs": "anneal_std",
+    "ablation_ppo_gamma": "episode_scale",
+    "ablation_ppo_long_anneal": "anneal_std",
+    "ablation_ppo_long_small_steps": "anneal_std",
+    "ablation_ppo_mlp_critic": "episode_scale",
+    "ablation_ppo_no_episode_scale": "episode_scale",
+    "ablation_ppo_no_sde": "episode_scale",
+    "ablation_ppo_no_whiten": "episode_scale",
+    "ablation_ppo_recipe": "episode_scale",
+    "ablation_sac_average": "average",
+}
 
 
 def ablation(name: str) -> tuple[str, dict]:

@@ -160,7 +160,7 @@ def test_sb3_algorithms_train_and_act_in_volts(name, changes, model):
     assert v.shape == (3, 1)
 
 
-def test_ppo_with_whitening_quadratic_critic_and_episode_scale():
+def test_ppo_with_whitening_and_quadratic_critic():
     """The linear-quadratic PPO recipe's options on a tiny budget: the whitening is
     estimated from the agent's own first steps (counted in the budget) and folded into
     the final actor, which then takes the raw observation and exports as a plain actor."""
@@ -170,7 +170,7 @@ def test_ppo_with_whitening_quadratic_critic_and_episode_scale():
     from train.config import TrainConfig
 
     data = yaml.safe_load(open("train/benchmark/ppo.yaml"))
-    data.update(timesteps=4000, n_envs=2, whiten_steps=1000, episode_scale=True, eval_points=1)
+    data.update(timesteps=4000, n_envs=2, whiten_steps=1000, eval_points=1)
     data["model"] = {**data["model"], "n_steps": 500, "batch_size": 500, "n_epochs": 1}
     seen = []
     policy, record = train_algo(
@@ -265,37 +265,6 @@ def test_a_policy_with_its_own_fold_gets_the_whitening():
     T = np.arange(9.0).reshape(3, 3)
     fold_whitening(model, T.tolist())
     assert len(got) == 1 and isinstance(got[0], np.ndarray) and np.array_equal(got[0], T)
-
-
-def test_episode_scaled_advantages():
-    from train.bench.sb3_policies import EpisodeScaledRolloutBuffer
-
-    box = gym.spaces.Box(-1, 1, (2,))
-    buf = EpisodeScaledRolloutBuffer(6, box, box, n_envs=2, gamma=1.0, gae_lambda=1.0)
-    for t in range(6):
-        scale = np.array([1.0, 1000.0]) if t < 3 else np.array([1.0, 0.001])
-        starts = np.array([t == 0, t in (0, 3)])
-        buf.add(
-            np.zeros((2, 2)),
-            np.zeros((2, 2)),
-            -scale * (t + 1),
-            starts,
-            torch_zeros(2),
-            torch_zeros(2),
-        )
-    buf.compute_returns_and_advantage(torch_zeros(2), np.zeros(2, dtype=bool))
-    rms = [
-        np.sqrt(np.mean(buf.advantages[a:b, e] ** 2))
-        for e, a, b in [(0, 0, 6), (1, 0, 3), (1, 3, 6)]
-    ]
-    assert np.allclose(rms, 1.0)
-    assert buf.returns[0, 1] == pytest.approx(-6000.0)  # the critic's targets unscaled
-
-
-def torch_zeros(n):
-    import torch
-
-    return torch.zeros(n)
 
 
 def test_whitening_and_actor():

@@ -1,5 +1,5 @@
 """What the training-loop unit tests share: tiny SAC, PPO and CrossQ configurations and a
-stand-in for an SB3 model (``Averaging``, ``Selection`` and ``train_algo`` read only
+stand-in for an SB3 model (``Selection`` and ``train_algo`` read only
 ``model.policy``)."""
 
 import dataclasses

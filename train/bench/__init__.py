@@ -27,9 +27,7 @@ reports learning-curve points through a callback, and returns a policy with SB3'
   a ZCA whitening of the observation estimated from the agent's own first rollouts
   (:class:`train.vec.VecWhiten`, the steps counted in the budget); for PPO the policy
   ``SplitCriticPolicy`` (the critic on its own features, e.g. quadratic ones,
-  :class:`train.bench.sb3_policies.SplitCriticPolicy`) and ``episode_scale``, advantages normalised
-  per episode
-  (:class:`train.bench.sb3_policies.EpisodeScaledRolloutBuffer`).
+  :class:`train.bench.sb3_policies.SplitCriticPolicy`).
 
 Modules, in the order of a run (the config is :mod:`train.config`, the env
 :mod:`train.vec`): ``search`` (``vrs``), ``sb3_policies`` and ``sb3_train`` (the SB3

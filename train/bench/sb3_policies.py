@@ -1,8 +1,6 @@
 """Policy pieces for the SB3 algorithms: a critic on its own (e.g. quadratic) features
-(:class:`train.bench.sb3_policies.SplitCriticPolicy`), advantages normalised per episode
-(:class:`train.bench.sb3_policies.EpisodeScaledRolloutBuffer`), and a trained model as a
-``predict`` policy in
-volts (:class:`SB3Policy`)."""
+(:class:`train.bench.sb3_policies.SplitCriticPolicy`), and a trained model as a
+``predict`` policy in volts (:class:`SB3Policy`)."""
 
 from __future__ import annotations
 
@@ -12,7 +10,6 @@ import numpy as np
 import torch
 import torch.nn as nn
 from gymnasium import spaces
-from stable_baselines3.common.buffers import RolloutBuffer
 from stable_baselines3.common.policies import ActorCriticPolicy, ContinuousCritic
 from stable_baselines3.common.torch_layers import (
     BaseFeaturesExtractor,
@@ -38,7 +35,6 @@ __all__ = [
     "DropLast",
     "ScaledQuadraticFeatures",
     "NegativeScaledQuadraticFeature",
-    "EpisodeScaledRolloutBuffer",
     "SB3Policy",
 ]
 
@@ -272,23 +268,6 @@ class AsymmetricCriticPolicy(SplitCriticPolicy):
     def __init__(self, *args, critic_features: str = "scaled_quadratic", **kwargs):
         kwargs.setdefault("features_extractor_class", DropLast)
         super().__init__(*args, critic_features=critic_features, **kwargs)
-
-
-class EpisodeScaledRolloutBuffer(RolloutBuffer):
-    """A ``RolloutBuffer`` that divides the GAE advantages of each episode segment (per
-    sub-env, split at episode starts) by their root mean square, after the returns
-    (the critic's targets, unchanged) are computed: advantage normalisation per
-    episode (per load). Episodes whose returns differ by decades then weigh alike in
-    the policy gradient, as in the random search's -log(-R) score."""
-
-    def compute_returns_and_advantage(self, last_values, dones) -> None:
-        super().compute_returns_and_advantage(last_values, dones)
-        n = self.buffer_size
-        for e in range(self.n_envs):
-            starts = [0, *[int(t) for t in np.flatnonzero(self.episode_starts[1:, e]) + 1], n]
-            for a, b in zip(starts[:-1], starts[1:], strict=True):
-                rms = float(np.sqrt(np.mean(self.advantages[a:b, e] ** 2)))
-                self.advantages[a:b, e] /= max(rms, 1e-12)
 
 
 class _PolicyOnly:

@@ -8,7 +8,6 @@ from __future__ import annotations
 import copy
 import inspect
 from collections.abc import Callable
-from contextlib import contextmanager
 
 import numpy as np
 import torch
@@ -27,16 +26,13 @@ from .evaluate import CurveCallback, eval_schedule
 from .sb3_policies import (
     AsymmetricCriticPolicy,
     AsymmetricSACPolicy,
-    EpisodeScaledRolloutBuffer,
     SB3Policy,
     SplitCriticPolicy,
 )
 
 __all__ = [
-    "Averaging",
     "LinearSchedule",
     "Selection",
-    "StdAnnealing",
     "fold_whitening",
     "make_model",
     "train_sb3",
@@ -176,8 +172,6 @@ def make_model(cfg: TrainConfig, venv, seed: int, **kwargs):
                 f"{cfg.action_headroom!r}: give it once, as action_headroom"
             )
         model_kwargs["policy_kwargs"] = {**pk, "action_headroom": cfg.action_headroom}
-    if cfg.episode_scale:
-        model_kwargs["rollout_buffer_class"] = EpisodeScaledRolloutBuffer
     model_kwargs.setdefault("verbose", 0)
     cls = algo_class(cfg.algo)
     model_kwargs = _flat_n_step_buffer(cls, venv, {**model_kwargs, **kwargs})
@@ -267,107 +261,6 @@ class Selection:
         }
 
 
-class Averaging:
-    """Weight averaging of :class:`train.config.AverageConfig` (``cfg.average``; inert if
-    None): :meth:`update` folds the SB3 policy's floating-point parameters into the running
-    average (in float64) once ``steps`` reaches ``start``; :meth:`applied` is a context in
-    which the model's policy holds the average (its own parameters restored on exit), and
-    :meth:`apply` loads the average for good. Before the first update both leave the model
-    as it is."""
-
-    def __init__(self, cfg: TrainConfig):
-        self.config = cfg.average_config
-        self.mean: dict | None = None
-        self.count = 0
-        self.last = 0
-
-    def update(self, steps: int, model) -> None:
-        if self.config is None or steps < self.config.start:
-            return
-        params = {
-            k: v.detach().to(torch.float64, copy=True)
-            for k, v in model.policy.state_dict().items()
-            if v.is_floating_point()
-        }
-        self.count += 1
-        if self.mean is None:
-            self.mean = params
-        else:
-            half = self.config.halflife
-            w = 1.0 / self.count if half is None else 1.0 - 0.5 ** ((steps - self.last) / half)
-            for k, v in params.items():
-                self.mean[k] += w * (v - self.mean[k])
-        self.last = int(steps)
-
-    def _load(self, model) -> None:
-        state = model.policy.state_dict()
-        model.policy.load_state_dict(
-            {**state, **{k: v.to(state[k].dtype) for k, v in self.mean.items()}}
-        )
-
-    @contextmanager
-    def applied(self, model):
-        if self.mean is None:
-            yield
-            return
-        saved = copy.deepcopy(model.policy.state_dict())
-        self._load(model)
-        try:
-            yield
-        finally:
-            model.policy.load_state_dict(saved)
-
-    def apply(self, model) -> dict | None:
-        """Load the average into the model; the record (start, halflife, iterates)."""
-        if self.mean is None:
-            return None
-        self._load(model)
-        return {
-            "start": self.config.start,
-            "halflife": self.config.halflife,
-            "iterates": self.count,
-        }
-
-
-class StdAnnealing:
-    """The annealed exploration noise of :class:`train.config.StdAnnealConfig`
-    (``cfg.anneal_std``; inert if None): :meth:`update`, before each rollout, freezes the
-    policy's ``log_std`` the first time the run is at or past ``start`` and sets it to the
-    frozen value plus log f (gSDE: the noise is drawn anew at that std); :meth:`record`
-    says what it did."""
-
-    def __init__(self, cfg: TrainConfig):
-        self.config = cfg.anneal_std_config
-        self.frozen: torch.Tensor | None = None
-        self.factor = 1.0
-        self.at: int | None = None
-
-    def update(self, steps: int, stop: int, model, n_envs: int) -> None:
-        if self.config is None or steps < self.config.start:
-            return
-        log_std = model.policy.log_std
-        if self.frozen is None:
-            self.frozen = log_std.detach().clone()
-            self.at = int(steps)
-            log_std.requires_grad_(False)  # Adam skips a parameter without a gradient
-        self.factor = self.config.factor(steps, stop)
-        with torch.no_grad():
-            log_std.copy_(self.frozen + float(np.log(self.factor)))
-        if getattr(model, "use_sde", False):
-            model.policy.reset_noise(n_envs)
-
-    def record(self) -> dict | None:
-        if self.config is None:
-            return None
-        return {
-            "start": self.config.start,
-            "end": self.config.end,
-            "frozen_at": self.at,
-            "last_factor": self.factor,
-            "frozen_log_std": None if self.frozen is None else self.frozen.flatten().tolist(),
-        }
-
-
 def train_sb3(
     cfg: TrainConfig,
     seed: int,
@@ -441,44 +334,33 @@ def train_sb3(
         white.set_transform(transform)
 
     select = Selection(cfg, env_id)
-    average = Averaging(cfg)
-    anneal = StdAnnealing(cfg)
 
     class Curve(BaseCallback):
         def _on_step(self) -> bool:
             steps = offset + int(self.num_timesteps)
             if callback is not None and schedule.due(steps):
-                with average.applied(model):
-                    callback(steps, snapshot())
+                callback(steps, snapshot())
             # a check due at the budget's end is finish()'s, after the last update: SB3
             # calls this before the update of the rollout the step belongs to
             if select.due(steps) and steps < offset + budget:
-                with average.applied(model):
-                    select.check(steps, model, snapshot)
+                select.check(steps, model, snapshot)
             return True
 
         def _on_training_start(self) -> None:
             self._on_step()
 
-        def _on_rollout_start(self) -> None:  # after SB3 drew gSDE's noise for it
-            anneal.update(offset + int(self.num_timesteps), offset + budget, model, venv.num_envs)
-
         def _on_rollout_end(self) -> None:  # before the update of this rollout
-            average.update(offset + int(self.num_timesteps), model)
             if ent_sched is not None:  # the last rollout may overshoot the budget
                 model.ent_coef = ent_sched(max(1.0 - self.num_timesteps / budget, 0.0))
 
     budget = max(cfg.timesteps - offset, 1)
     model.learn(budget, callback=Curve())
     steps = offset + int(model.num_timesteps)
-    averaged = average.apply(model)  # from here on the model is the averaged policy
     record = {
         "steps": steps,
         "whiten_steps": offset,
         "transform": None if transform is None else transform.tolist(),
         "distill": distilled,
-        "average": averaged,
-        "anneal_std": anneal.record(),
         "select": select.finish(steps, model, snapshot),
     }
     if transform is not None:  # u = T' z into the actor's first layer: a plain SB3 actor on z

@@ -35,6 +35,7 @@ import acld_gym
 from acld_gym.benchmark import TEST_SETS
 from acld_gym.envs.presets import check_env_id
 from acld_gym.util.atomic import check_directory, check_writable, write_json, write_text
+from acld_gym.util.text import plain, prog
 
 from .analysis.control import Analysis, analyze
 from .evaluate import add_score_episodes_argument, check_score_episodes
@@ -93,8 +94,8 @@ def _finite(obj):
 
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
-        prog="python -m baselines.analyze",
-        description=__doc__,
+        prog=prog("python -m baselines.analyze"),
+        description=plain(__doc__),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument(

@@ -35,6 +35,7 @@ from acld_gym.design.observer import DiscreteObserver
 from acld_gym.envs.config import PARAM_NOISE_MAX
 from acld_gym.physics.truth import MESHES
 from acld_gym.physics.uncertainty import PARAM_NOISE_CLIP, RANDOMIZED
+from acld_gym.util.text import plain, prog
 
 __all__ = ["closed_loop_matrix", "spectral_radius", "corner_plants", "corner_study", "main"]
 
@@ -118,8 +119,8 @@ def main(argv: list[str] | None = None) -> int:
     from .policies import LQRPolicy, MPCPolicy, SMCPolicy
 
     p = argparse.ArgumentParser(
-        prog="python -m baselines.robustness",
-        description=__doc__,
+        prog=prog("python -m baselines.robustness"),
+        description=plain(__doc__),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("--mesh", choices=MESHES, nargs="+", default=list(MESHES))

@@ -41,6 +41,7 @@ from acld_gym.physics.truth import MESHES
 from acld_gym.thesis.table2 import thesis_row
 from acld_gym.util.atomic import check_directory, check_writable, save_figure, write_json
 from acld_gym.util.progress import Progress
+from acld_gym.util.text import plain, prog
 from acld_gym.util.validate import arg_type
 
 from .marks import level_references, mark_labels
@@ -309,8 +310,8 @@ def plot_episodes(episodes: dict, directory: Path) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(
-        prog="python -m baselines.evaluate",
-        description=__doc__,
+        prog=prog("python -m baselines.evaluate"),
+        description=plain(__doc__),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("--json", metavar="PATH", help="write the rows as JSON")

@@ -20,6 +20,7 @@ from pathlib import Path
 
 from acld_gym.physics.loads import THESIS_CASES
 from acld_gym.util.atomic import check_directory
+from acld_gym.util.text import plain, prog
 
 from .agent import CURVE_FILE, TrainedAgent
 from .agent_files import check_replaceable, curve_rows
@@ -106,7 +107,11 @@ def ship(
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m train.ship", description=__doc__)
+    p = argparse.ArgumentParser(
+        prog=prog("python -m train.ship"),
+        description=plain(__doc__),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     p.add_argument(
         "run",
         help="an agent directory: the --out of python -m train, or "

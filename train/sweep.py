@@ -16,6 +16,7 @@ import sys
 from pathlib import Path
 
 from acld_gym.util.atomic import check_directory
+from acld_gym.util.text import plain, prog
 from acld_gym.util.validate import arg_type, run_main
 
 from .cli import MAX_SEED, RECIPES
@@ -71,8 +72,8 @@ def _tune_trainable(config: dict) -> None:
 
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
-        prog="python -m train.sweep",
-        description=__doc__,
+        prog=prog("python -m train.sweep"),
+        description=plain(__doc__),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("algo", choices=RECIPES)

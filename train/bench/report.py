@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from acld_gym.util.atomic import save_figure, write_texts
+from acld_gym.util.text import plain, prog
 from acld_gym.util.validate import check_figure_path, os_error_line, run_main
 
 from .evaluate import CASES, OBJECTIVE_LOADS
@@ -482,7 +483,11 @@ def main(argv: list[str] | None = None) -> int:
     its learning curves (:func:`plot_curves`)."""
     import argparse
 
-    p = argparse.ArgumentParser(prog="python -m train.bench.report", description=main.__doc__)
+    p = argparse.ArgumentParser(
+        prog=prog("python -m train.bench.report"),
+        description=plain(main.__doc__),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     p.add_argument("results", type=Path, help="a results.json of python -m train.benchmark")
     p.add_argument(
         "--write",

@@ -1,5 +1,6 @@
-"""``acld-gym`` command line: ``reproduce`` (Table 2), ``model`` (model facts), ``mesh``
-(mesh convergence, thesis mesh vs converged plant), ``params``."""
+"""The thesis's commands of ``acld-gym`` (:mod:`train.console`): ``reproduce`` (Table 2),
+``model`` (model facts), ``mesh`` (mesh convergence, thesis mesh vs converged plant),
+``params``. ``acld-gym reproduce ...`` runs ``main(["reproduce", ...])``."""
 
 from __future__ import annotations
 
@@ -18,6 +19,7 @@ from acld_gym.thesis.metrics import peak
 from acld_gym.thesis.reproduce import CONTROLLERS, T_END, format_table2, run_cases
 from acld_gym.util.atomic import check_directory, check_writable, write_json
 from acld_gym.util.progress import Progress
+from acld_gym.util.text import plain
 from acld_gym.util.validate import arg_type, run_main
 
 __all__ = ["main"]
@@ -131,10 +133,32 @@ def cmd_params(args: argparse.Namespace) -> int:
     return 0
 
 
+#: Each command's help: its first sentence for the list, all of it for its own ``--help``.
+COMMANDS = {
+    "reproduce": "Reproduce the thesis's Table 2 (and figures). Simulates the thesis's beam, on "
+    "its own mesh and design model, passive and under LQR and SMC, with and without the "
+    "+/-120 V limit, on the three load cases, and prints the peak, the settling time and "
+    "the largest voltage beside the thesis's values.",
+    "model": "Natural frequencies, Hankel values, passive peak. The facts of a preset's "
+    "model: its states, first natural frequencies, the Hankel singular values of the "
+    "reduction, and the passive beam's peak on load case 1.",
+    "mesh": "Mesh convergence; the thesis mesh against the converged plant. The numbers of "
+    "docs/mesh.md: the modes as the mesh is refined, the two plants and their design "
+    "models, and the thesis's passive and LQR responses on each.",
+    "params": "Print the parameter table (Markdown). Every parameter of a preset with its "
+    "symbol, value, unit and description.",
+}
+
+
+def _command(sub, name: str) -> argparse.ArgumentParser:
+    text = COMMANDS[name]
+    return sub.add_parser(name, help=text.split(". ")[0], description=text)
+
+
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="acld-gym", description=__doc__)
+    p = argparse.ArgumentParser(prog="acld-gym", description=plain(__doc__))
     sub = p.add_subparsers(dest="command", required=True)
-    r = sub.add_parser("reproduce", help="reproduce the thesis's Table 2 (and figures)")
+    r = _command(sub, "reproduce")
     r.add_argument("--json", metavar="PATH", help="write the rows as JSON")
     r.add_argument("--plots", metavar="DIR", help="write figures (PNG) to DIR")
     r.add_argument("--preset", choices=sorted(PRESETS), default="matlab")
@@ -152,18 +176,14 @@ def build_parser() -> argparse.ArgumentParser:
     )
     r.add_argument("--quiet", action="store_true", help="no progress bar")
     r.set_defaults(func=cmd_reproduce)
-    m = sub.add_parser("model", help="natural frequencies, Hankel values, passive peak")
+    m = _command(sub, "model")
     m.add_argument("--json", metavar="PATH", help="write the facts as JSON")
     m.add_argument("--preset", choices=sorted(PRESETS), default="matlab")
     m.set_defaults(func=cmd_model)
-    me = sub.add_parser(
-        "mesh",
-        help="mesh convergence; the thesis mesh against the converged "
-        "plant (the tables of docs/mesh.md)",
-    )
+    me = _command(sub, "mesh")
     me.add_argument("--json", metavar="PATH", help="write the numbers as JSON")
     me.set_defaults(func=cmd_mesh)
-    pa = sub.add_parser("params", help="print the parameter table (Markdown)")
+    pa = _command(sub, "params")
     pa.add_argument("--preset", choices=sorted(PRESETS), default="matlab")
     pa.set_defaults(func=cmd_params)
     return p

@@ -27,6 +27,13 @@ __all__ = [
 ]
 
 
+def shown(value, limit: int = 60) -> str:
+    """``repr(value)`` cut to ``limit`` characters (an error message names a value, it does
+    not echo a 400-digit integer or a file's bytes)."""
+    text = repr(value)
+    return text if len(text) <= limit else f"{text[: limit - 3]}..."
+
+
 def check_real(
     name: str,
     value,
@@ -40,9 +47,12 @@ def check_real(
     a string) in [low, high] (``low_open``: (low, high]); else ``ValueError`` naming it."""
     u = f" {unit}" if unit and unit != "-" else ""
     ok = isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
-    v = float(value) if ok else math.nan
+    try:
+        v = float(value) if ok else math.nan
+    except OverflowError:  # an integer beyond the float range
+        v = math.nan
     if not ok or not math.isfinite(v):
-        raise ValueError(f"{name} must be a finite real number{u}, got {value!r}")
+        raise ValueError(f"{name} must be a finite real number{u}, got {shown(value)}")
     if low is not None and (v < low or (low_open and v == low)):
         rel = ">" if low_open else ">="
         raise ValueError(f"{name} must be {rel} {low:g}{u}, got {value!r}")
@@ -189,7 +199,8 @@ def run_main(main, prog: str | None = None) -> int:
     and no traceback for a failed file operation (a full disk, a vanished or unreadable
     file) or a damaged input file (:class:`DataFileError`): one line on stderr,
     ``<prog>: error: <file>: <reason>``, and exit status 1 (2 for a damaged input, as for
-    a bad argument)."""
+    a bad argument); Ctrl-C (``KeyboardInterrupt``) is one line too, exit status 130 (the
+    shell's 128 + SIGINT)."""
     from acld_gym.util.blas import one_blas_thread
 
     with closed_pipe_is_fine(), one_blas_thread():
@@ -203,4 +214,7 @@ def run_main(main, prog: str | None = None) -> int:
         except DataFileError as exc:
             print(f"{prog or _prog(main)}: error: {exc}", file=sys.stderr)
             return 2
+        except KeyboardInterrupt:  # Ctrl-C: one line, not a traceback of where it landed
+            print(f"{prog or _prog(main)}: interrupted", file=sys.stderr)
+            return 130
     return 0

@@ -94,6 +94,17 @@ def test_run_main_turns_a_failed_file_operation_into_one_line(tmp_path, capsys):
         run_main(lambda: 1 / 0, "cmd")
 
 
+def test_run_main_ctrl_c_is_one_line_and_status_130(capsys):
+    """Ctrl-C during a command: one line, exit status 130, no traceback."""
+    from acld_gym.util.validate import run_main
+
+    def interrupted():
+        raise KeyboardInterrupt
+
+    assert run_main(interrupted, "cmd") == 130
+    assert capsys.readouterr().err == "cmd: interrupted\n"
+
+
 @pytest.mark.parametrize(
     "module, args",
     [

@@ -46,7 +46,7 @@ from stable_baselines3.common.vec_env import VecEnv
 from acld_gym.envs.config import EnvConfig
 from acld_gym.envs.step import INFO_KEYS
 from acld_gym.envs.vector_env import ACLDBeamVectorEnv
-from acld_gym.util.validate import check_int, check_seed
+from acld_gym.util.validate import check_int, check_seed, shown
 
 #: Attributes the env derives its tables and design from at construction: every field of
 #: the configuration but ``load_case`` (settable: the next resets' case), and what follows.
@@ -147,8 +147,9 @@ class SB3VecEnv(VecEnv):
 
     Parameters
     ----------
-    num_envs : int
-        Number of sub-envs, when the adapter builds the env (ignored with ``venv=``).
+    num_envs : int, optional
+        Number of sub-envs (default 1) when the adapter builds the env; with ``venv=``,
+        omitted or ``venv``'s own count (another count is refused).
     venv : gymnasium.vector.VectorEnv, optional
         An existing env: an :class:`ACLDBeamVectorEnv` (``gym.make_vec`` of an acld_gym
         id), bare or in vector action, observation and reward wrappers (e.g.
@@ -187,7 +188,7 @@ class SB3VecEnv(VecEnv):
 
     def __init__(
         self,
-        num_envs: int = 1,
+        num_envs: int | None = None,
         venv: VectorEnv | None = None,
         config: EnvConfig | None = None,
         seed_group: int = 1,
@@ -195,10 +196,16 @@ class SB3VecEnv(VecEnv):
         **env_kwargs,
     ):
         if venv is None:
-            venv = ACLDBeamVectorEnv(num_envs=num_envs, config=config, **env_kwargs)
+            n = 1 if num_envs is None else num_envs
+            venv = ACLDBeamVectorEnv(num_envs=n, config=config, **env_kwargs)
         elif env_kwargs or config is not None:
             raise ValueError("pass either venv= or the env's configuration, not both")
         base, _ = wrapper_chain(venv)  # checked before the wrappers are applied
+        if num_envs is not None and num_envs != base.num_envs:
+            raise ValueError(
+                f"num_envs={shown(num_envs)} differs from venv's {base.num_envs} sub-envs: "
+                "omit num_envs with venv= (the env's count is used)"
+            )
         check_int("seed_group", seed_group, 1, base.num_envs)
         if base.num_envs % seed_group:
             raise ValueError(

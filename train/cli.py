@@ -26,6 +26,7 @@ from pathlib import Path
 
 from acld_gym import ENV_ID
 from acld_gym.util.atomic import check_writable
+from acld_gym.util.text import plain, prog
 from acld_gym.util.validate import arg_type
 
 from .agent_files import check_replaceable
@@ -66,8 +67,8 @@ def _load_case_arg(text: str):
 
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
-        prog="python -m train",
-        description=__doc__,
+        prog=prog("python -m train"),
+        description=plain(__doc__),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument(

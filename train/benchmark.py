@@ -47,6 +47,7 @@ import time
 from pathlib import Path
 
 from acld_gym.util.atomic import check_directory, check_writable, write_text, write_texts
+from acld_gym.util.text import plain, prog
 from acld_gym.util.validate import DataFileError, arg_type, run_main
 
 from .agent_files import check_replaceable
@@ -83,8 +84,8 @@ __all__ = [
 
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
-        prog="python -m train.benchmark",
-        description=__doc__,
+        prog=prog("python -m train.benchmark"),
+        description=plain(__doc__),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument(

@@ -36,6 +36,7 @@ from acld_gym.util.atomic import (
     write_text,
 )
 from acld_gym.util.progress import Progress
+from acld_gym.util.text import plain, prog
 from acld_gym.util.validate import arg_type
 from baselines.evaluate import (
     EvalRow,
@@ -300,8 +301,8 @@ def plot_learning_curves(agents: dict, directory: Path) -> Path | None:
 
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
-        prog="python -m train.compare",
-        description=__doc__,
+        prog=prog("python -m train.compare"),
+        description=plain(__doc__),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("--json", metavar="PATH", help="write the rows as JSON")

@@ -1,7 +1,10 @@
 """What a core install (``pip install acld-gym``, no extras) must do, checked from outside
-the checkout: ``gym.make`` of every registered id, ``python -m baselines.evaluate`` for
-passive, LQR, SMC and the bound (MPC skipped with one line naming the extra where osqp is
-missing), and ``TrainedAgent.load`` plus a rollout of every shipped agent, with numpy only.
+the checkout: ``gym.make`` of every registered id; the ``acld-gym`` command
+(:mod:`train.console`): ``--version``, ``--help`` listing every subcommand, ``acld-gym
+evaluate`` (``python -m baselines.evaluate``) for passive, LQR, SMC and the bound (MPC
+skipped with one line naming the extra where osqp is missing), and ``acld-gym train``
+ending with one line naming the train extra; and ``TrainedAgent.load`` plus a rollout of
+every shipped agent, with numpy only.
 ``--compiled``: the env's compiled step (``acld_gym.envs._stepcore``) must be in use.
 
 Run by ``.ci/run`` in a clean venv with the wheel installed, and by
@@ -47,15 +50,35 @@ def check_envs() -> str:
     )
 
 
-def check_evaluate() -> str:
-    from baselines.evaluate import main
-    from baselines.policies import mpc_available
+def _console(argv: list[str]) -> tuple[int, str, str]:
+    """``acld-gym ARGV`` in this process: (exit status, stdout, stderr)."""
+    from train.console import main
 
-    out = io.StringIO()
-    with contextlib.redirect_stdout(out):
-        code = main(["--score-episodes", "5", "--quiet"])
-    text = out.getvalue()
-    assert code == 0, text
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            code = main(argv)
+        except SystemExit as exc:  # argparse's --help and usage errors
+            code = exc.code
+    return code, out.getvalue(), err.getvalue()
+
+
+def check_command() -> str:
+    from importlib.metadata import version
+
+    from baselines.policies import mpc_available
+    from train.console import COMMANDS
+
+    code, text, err = _console(["--version"])
+    assert (code, text) == (0, f"acld-gym {version('acld-gym')}\n"), (code, text, err)
+    code, text, err = _console(["--help"])
+    listed = {line.split()[0] for line in text.splitlines() if line.startswith("  ")}
+    assert code == 0 and set(COMMANDS) <= listed, (code, text, err)
+    code, text, err = _console(["train", "ppo"])
+    assert code == 1 and len(err.splitlines()) == 1 and "acld-gym[train]" in err, (code, err)
+    extra = err.strip()
+    code, text, err = _console(["evaluate", "--score-episodes", "5", "--quiet"])
+    assert code == 0, text + err
     rows = {
         line.split()[0]
         for line in text.splitlines()
@@ -68,9 +91,10 @@ def check_evaluate() -> str:
     skipped = [line for line in text.splitlines() if line.startswith("mpc skipped")]
     assert mpc_available() or (len(skipped) == 1 and "acld-gym[baselines]" in skipped[0]), text
     return (
-        "python -m baselines.evaluate: "
+        f"acld-gym --version, --help ({len(COMMANDS)} commands); acld-gym evaluate: "
         + ", ".join(sorted(rows))
         + ("" if mpc_available() else f" ({skipped[0]})")
+        + f"; {extra}"
     )
 
 
@@ -92,7 +116,7 @@ def check_agents() -> str:
 
 
 def main() -> int:
-    checks = (check_envs, check_evaluate, check_agents)
+    checks = (check_envs, check_command, check_agents)
     for check in checks:
         try:
             print(f"ok   {check()}", flush=True)

@@ -97,11 +97,19 @@ def _check_sb3(cfg) -> None:
 def check_buildable(cfg, env_id: str | None = None) -> None:
     """Build ``cfg``'s algorithm once on its training env (SB3: the model on
     :func:`train.vec.make_vec_env`, with the whitening's first-layer check; ``vrs``: its
-    settings) and drop it: ``ValueError`` naming the setting a constructor refuses. A
-    second or two, no env step; call it before computing anything."""
+    settings) and drop it: ``ValueError`` naming the setting a constructor refuses, or a
+    ``restart_above`` that does not apply to ``env_id`` (a bare number on another level
+    than the one it was calibrated on,
+    :meth:`train.bench.threshold.RestartRule.check_level`). A second or two, no env step;
+    call it before computing anything."""
     import acld_gym
 
+    from .bench.threshold import RestartRule
+
     env_id = env_id or acld_gym.ENV_ID
+    rule = RestartRule.parse(cfg.restart_above)
+    if rule is not None:  # a bare number is one level's cost: refused on the others
+        rule.check_level(env_id)
     if cfg.algo == "vrs":  # RandomSearch is built by check_model; here its envs, one each
         _check_envs(cfg, env_id)
         return

@@ -11,8 +11,9 @@ Two meshes (``mesh=``):
   (2305 DOFs; modes 1-4 within 0.005 % of their Richardson limits, see
   :mod:`acld_gym.physics.convergence`), projected by Galerkin onto a rational Krylov
   subspace: the responses to the voltage and to the tip load at
-  :math:`s = 0` and at :math:`s = j\omega_i` for every mode below the band
-  :math:`2\pi / \Delta t` (twice the control's Nyquist frequency),
+  :math:`s = 0` and at :math:`s = j\omega_i` for every mode below 1.3 times the band
+  :math:`2\pi / \Delta t` (twice the control's Nyquist frequency; the margin:
+  :data:`acld_gym.physics.krylov.SHIFT_MARGIN`),
 
   .. math::
 
@@ -21,7 +22,7 @@ Two meshes (``mesh=``):
 
   18 vectors for the default 1 ms period, 36 states (directions below 1e-10 of the
   largest singular value are rounding and dropped:
-  :func:`acld_gym.physics.krylov.subspace_basis`; 78 states at 0.1 ms). The modes are
+  :func:`acld_gym.physics.krylov.subspace_basis`; 86 states at 0.1 ms). The modes are
   enumerated on the fine mesh itself (:mod:`acld_gym.physics.spectrum`). Interpolating at the
   resonances makes the projection match the fine mesh's frequency responses to
   about 1e-5 (relative H-infinity) in the band.

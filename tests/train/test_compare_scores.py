@@ -21,12 +21,16 @@ def _scores():
 
 def test_every_policy_of_the_shipped_table_has_a_full_score():
     scores = _scores()
-    assert {"passive", "lqr", "smc", "mpc", "mpc_reward", "bound"} <= set(scores)
+    names = {"passive", "lqr", "smc", "mpc", "mpc_reward", "lqg", "mpc_rig", "mpc_oracle"}
+    assert names | {"bound"} <= set(scores)
     for name, s in scores.items():
         assert s["n_episodes"] >= 100 and s["test_set"] == "ACLDBeam-v1/test-v1", name
-        assert s["ci_low"] <= s["iqm"] <= s["ci_high"]
-    assert scores["lqr"]["iqm"] == 0.0 and scores["bound"]["iqm"] == 1.0
-    assert scores["passive"]["iqm"] < 0
+        assert s["ci_low"] <= s["iqm"] <= s["ci_high"] and s["version"] == 2
+    # score v2's anchors: passive 0, the bound 1; the thesis LQR's ISE the thesis-facing 1
+    assert scores["passive"]["iqm"] == 0.0 and scores["bound"]["iqm"] == 1.0
+    assert scores["lqr"]["ise_rel_thesis_lqr"] == 1.0 and 0 < scores["lqr"]["iqm"] < 1
+    # the plant oracle at least every engineer's design (issue 66)
+    assert scores["mpc_oracle"]["iqm"] >= max(scores["lqg"]["iqm"], scores["mpc_rig"]["iqm"])
 
 
 def test_scores_order_the_policies_as_their_mean_ise_where_the_intervals_separate():
@@ -69,12 +73,13 @@ def test_the_markdown_has_the_effort_and_the_score(tmp_path, capsys):
     assert main(argv) == 0
     text = md.read_text()
     assert "| V rms [V] | Q [mvar] | TV after settling [kV/s] |" in text
-    assert "| vrs | from scratch |" in text and "95 % CI" in text
+    assert "| vrs | from scratch |" in text and "95 % CI" in text and "score v2 (IQM)" in text
+    assert "| mpc_oracle | oracle |" in text
     assert "| ISE / bound | return |" in text and "| mpc_reward | designed |" in text
     rows = json.loads(js.read_text())
     assert markdown_table(rows) in text and markdown_scores(rows) in text
     assert {r["score"]["n_episodes"] for r in rows} == {2}
-    assert "score on ACLDBeam-v1/test-v1 (2 random loads" in capsys.readouterr().out
+    assert "score on ACLDBeam-v1/test-v1 (score v2: 2 random loads" in capsys.readouterr().out
 
 
 @pytest.mark.parametrize(

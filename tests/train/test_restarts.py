@@ -9,7 +9,7 @@ import pytest
 
 import acld_gym  # noqa: F401  (registers the envs)
 from tests.train.tiny_sb3 import tiny_sac, tiny_sac_recipe
-from train.bench import algos, evaluate
+from train.bench import algos, evaluate, threshold
 from train.bench.algos import restart_seeds, train_algo
 
 
@@ -27,7 +27,7 @@ def _fake_runs(monkeypatch, costs):
     list the seeds of the runs trained are appended to."""
     calls = []
 
-    def fake_train(cfg_, seed, env_id, timed):
+    def fake_train(cfg_, seed, env_id, timed, **_):
         calls.append(seed)
         timed(0, f"policy-{seed}")
         timed(cfg_.timesteps, f"policy-{seed}")
@@ -119,21 +119,59 @@ def test_restart_above_retries_only_a_failed_run(monkeypatch, costs, trained, ch
     assert [r["cost"] for r in record["restarts"]["runs"]] == list(costs[:trained])
 
 
-def test_restart_above_lqr_is_lqrs_cost_on_the_selections_validation_loads(monkeypatch):
+@pytest.mark.parametrize("env_id", ["ACLDBeam-v1", "ACLDBeamHard-v1"])
+@pytest.mark.parametrize("rule, ratio", [("lqr", 1.0), ("1.02 * lqg", 1.02)])
+def test_restart_above_is_the_references_cost_on_the_selections_validation_loads(
+    monkeypatch, capsys, env_id, rule, ratio
+):
     seeds = restart_seeds(5, 3)
     calls = _fake_runs(monkeypatch, dict(zip(seeds, (0.55, 0.52, 0.5), strict=True)))
     asked = []
 
-    def fake_lqr(env_id, loads):
-        asked.append((env_id, loads))
-        return 0.535
+    def fake_reference(reference, env_id, loads):
+        asked.append((reference, env_id, loads))
+        return 0.535 / ratio
 
-    monkeypatch.setattr(algos, "lqr_validation_cost", fake_lqr)
-    policy, record = train_algo(_cfg(restarts=3, restart_above="lqr"), 5, "ACLDBeam-v1")
-    # the first run does not beat LQR (0.55 > 0.535): retried; the second does
+    monkeypatch.setattr(threshold, "reference_cost", fake_reference)
+    policy, record = train_algo(_cfg(restarts=3, restart_above=rule), 5, env_id)
+    # the first run is above the threshold (0.55 > 0.535): retried; the second is not
     assert calls == seeds[:2] and policy == f"policy-{seeds[1]}"
-    assert asked == [("ACLDBeam-v1", evaluate.validation_seeds(2))]  # select's 2 episodes
-    assert record["restarts"]["threshold"] == 0.535
+    reference = rule.split()[-1]
+    assert asked == [(reference, env_id, evaluate.validation_seeds(2))]  # select's 2 loads
+    rs = record["restarts"]
+    assert rs["threshold"] == pytest.approx(0.535)
+    assert rs["rule"] == {
+        "threshold": rs["threshold"],
+        "rule": f"{ratio:g} * {reference}",
+        "ratio": ratio,
+        "reference": reference,
+        "reference_cost": 0.535 / ratio,
+        "loads": 2,
+    }
+    # a retry is said, with its reason, on the console and in the record
+    assert rs["retries"] == [rs["runs"][0]["retried"]] and "retried" not in rs["runs"][1]
+    reason = rs["retries"][0]
+    assert "validation cost 0.5500 above the threshold 0.5350" in reason
+    assert f"{reference}'s {0.535 / ratio:.4f} on 2 validation loads" in reason
+    out = capsys.readouterr().out
+    assert f"retry: {reason}; training run 2" in out
+    assert "retry threshold 0.5350" in out and "run 2 of up to 3" in out
+
+
+def test_a_seed_whose_runs_all_miss_the_threshold_says_so(monkeypatch, capsys):
+    seeds = restart_seeds(5, 3)
+    _fake_runs(monkeypatch, dict(zip(seeds, (0.7, 0.6, 0.65), strict=True)))
+    monkeypatch.setattr(threshold, "reference_cost", lambda *a: 0.5)
+    _, record = train_algo(_cfg(restarts=3, restart_above="1.03 * lqg"), 5, "ACLDBeamLab-v1")
+    rs = record["restarts"]
+    assert len(rs["retries"]) == 2 and rs["chosen"] == 1  # the last run is not "retried"
+    assert [r.split(":")[0] for r in rs["retries"]] == [
+        f"run 1 (seed {seeds[0]})",
+        f"run 2 (seed {seeds[1]})",
+    ]
+    out = capsys.readouterr().out
+    assert out.count("retry: ") == 2
+    assert "none of the 3 runs met it; the lowest returned, run 2 (0.6000)" in out
 
 
 def test_lqr_validation_cost_is_the_lqr_policys():
@@ -149,12 +187,20 @@ def test_lqr_validation_cost_is_the_lqr_policys():
 @pytest.mark.parametrize(
     "fields, match",
     [
-        ({"restart_above": "passive"}, "restart_above must be a positive number, 'lqr' or null"),
+        ({"restart_above": "smc"}, "restart_above must be '<ratio> \\* <reference>'"),
+        ({"restart_above": "1.03 * mpc"}, "restart_above must be '<ratio> \\* <reference>'"),
+        ({"restart_above": "1.03 *"}, "restart_above must be '<ratio> \\* <reference>'"),
+        ({"restart_above": "x * lqg"}, "restart_above: the ratio must be a number"),
+        ({"restart_above": "0 * lqg"}, "restart_above: the ratio must be finite and > 0"),
+        ({"restart_above": "-1 * lqg"}, "restart_above: the ratio must be finite and > 0"),
+        ({"restart_above": "nan * lqg"}, "restart_above: the ratio must be finite and > 0"),
+        ({"restart_above": "inf * lqr"}, "restart_above: the ratio must be finite and > 0"),
+        ({"restart_above": ["lqg"]}, "restart_above must be a finite real number"),
         ({"restarts": 1, "restart_above": "lqr"}, "restart_above needs restarts >= 2"),
         ({"restarts": 1, "restart_above": 1.0}, "restart_above needs restarts >= 2"),
         ({"restart_above": 0.0}, "restart_above must be > 0"),
         ({"restart_above": -1}, "restart_above must be > 0"),
-        ({"restart_above": "1"}, "restart_above must be a positive number, 'lqr' or null"),
+        ({"restart_above": "1"}, "restart_above must be '<ratio> \\* <reference>'"),
         ({"restart_above": True}, "restart_above must be a finite real number"),
         ({"restart_above": float("nan")}, "restart_above must be a finite real number"),
     ],
@@ -169,7 +215,10 @@ def test_a_run_whose_curve_stops_short_gets_a_last_point(monkeypatch):
     monkeypatch.setattr(
         algos,
         "train_sb3",
-        lambda cfg, seed, env_id, timed: (timed(0, "p0"), ("p", {"steps": cfg.timesteps}))[1],
+        lambda cfg, seed, env_id, timed, **_: (
+            timed(0, "p0"),
+            ("p", {"steps": cfg.timesteps}),
+        )[1],
     )
     policy, record = train_algo(
         _cfg(restarts=1, select=False), 3, "ACLDBeam-v1", lambda s, p: {"policy": p}
@@ -184,7 +233,7 @@ def test_one_run_is_the_plain_recipe(monkeypatch):
     monkeypatch.setattr(
         algos,
         "train_sb3",
-        lambda cfg, seed, env_id, timed: (
+        lambda cfg, seed, env_id, timed, **_: (
             seen.append(seed) or "p",
             {"steps": cfg.timesteps, "select": {"steps": 0, "cost": 1}},
         ),
@@ -251,7 +300,7 @@ def test_a_run_in_this_process_has_one_blas_thread_as_a_worker_has(monkeypatch):
 
     seen = []
 
-    def fake_train(cfg_, seed, env_id, timed):
+    def fake_train(cfg_, seed, env_id, timed, **_):
         seen.append([d["num_threads"] for d in threadpool_info() if d["user_api"] == "blas"])
         return "policy", {"steps": cfg_.timesteps, "select": {"steps": 50, "cost": 1.0}}
 

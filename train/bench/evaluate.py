@@ -109,15 +109,22 @@ def batched_ise(policy, env_id: str = DEFAULT_ENV_ID, episodes: dict | None = No
 def _side_by_side(policy, venvs: list, obs: list, value) -> tuple[list, list]:
     """Run one episode in every sub-env of ``venvs`` (already reset, first observations
     ``obs``), side by side: the deterministic ``policy.predict`` once per step on all of
-    them, each sub-env counted until it ends. Returns, one array per vector env, the sum over
+    them, each sub-env counted until it ends; a policy with a state (SB3's recurrent
+    protocol: an engineer's reference's filter, :class:`baselines.policies.MeasurementFeedback`'s
+    observer) gets it back at every step, with ``episode_start`` true at the first.
+    Returns, one array per vector env, the sum over
     each sub-env's steps of ``value(reward, info)`` and its step count; closes the vector
     envs."""
     sizes = np.cumsum([venv.num_envs for venv in venvs])[:-1]
     n = sum(venv.num_envs for venv in venvs)
     total, steps = np.zeros(n), np.zeros(n)
     alive = np.ones(n, dtype=bool)
+    state, start = None, np.ones(n, dtype=bool)  # SB3's recurrent protocol, as rollout()'s
     while alive.any():
-        act, _ = policy.predict(np.concatenate(obs), deterministic=True)
+        act, state = policy.predict(
+            np.concatenate(obs), state=state, episode_start=start, deterministic=True
+        )
+        start = np.zeros(n, dtype=bool)  # a sub-env that ends is not counted afterwards
         act = np.asarray(act, dtype=np.float64).reshape(-1, 1)
         obs, got, done = [], [], []
         for venv, a in zip(venvs, np.split(act, sizes), strict=True):

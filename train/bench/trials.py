@@ -24,6 +24,7 @@ __all__ = [
     "policy_program",
     "save_agent",
     "run_trials",
+    "trained_line",
     "ray_available",
 ]
 
@@ -41,6 +42,7 @@ def run_trial(
     out: str | Path | None = None,
     command: str | None = None,
     workers: int = 1,
+    quiet: bool = False,
 ) -> tuple[dict, object]:
     """Train one (config, seed) and evaluate it; returns ``(record, policy)``: the trial's
     record (JSON-able: the learning curve, mean ISE per case at each evaluation, batched --
@@ -50,7 +52,13 @@ def run_trial(
     first :data:`train.bench.evaluate.OBJECTIVE_LOADS` validation loads; the command) and
     the final policy. With ``out``, the policy is saved as an
     agent in :func:`agent_dir`. ``workers``: how many of the trial's runs (``restarts``)
-    train at once (:func:`train.bench.algos.train_algo`: the same result, in less time)."""
+    train at once (:func:`train.bench.algos.train_algo`: the same result, in less time).
+
+    On the console, lines labelled ``<name> s<seed>``
+    (:class:`train.bench.progress.Progress`): one per evaluation with the current
+    validation score (none with ``quiet``), the retry threshold and every retry with its
+    reason, which the record keeps too (``retries``, ``[]`` when the first run sufficed or
+    there is one)."""
     import torch
 
     from .algos import train_algo
@@ -61,12 +69,14 @@ def run_trial(
         validation_cost,
         validation_seeds,
     )
+    from .progress import Progress
 
     torch.set_num_threads(1)
     cfg = TrainConfig.from_dict(config)
     episodes = eval_episodes(random_episodes)
     t0 = time.perf_counter()
-    policy, record = train_algo(cfg, seed, env_id, CaseISE(env_id, episodes), workers)
+    progress = Progress(f"{name} s{seed}", quiet)
+    policy, record = train_algo(cfg, seed, env_id, CaseISE(env_id, episodes), workers, progress)
     wall = time.perf_counter() - t0
     final = rollout_ise(policy, env_id, episodes)
     cost = validation_cost(policy, env_id, validation_seeds(OBJECTIVE_LOADS))
@@ -86,6 +96,8 @@ def run_trial(
         "wall_seconds": wall,
         "final_ise": {str(c): v for c, v in final.items()},
         "validation_cost": cost,
+        "runs": len(record.get("restarts", {}).get("runs", [None])),
+        "retries": record.get("restarts", {}).get("retries", []),
         "curve": record["curve"],
         "record": {
             k: v
@@ -112,6 +124,17 @@ class CaseISE:
 
         ise = batched_ise(policy, self.env_id, self.episodes)
         return {"ise": {str(c): v for c, v in ise.items()}}
+
+
+def trained_line(rec: dict) -> str:
+    """What a trial's record says of its training in one line: the time, and with several
+    runs how many it took and why (``trained in 412 s, 3 runs (2 retries: ...)``)."""
+    text = f"trained in {rec['train_seconds']:.0f} s"
+    runs, retries = rec.get("runs", 1), rec.get("retries", [])
+    if runs > 1:
+        why = f" ({len(retries)} retr{'y' if len(retries) == 1 else 'ies'}: " if retries else ""
+        text += f", {runs} runs{why}{'; '.join(retries)}{')' if retries else ''}"
+    return text
 
 
 def trial_path(out: Path, name: str, seed: int) -> Path:
@@ -235,10 +258,7 @@ def run_trials(
         for t in trials:
             rec, _ = run_trial(**t, out=out)
             write_text(trial_path(out, rec["name"], rec["seed"]), json.dumps(rec) + "\n")
-            print(
-                f"  {rec['name']} seed {rec['seed']}: trained in {rec['train_seconds']:.0f} s",
-                flush=True,
-            )
+            print(f"  {rec['name']} seed {rec['seed']}: {trained_line(rec)}", flush=True)
             records.append(rec)
         return records
     from ray import tune

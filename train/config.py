@@ -205,15 +205,19 @@ class TrainConfig:
         from it, :func:`train.bench.algos.restart_seeds`); the trial returns the run whose
         chosen check has the lowest validation cost (the same validation loads for all).
         The budget is ``restarts * timesteps`` (:attr:`budget`). Default 1: one run.
-    restart_above : float, "lqr" or None
+    restart_above : str, float or None
         With ``restarts`` > 1: a run is followed by the next only if its chosen check's
-        validation cost is above this (:func:`train.bench.evaluate.validation_cost`, the
-        passive beam's 1 on every load, so 1.0 retries a run that controls worse than no
-        control at all); ``"lqr"``: above LQR's cost on the same validation loads
-        (:func:`train.bench.evaluate.lqr_validation_cost`), so a run that does not beat
-        LQR there is retried. The first run at or below it is returned, and if none is,
-        the lowest. Seeds then train ``timesteps`` to :attr:`budget` env steps, by one
-        rule. None (default): every run, the lowest returned.
+        validation cost (:func:`train.bench.evaluate.validation_cost`) is above this:
+        ``"<ratio> * <reference>"`` (e.g. ``"1.03 * lqg"``; a reference alone: ratio 1),
+        the ratio times the reference's cost on the same validation loads of the level
+        the run trains on (``lqg``, the level's engineer's LQG; ``lqr``, the thesis LQR;
+        ``passive``), resolved before the first run
+        (:class:`train.bench.threshold.RestartRule`), so one recipe carries over to every
+        level; a bare number: an absolute cost of ``ACLDBeam-v1``, the level such numbers
+        were calibrated on, refused on any other. The first run at or below it is
+        returned, and if none is, the lowest; every retry is said, with its reason. Seeds
+        then train ``timesteps`` to :attr:`budget` env steps, by one rule. None (default):
+        every run, the lowest returned.
     """
 
     algo: str
@@ -248,14 +252,9 @@ class TrainConfig:
             check_int(name, getattr(self, name), 1, most)  # most: what memory allows
         check_int("restarts", self.restarts, 1, 64)
         if self.restart_above is not None:
-            if isinstance(self.restart_above, str):
-                if self.restart_above != "lqr":
-                    raise ValueError(
-                        "restart_above must be a positive number, 'lqr' or null, "
-                        f"got {self.restart_above!r}"
-                    )
-            else:
-                check_real("restart_above", self.restart_above, 0.0, None, low_open=True)
+            from .bench.threshold import RestartRule
+
+            RestartRule.parse(self.restart_above)
             if self.restarts < 2:
                 raise ValueError(
                     f"restart_above needs restarts >= 2 (runs to choose from), "

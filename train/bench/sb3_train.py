@@ -218,13 +218,15 @@ class Selection:
     (:func:`train.bench.evaluate.validation_rollout`) and keeps a copy of the SB3 policy's
     parameters when it is the best so far; :meth:`finish` checks the final policy too,
     loads the best parameters back into the model and returns the record (the step and
-    cost of each check, the step chosen, the env steps of all validation episodes)."""
+    cost of each check, the step chosen, the env steps of all validation episodes).
+    ``progress`` (a :class:`train.bench.progress.Progress`) says each check."""
 
-    def __init__(self, cfg: TrainConfig, env_id: str):
+    def __init__(self, cfg: TrainConfig, env_id: str, progress=None):
         from .evaluate import validation_seeds
 
         self.config = cfg.select_config
         self.env_id = env_id
+        self.progress = progress
         self.seeds = () if self.config is None else validation_seeds(self.config.episodes)
         self.next = None if self.config is None else self.config.start
         self.history: list[dict] = []
@@ -242,6 +244,8 @@ class Selection:
         self.history.append({"steps": int(steps), "cost": cost})
         if self.best is None or cost < self.best[0]:
             self.best = (cost, int(steps), copy.deepcopy(model.policy.state_dict()))
+        if self.progress is not None:
+            self.progress.check(steps, cost, self.best[0], len(self.seeds))
         while self.next <= steps:
             self.next += self.config.every
 
@@ -268,6 +272,7 @@ def train_sb3(
     callback: CurveCallback | None = None,
     *,
     make_env: Callable[[TrainConfig, int, str], VecNormalize] = make_vec_env,
+    progress=None,
 ) -> tuple[SB3Policy, dict]:
     """Train an SB3 / sb3-contrib algorithm for ``cfg.timesteps`` env steps (with
     ``cfg.whiten_steps``: first that many steps of the initial policy, from which the
@@ -277,7 +282,8 @@ def train_sb3(
     ``make_env(cfg, seed, env_id)`` builds the training env: :func:`train.vec.make_vec_env`
     unless a probe wraps its own (it must return the same layers, ``VecNormalize`` over
     :class:`train.vec.VecWhiten` where ``cfg.whiten_steps`` is set); the evaluation and the
-    validation checks run on the plain env whatever it is."""
+    validation checks run on the plain env whatever it is. ``progress`` (a
+    :class:`train.bench.progress.Progress`) says each validation check."""
     from stable_baselines3.common.callbacks import BaseCallback
 
     torch.set_num_threads(1)
@@ -333,7 +339,7 @@ def train_sb3(
         white.collect = None
         white.set_transform(transform)
 
-    select = Selection(cfg, env_id)
+    select = Selection(cfg, env_id, progress)
 
     class Curve(BaseCallback):
         def _on_step(self) -> bool:

@@ -171,6 +171,16 @@ def test_plain_fills_paragraphs_to_the_width():
         assert lines[lines.index("") + 1].startswith("* item") and lines[-1].startswith("  ")
 
 
+@pytest.mark.parametrize("lead", range(0, 40, 3))
+def test_plain_keeps_a_short_literal_on_one_line(lead):
+    doc = "a " * lead + "``python -m train ppo --seed N`` then " + "b " * 20
+    lines = plain(doc, width=40).splitlines()
+    assert any("python -m train ppo --seed N" in line for line in lines), lines
+    assert max(len(line) for line in lines) <= 40
+    long = "x " * lead + "``" + "y " * 30 + "``"  # longer than a line: breaks, within width
+    assert max(len(line) for line in plain(long, width=40).splitlines()) <= 40
+
+
 def test_math_text():
     assert (
         math_text(r"\frac{a}{b} \le \alpha^{-1}, \mathrm{ISE}_{k+1}") == "(a)/(b) ≤ α⁻¹, ISE_(k+1)"

@@ -90,6 +90,8 @@ _SYMBOLS = {
 #: Accents (LaTeX command names) and the combining mark each puts on its argument.
 _ACCENTS = {"hat|widehat": "\u0302", "bar|overline": "\u0304", "dot": "\u0307"}
 _SUPERSCRIPTS = str.maketrans("0123456789+-=()nT", "⁰¹²³⁴⁵⁶⁷⁸⁹⁺⁻⁼⁽⁾ⁿᵀ")
+#: Stands for a space that filling must not break at (short literals), and their length limit.
+_KEEP, _KEEP_UP_TO = "\x00", 60
 _ROLE = re.compile(r":(?:[A-Za-z][\w-]*:)+`([^`]+)`")
 _MATH_ROLE = re.compile(r":math:`([^`]+)`")
 _DIRECTIVE = re.compile(r"^(\s*)\.\.\s+([\w-]+)::\s*(.*)$")
@@ -135,11 +137,18 @@ def _role(match: re.Match) -> str:
     return text.lstrip("!")
 
 
+def _literal(match: re.Match) -> str:
+    """A double-backtick literal's text; a short one (a command, an expression) held on one
+    line when filled (:data:`_KEEP` for its spaces, made spaces again by :func:`plain`)."""
+    text = " ".join(match[1].split())
+    return text.replace(" ", _KEEP) if len(text) <= _KEEP_UP_TO else text
+
+
 def _inline(text: str) -> str:
     """Inline reStructuredText as plain text (roles, literals, emphasis, interpreted text)."""
     text = _MATH_ROLE.sub(lambda m: math_text(m[1]), text)
     text = _ROLE.sub(_role, text)
-    text = re.sub(r"``(.+?)``", r"\1", text, flags=re.S)
+    text = re.sub(r"``(.+?)``", _literal, text, flags=re.S)
     text = re.sub(r"(?<![\w`])`([^`]+)`_{0,2}(?![\w`])", r"\1", text)
     text = re.sub(r"(?<![\w*])\*\*(\S(?:.*?\S)?)\*\*(?![\w*])", r"\1", text, flags=re.S)
     text = re.sub(r"(?<![\w*])\*(\S(?:[^*]*?\S)?)\*(?![\w*])", r"\1", text, flags=re.S)
@@ -151,14 +160,20 @@ def _indent(line: str) -> int:
 
 
 def _fill(text: str, width: int, first: str, rest: str) -> str:
-    return textwrap.fill(
-        " ".join(text.split()),
-        width,
-        initial_indent=first,
-        subsequent_indent=rest,
-        break_long_words=False,
-        break_on_hyphens=False,
-    )
+    """``text`` filled to ``width``, each short literal on one line unless one is longer
+    than a line (then it breaks at its spaces too)."""
+    for kept in (text, text.replace(_KEEP, " ")):
+        filled = textwrap.fill(
+            " ".join(kept.split()),
+            width,
+            initial_indent=first,
+            subsequent_indent=rest,
+            break_long_words=False,
+            break_on_hyphens=False,
+        )
+        if all(len(line) <= width for line in filled.split("\n")):
+            break
+    return filled
 
 
 def _prose(lines: list[str], width: int) -> str:
@@ -250,7 +265,7 @@ def plain(doc: str | None, width: int | None = None) -> str:
             if not block:
                 continue
         out.append(_prose(block, width))
-    return "\n\n".join(out)
+    return "\n\n".join(out).replace(_KEEP, " ")
 
 
 def prog(default: str) -> str:

@@ -94,6 +94,8 @@ def test_subcommands_run_and_fail_under_their_name(capsys):
     assert err.splitlines()[-1].startswith("acld-gym evaluate: error: --env-id must be one of")
     code, _, err = run(["reproduce", "--t-end", "-1"], capsys)
     assert code == 2 and "acld-gym reproduce: error: argument --t-end" in err
+    code, _, err = run(["model", "--json", f"{__file__}/x.json"], capsys)
+    assert code == 2 and err.splitlines()[-1].startswith("acld-gym model: error: --json:")
 
 
 def test_the_console_script_is_this_command():

@@ -175,24 +175,24 @@ def build_parser() -> argparse.ArgumentParser:
         help="simulated window [s]",
     )
     r.add_argument("--quiet", action="store_true", help="no progress bar")
-    r.set_defaults(func=cmd_reproduce)
+    r.set_defaults(func=cmd_reproduce, parser=r)
     m = _command(sub, "model")
     m.add_argument("--json", metavar="PATH", help="write the facts as JSON")
     m.add_argument("--preset", choices=sorted(PRESETS), default="matlab")
-    m.set_defaults(func=cmd_model)
+    m.set_defaults(func=cmd_model, parser=m)
     me = _command(sub, "mesh")
     me.add_argument("--json", metavar="PATH", help="write the numbers as JSON")
-    me.set_defaults(func=cmd_mesh)
+    me.set_defaults(func=cmd_mesh, parser=me)
     pa = _command(sub, "params")
     pa.add_argument("--preset", choices=sorted(PRESETS), default="matlab")
-    pa.set_defaults(func=cmd_params)
+    pa.set_defaults(func=cmd_params, parser=pa)
     return p
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    _check_outputs(parser, args)
+    _check_outputs(args.parser, args)  # its errors under 'acld-gym <command>'
     # one BLAS thread, a quiet end if the reader closes the pipe (acld-gym params | head -1),
     # one line for a failed write (a full disk)
     return run_main(lambda: args.func(args), "acld-gym")

@@ -189,6 +189,16 @@ class ActorProgram:
             )
         return got
 
+    @property
+    def input_width(self) -> int:
+        """The observation width d the program reads (its first array's)."""
+        kinds = [op["op"] for op in self.ops]
+        i = kinds.index("linear")  # (check_ops: there is one)
+        if "normalize" in kinds[:i]:
+            i = kinds.index("normalize")
+            return int(self.arrays["mean"].shape[0]) - kinds[:i].count("direction")
+        return int(self.arrays[f"W{self.ops[i]['layer']}"].shape[0]) - kinds[:i].count("direction")
+
     def __call__(self, obs: np.ndarray) -> np.ndarray:
         """Actions in [-1, 1], shape (n, 1), for raw observations (n, d); ``ValueError`` if
         a finite observation gives a non-finite action (weights that overflow on it)."""
@@ -284,6 +294,8 @@ class TrainedAgent:
         name: str = "agent",
         directory: Path | None = None,
     ):
+        if not isinstance(metadata, dict):
+            raise TypeError(f"metadata: expected a dict, got {type(metadata).__name__}")
         self.actor = actor
         self.metadata = dict(metadata)
         self.name = name
@@ -404,6 +416,12 @@ class TrainedAgent:
                 "deterministic must be True: TrainedAgent evaluates the deterministic policy"
             )
         obs = np.asarray(observation, dtype=np.float32)
+        width = self.actor.input_width
+        if obs.shape not in ((width,),) and not (obs.ndim == 2 and obs.shape[1] == width):
+            raise ValueError(
+                f"observation: expected shape ({width},) or (n, {width}) (the observation of "
+                f"{self.metadata.get('env', {}).get('id', 'its env')}), got shape {obs.shape}"
+            )
         batched = obs.ndim == 2
         obs2 = np.atleast_2d(obs)
         v = self.map(self.actor(obs2), obs2)

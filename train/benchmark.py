@@ -8,7 +8,8 @@ ISE / ISE_LQR on thesis cases 1, 2, 3 (seed 0) and on the held-out random set
 (``train.bench.evaluate.HELDOUT_SEEDS``). LQR, SMC, MPC and the clairvoyant bound are used
 only to normalise and report these numbers.
 
-Writes to ``--out`` (default ``runs/benchmark``), atomically:
+Writes to ``--out`` (default ``runs/<env id>/benchmark``: runs on different levels never
+share a folder), atomically:
 
 * ``results.md`` / ``results.json``: per algorithm the interquartile mean (IQM) over
   seeds with 95 % stratified-bootstrap intervals, the training wall time, the
@@ -24,10 +25,15 @@ other (``--backend local``).
 Examples::
 
     python -m train.benchmark                                  # 5 algorithms x 5 seeds
-    python -m train.benchmark --algos vrs --seeds 0 1 2 3 4 --out runs/benchmark/vrs
-    python -m train.benchmark --config train/benchmark/ablation_vrs_return.yaml \\
-        --seeds 0 1 2 --out runs/benchmark/ablation_vrs_return
-    python -m train.benchmark --env-id ACLDBeam-v1 --backend ray --num-cpus 2
+    python -m train.benchmark --algos vrs --seeds 0 1 2 3 4 --out runs/ACLDBeam-v1/vrs
+    python -m train.benchmark --config studies/ablations/ablation_vrs_return.yaml \\
+        --seeds 0 1 2 --out runs/ACLDBeam-v1/ablation_vrs_return
+    python -m train.benchmark --env-id ACLDBeamLab-v1 --backend ray --num-cpus 2
+
+The recipes run unchanged on every registered id: a recipe's retry threshold is resolved
+on the level's own reference (:mod:`train.bench.threshold`). While it trains, each trial
+says a line per evaluation with its current validation score (``--quiet``: none), the
+threshold, and every retry with its reason, which its record keeps (``retries``).
 
 A recipe with several runs per seed (``restarts``: PPO's and SAC's) trains up to
 ``--cpus-per-trial`` of them at once, in worker processes: the same runs, taken in the
@@ -148,7 +154,14 @@ def build_parser() -> argparse.ArgumentParser:
         "--num-cpus, so such trials run one after another; with --address 1)",
     )
     p.add_argument("--address", default=None, help="Ray cluster address (default: local)")
-    p.add_argument("--out", default="runs/benchmark", help="output directory")
+    p.add_argument(
+        "--out", default=None, help="output directory (default: runs/<env id>/benchmark)"
+    )
+    p.add_argument(
+        "--quiet",
+        action="store_true",
+        help="no line per evaluation (thresholds and retries are still said)",
+    )
     p.add_argument(
         "--no-bound",
         action="store_true",
@@ -270,7 +283,7 @@ def main(argv: list[str] | None = None) -> int:
     names = [name for _, name, _ in configs]
     if len(set(names)) != len(names):
         parser.error(f"two configs of one name would share their trials: {names}")
-    out = Path(args.out)
+    out = Path(args.out) if args.out else Path("runs") / args.env_id / "benchmark"
     planned = []
     for path, name, data in configs:
         data = dict(data)
@@ -290,6 +303,7 @@ def main(argv: list[str] | None = None) -> int:
                     "seed": seed,
                     "env_id": args.env_id,
                     "random_episodes": args.random_episodes,
+                    "quiet": args.quiet,
                 }
             )
     try:
@@ -310,11 +324,13 @@ def main(argv: list[str] | None = None) -> int:
         if not records:
             parser.error(f"--no-train: no trials to report in {out / 'trials'}")
     t0 = time.perf_counter()
-    refs = resumed_references(args.env_id, out, args.random_episodes, not args.no_bound)
     print(
-        f"{len(trials)} runs ({len(records)} reused), backend {backend}, env {args.env_id}",
+        f"benchmark on {args.env_id}: {', '.join(names)} x seeds "
+        f"{' '.join(map(str, args.seeds))}: {len(trials)} runs to train ({len(records)} "
+        f"reused), backend {backend} -> {out}/",
         flush=True,
     )
+    refs = resumed_references(args.env_id, out, args.random_episodes, not args.no_bound)
     workers = trial_workers(args.cpus_per_trial, args.num_cpus, args.address)
     records += run_trials(trials, out, backend, args.num_cpus, args.address, workers)
     wall = time.perf_counter() - t0

@@ -8,12 +8,16 @@ same env factory, training and evaluation), so ``python -m train ppo --seed N`` 
 agent that ``python -m train.benchmark --algos ppo --seeds N`` saves in
 ``<out>/agents/ppo-sN``, bit for bit on one machine.
 
-Writes to ``--out`` (default ``runs/<recipe>-s<seed>``): the agent as ``policy.npz`` +
+Writes to ``--out`` (default ``runs/<env id>/<recipe>-s<seed>``, so runs on different
+levels never overwrite one another): the agent as ``policy.npz`` +
 ``metadata.json`` (loads with :meth:`train.agent.TrainedAgent.load`; the metadata records
 the command, seed, config, versions, how it was trained, and the observation
 fingerprint), ``learning_curve.csv`` (ISE per case during training) and ``trial.json``
-(the benchmark's record of the run). Prints ISE / LQR of the final policy on thesis cases
-1, 2, 3 and the held-out random loads.
+(the benchmark's record of the run, every retry with its reason included). Prints the env
+id it trains on, a line per evaluation with the current validation score (``--quiet``:
+none), the retry threshold of a recipe with several runs resolved on that level and every
+retry with its reason, then ISE / LQR of the final policy on thesis cases 1, 2, 3 and the
+held-out random loads.
 """
 
 from __future__ import annotations
@@ -32,7 +36,15 @@ from acld_gym.util.validate import arg_type
 from .agent_files import check_replaceable
 from .config import ALGOS, CONFIG_DIR, config_path, parse_load_case, read_config
 
-__all__ = ["main", "build_parser", "configure", "env_id_arg", "RECIPES", "MAX_SEED"]
+__all__ = [
+    "main",
+    "build_parser",
+    "configure",
+    "default_out",
+    "env_id_arg",
+    "RECIPES",
+    "MAX_SEED",
+]
 
 #: The recipes ``python -m train`` knows by name (a file ``train/benchmark/<algo>.yaml``).
 RECIPES = tuple(a for a in ALGOS if (CONFIG_DIR / f"{a}.yaml").is_file())
@@ -55,6 +67,12 @@ def env_id_arg(text: str) -> str:
         return check_env_id(text, "expected")
     except ValueError as err:
         raise argparse.ArgumentTypeError(str(err).replace("expected must be", "expected")) from None
+
+
+def default_out(env_id: str, name: str, seed: int) -> Path:
+    """``--out``'s default: ``runs/<env id>/<recipe>-s<seed>`` (the env id named, so a run
+    on one level never replaces another's)."""
+    return Path("runs") / env_id / f"{name}-s{seed}"
 
 
 def _load_case_arg(text: str):
@@ -129,7 +147,12 @@ def build_parser() -> argparse.ArgumentParser:
         "--out",
         metavar="DIR",
         default=None,
-        help="output directory (default: runs/<recipe>-s<seed>)",
+        help="output directory (default: runs/<env id>/<recipe>-s<seed>)",
+    )
+    p.add_argument(
+        "--quiet",
+        action="store_true",
+        help="no line per evaluation (the retry threshold and any retry are still said)",
     )
     return p
 
@@ -171,7 +194,7 @@ def main(argv: list[str] | None = None) -> int:
         name, data = configure(args)
     except (OSError, ValueError) as exc:
         parser.error(str(exc))  # exit status 2, no traceback
-    out = Path(args.out or f"runs/{name}-s{args.seed}")
+    out = Path(args.out or default_out(args.env_id, name, args.seed))
     if out.exists() and not out.is_dir():
         parser.error(f"--out: {str(out)!r} exists and is not a directory")
     try:  # before any training: an unusable --out fails now, not after the run
@@ -183,7 +206,7 @@ def main(argv: list[str] | None = None) -> int:
     except ValueError as exc:
         parser.error(f"--out: {exc}")
     from .bench.evaluate import eval_episodes, lqr_ise
-    from .bench.trials import run_trial, save_agent
+    from .bench.trials import run_trial, save_agent, trained_line
     from .config import TrainConfig
 
     cfg = TrainConfig.from_dict(data)
@@ -195,9 +218,10 @@ def main(argv: list[str] | None = None) -> int:
     runs = f" ({upto}{cfg.restarts} runs of {cfg.timesteps})" if cfg.restarts > 1 else ""
     if runs and args.cpus > 1:
         runs = runs[:-1] + f", {min(args.cpus, cfg.restarts)} at once)"
+    rule = f"; a run retried while its validation cost is above {cfg.restart_above}" if upto else ""
     print(
-        f"training {cfg.algo.upper()} ({name}, {cfg.training}) for {upto}{cfg.budget} env "
-        f"steps{runs}, seed {args.seed}",
+        f"training {cfg.algo.upper()} ({name}, {cfg.training}) on {args.env_id} for {upto}"
+        f"{cfg.budget} env steps{runs}, seed {args.seed}{rule} -> {out}/",
         flush=True,
     )
     rec, policy = run_trial(
@@ -208,11 +232,13 @@ def main(argv: list[str] | None = None) -> int:
         args.random_episodes,
         command=command,
         workers=args.cpus,  # train_algo takes at most one per run
+        quiet=args.quiet,
     )
     save_agent(policy, rec, out, {"trial.json": json.dumps(rec) + "\n"})  # all or none
     episodes = eval_episodes(args.random_episodes)
     lqr = lqr_ise(args.env_id, episodes)
     rel = "  ".join(f"case {c}: {rec['final_ise'][str(c)] / lqr[c]:.3f}" for c in episodes)
-    print(f"trained in {rec['train_seconds']:.0f} s; ISE / LQR  {rel}")
+    print(f"{trained_line(rec)}; validation cost {rec['validation_cost']:.4f}")
+    print(f"ISE / LQR on {args.env_id}  {rel}")
     print(f"wrote {out}/: policy.npz + metadata.json (the agent), learning_curve.csv, trial.json")
     return 0

@@ -1,24 +1,19 @@
 """``python -m train.compare``: the shipped agents against the reference policies.
 
-For each thesis load case (1, 2, 3) and a fixed held-out set of random loads
-(``case "random"``: the mean over the set; seeds disjoint from anything used in
-training), runs passive / LQR / SMC / MPC, the MPC of the env's own reward
-(``mpc_reward``, :func:`reference_policies`), every shipped agent (``train/agents/``,
-labelled by how it was trained: "from scratch" or "DAgger from MPC + RL") and the
-clairvoyant bound through ``ACLDBeam-v1`` (+/-120 V, 1 ms, default Kalman observer) and prints
-peak [mm], 5 % settling [s], ISE [m^2 s], ISE relative to LQR and to the bound,
-max |V| [V], return, compute time per step [ms], the effort (RMS voltage, amplifier
-reactive power, chattering and time at the limit after settling,
-:mod:`baselines.analysis.effort`), and every policy's score on the published test set
-(:mod:`baselines.analysis.score`: IQM of (ISE_LQR - ISE) / (ISE_LQR - ISE_bound) with a
-95 % bootstrap interval; ``--score-episodes``).
+For each thesis load case (1, 2, 3) and a fixed held-out set of random loads (``case
+"random"``: the mean over the set; seeds disjoint from training), runs the references
+(:func:`reference_policies`: the thesis's delay-free LQR and SMC, the nominal MPC,
+``mpc_reward``, the engineer's designs, the plant oracle ``mpc_oracle``), every shipped
+agent (labelled by how it was trained) and the bound through ``ACLDBeam-v1``; prints peak
+[mm], 5 % settling [s], ISE [m^2 s] (and / LQR, / bound), max |V| [V], return, ms per
+step, the effort after settling (:mod:`baselines.analysis.effort`), and score v2 on the
+test set (:mod:`baselines.analysis.score`: passive 0, bound 1; ``--score-episodes``)
+beside the mean ISE relative to the thesis LQR's.
 
-``--param-noise X`` repeats the comparison with per-episode parameter
-randomization (every policy sees the same randomized plants; the bound knows
-the plant). ``--json PATH`` writes the rows (as ``baselines.evaluate``'s, plus
-``ise_rel_lqr``, ``ise_rel_bound`` and the policy's ``score``); ``--markdown PATH`` the
-table and the score table; ``--plots DIR`` writes one figure per thesis case and the
-learning curves.
+``--param-noise X``: per-episode parameter randomization (the same plants for every
+policy; the bound knows the plant). ``--json PATH``: the rows (``baselines.evaluate``'s,
+plus ``ise_rel_lqr``, ``ise_rel_bound``, ``score``); ``--markdown PATH``: the table and
+the score table; ``--plots DIR``: a figure per thesis case and the learning curves.
 """
 
 from __future__ import annotations
@@ -104,25 +99,28 @@ def load_agents(directory: str | Path = AGENTS_DIR, names=None, mesh: str = "con
 
 
 def reference_policies(mesh: str = "converged") -> dict:
-    """Passive, LQR, SMC and MPC (:func:`baselines.evaluate.default_policies`) and, where
-    the MPC's QP solver is installed, the MPC of the env's own reward
-    (:class:`baselines.policies.RewardMPCPolicy`, ``"mpc_reward"``: the nonlinear law built
-    for the objective the agents are trained on, at the env's default ``lam`` and
-    ``y_ref``), designed on the nominal ``mesh`` plant."""
+    """Passive, LQR, SMC, MPC (:func:`baselines.evaluate.default_policies`) and, with osqp,
+    the MPC of the env's reward (``"mpc_reward"``, :class:`baselines.policies.
+    RewardMPCPolicy`) on the nominal ``mesh`` plant; the engineer's designs and the plant
+    oracle (:func:`baselines.marks.marks_for`)."""
+    from acld_gym.envs.beam_env import ACLDBeamEnv
+    from baselines.marks import marks_for
     from baselines.policies import RewardMPCPolicy, mpc_available
 
     out = default_policies(mesh)
     if mpc_available():
         out[RewardMPCPolicy.name] = RewardMPCPolicy(mesh=mesh)
-    return out
+    return out | marks_for(ACLDBeamEnv(mesh=mesh))
 
 
 def training_labels(policies: dict) -> dict[str, str]:
-    """How each policy came about, for the tables: an agent's ``training`` ("from
-    scratch" or "DAgger from MPC + RL"); "designed" for the reference policies."""
-    out = {name: getattr(p, "training", "designed") for name, p in policies.items()}
-    out["bound"] = "clairvoyant"
-    return out
+    """How each policy came about: an agent's ``training``; "designed" for a reference,
+    "oracle" for the plant oracle (:mod:`baselines.oracle`), "clairvoyant" for the bound."""
+    kind = {True: "oracle", False: "designed"}
+    out = {
+        n: getattr(p, "training", kind[hasattr(p, "start_episode")]) for n, p in policies.items()
+    }
+    return out | {"bound": "clairvoyant"}
 
 
 def compare(
@@ -215,20 +213,23 @@ def markdown_scores(rows: list[dict]) -> str:
             seen.setdefault(d["policy"], d)
     if not seen:
         return ""
+    from baselines.analysis.score import SCORE_NAME
+
     first = next(iter(seen.values()))["score"]
     out = [
-        f"Score on `{first['test_set']}` ({first['n_episodes']} random loads): IQM of "
-        "(ISE_LQR - ISE) / (ISE_LQR - ISE_bound) per episode, 95 % bootstrap CI "
-        "(LQR 0, clairvoyant bound 1).",
+        f"{SCORE_NAME.capitalize()} on `{first['test_set']}` ({first['n_episodes']} random "
+        "loads): IQM of (ISE_passive - ISE) / (ISE_passive - ISE_bound) per episode, 95 % "
+        "bootstrap CI (passive 0, clairvoyant bound 1); mean ISE / the thesis LQR's.",
         "",
-        "| policy | trained | score (IQM) | 95 % CI |",
-        "|---|---|---|---|",
+        f"| policy | trained | {SCORE_NAME} (IQM) | 95 % CI | ISE / thesis LQR |",
+        "|---|---|---|---|---|",
     ]
     for name, d in seen.items():
         sc = d["score"]
+        rel = "-" if sc.get("ise_rel_thesis_lqr") is None else f"{sc['ise_rel_thesis_lqr']:.3f}"
         out.append(
             f"| {name} | {d.get('training', '')} | {sc['iqm']:.3f} "
-            f"| [{sc['ci_low']:.3f}, {sc['ci_high']:.3f}] |"
+            f"| [{sc['ci_low']:.3f}, {sc['ci_high']:.3f}] | {rel} |"
         )
     return "\n".join(out)
 

@@ -111,7 +111,7 @@ def test_benchmark_runs_end_to_end(tmp_path, capsys):
     assert f"| lqr (reference) | - | - | 1.000 | 1.000 | 1.000 | 1.000 | {refs['lqr']:.4f} |" in md
     # a repeat with --resume trains nothing
     assert main([*argv, "--resume"]) == 0
-    assert "0 runs (4 reused)" in capsys.readouterr().out
+    assert "0 runs to train (4 reused)" in capsys.readouterr().out
     # damaged files (issue 65): a truncated record and references file, an agent that no
     # longer loads: each said in one line and computed again, the others reused
     record, refs_file = out / "trials/tiny_vrs-s0.json", out / "references-ACLDBeam-v1.json"
@@ -124,7 +124,7 @@ def test_benchmark_runs_end_to_end(tmp_path, capsys):
     assert f"{record}: not valid JSON" in said and "training tiny_vrs seed 0 again" in said
     assert "tiny_ppo-s1: the agent does not load" in said and "tiny_ppo seed 1 again" in said
     assert f"{refs_file}: not valid JSON" in said and "computing the references again" in said
-    assert "2 runs (2 reused)" in said
+    assert "2 runs to train (2 reused)" in said
     assert json.loads(refs_file.read_text())["env_id"] == "ACLDBeam-v1"
     assert json.loads(record.read_text())["seed"] == 0
 

@@ -5,6 +5,7 @@
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 import time
 from pathlib import Path
@@ -17,7 +18,7 @@ from acld_gym.physics.loads import THESIS_CASES, thesis_load
 from acld_gym.physics.params import PRESETS
 from acld_gym.thesis.metrics import peak
 from acld_gym.thesis.reproduce import CONTROLLERS, T_END, format_table2, run_cases
-from acld_gym.util.atomic import check_directory, check_writable, write_json
+from acld_gym.util.atomic import check_directory, check_writable, write_files, write_json
 from acld_gym.util.progress import Progress
 from acld_gym.util.text import plain
 from acld_gym.util.validate import arg_type, run_main
@@ -44,12 +45,12 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     d = design(preset=args.preset)
     plots = Path(args.plots) if args.plots else None
+    files: dict[Path, bytes] = {}  # every output, written at the end all or none
     if plots is not None:
         from acld_gym.thesis.plots import plot_frequency_response, plot_hankel, plot_response
 
-        plots.mkdir(parents=True, exist_ok=True)
-        plot_hankel(plots / "hankel_singular_values.png", d)
-        plot_frequency_response(plots / "frequency_response.png", d)
+        plot_hankel(plots / "hankel_singular_values.png", d, files)
+        plot_frequency_response(plots / "frequency_response.png", d, files)
 
     def on_start(case, controller, saturation):
         bar.stage(f"case {case} · {controller} · {'saturated' if saturation else 'unsaturated'}")
@@ -68,6 +69,7 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
                 res.voltage,
                 title,
                 load=res.load,
+                out=files,
             )
 
     with Progress(2 * len(THESIS_CASES) * len(CONTROLLERS), "reproduce", args.quiet) as bar:
@@ -81,7 +83,9 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
         f"within {args.t_end:g} s)"
     )
     if args.json:
-        _write_json(args.json, [r.as_dict() for r in rows])
+        files[Path(args.json)] = (json.dumps([r.as_dict() for r in rows], indent=2) + "\n").encode()
+    write_files(files)
+    if args.json:
         print(f"wrote {args.json}")
     if plots is not None:
         print(f"wrote figures to {plots}/")

@@ -1,4 +1,6 @@
-"""Figures of the reproduction (thesis Figs. 5, 9-24 and 20)."""
+"""Figures of the reproduction (thesis Figs. 5, 9-24 and 20). Each function writes its
+figure to ``path`` atomically, or with ``out`` (a dict) puts its bytes in ``out[path]``
+for :func:`acld_gym.util.atomic.write_files` (a command's outputs all or none)."""
 
 from __future__ import annotations
 
@@ -18,7 +20,7 @@ from acld_gym.design.reduction import frequency_response  # noqa: E402
 __all__ = ["plot_response", "plot_hankel", "plot_frequency_response"]
 
 
-def plot_response(path: Path, t, y, v, title: str, load=None) -> None:
+def plot_response(path: Path, t, y, v, title: str, load=None, out: dict | None = None) -> None:
     """Tip deflection [mm] and voltage [V] vs time, as in thesis Figs. 9-24."""
     fig, ax = plt.subplots(2 if load is None else 3, 1, sharex=True, figsize=(7, 5.5))
     ax[0].plot(t, np.asarray(y) * 1e3, lw=0.9)
@@ -33,11 +35,11 @@ def plot_response(path: Path, t, y, v, title: str, load=None) -> None:
     for a in ax:
         a.grid(alpha=0.3)
     fig.tight_layout()
-    save_figure(fig, path, dpi=110)
+    save_figure(fig, path, out, dpi=110)
     plt.close(fig)
 
 
-def plot_hankel(path: Path, d: Design) -> None:
+def plot_hankel(path: Path, d: Design, out: dict | None = None) -> None:
     """Hankel singular values of the full model (thesis Fig. 5)."""
     hsv = d.reduced.hsv
     k = d.reduced.order
@@ -51,11 +53,11 @@ def plot_hankel(path: Path, d: Design) -> None:
     ax.grid(alpha=0.3, which="both")
     ax.legend()
     fig.tight_layout()
-    save_figure(fig, path, dpi=110)
+    save_figure(fig, path, out, dpi=110)
     plt.close(fig)
 
 
-def plot_frequency_response(path: Path, d: Design) -> None:
+def plot_frequency_response(path: Path, d: Design, out: dict | None = None) -> None:
     """Voltage and tip-load to tip deflection, full vs reduced (thesis Fig. 20)."""
     A, B, E, Cy = d.plant
     r = d.reduced
@@ -76,5 +78,5 @@ def plot_frequency_response(path: Path, d: Design) -> None:
     ax[-1].set_xlabel("frequency [rad/s]")
     ax[0].set_title("Frequency response to the tip deflection (thesis Fig. 20)")
     fig.tight_layout()
-    save_figure(fig, path, dpi=110)
+    save_figure(fig, path, out, dpi=110)
     plt.close(fig)

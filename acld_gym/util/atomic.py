@@ -4,8 +4,9 @@ Every result file of the package (JSON tables, figures, agents, cached plants) i
 written to a temporary file in the same directory and moved into place with
 ``os.replace`` (atomic on POSIX and Windows). A write that fails midway -- a full disk,
 ``ulimit -f`` -- leaves the previous file intact and no temporary behind.
-:func:`write_texts` writes several files all or none; :func:`replace_dir` replaces a whole
-folder (an agent) with one rename, so a reader sees the old folder or the new one.
+:func:`write_files` (:func:`write_texts`) writes several files all or none;
+:func:`replace_dir` replaces a whole folder (an agent) with one rename, so a reader sees
+the old folder or the new one.
 :func:`check_writable` lets a command refuse an unusable output path before it spends
 minutes computing.
 """
@@ -14,6 +15,7 @@ from __future__ import annotations
 
 import ctypes
 import ctypes.util
+import io
 import json
 import os
 import shutil
@@ -27,6 +29,7 @@ __all__ = [
     "write_text",
     "write_json",
     "write_texts",
+    "write_files",
     "replace_dir",
     "check_writable",
     "check_directory",
@@ -69,18 +72,23 @@ def write_json(path: str | Path, obj: Any) -> Path:
 
 
 def write_texts(texts: dict[str | Path, str]) -> list[Path]:
-    """Write several UTF-8 files all or none: every text goes to a temporary file beside its
-    target first (a full disk fails here, before any target changes), then each is moved into
-    place with ``os.replace``. Returns the paths written."""
+    """Write several UTF-8 files all or none (:func:`write_files`). Returns the paths written."""
+    return write_files({path: text.encode() for path, text in texts.items()})
+
+
+def write_files(files: dict[str | Path, bytes]) -> list[Path]:
+    """Write several files (their bytes) all or none: every file goes to a temporary file
+    beside its target first (a full disk fails here, before any target changes), then each
+    is moved into place with ``os.replace``. Returns the paths written."""
     staged: list[tuple[str, Path]] = []
     try:
-        for path, text in texts.items():
+        for path, data in files.items():
             path = Path(path)
             path.parent.mkdir(parents=True, exist_ok=True)
             fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
             staged.append((tmp, path))
             with os.fdopen(fd, "wb") as fh:
-                fh.write(text.encode())
+                fh.write(data)
                 fh.flush()
                 os.fsync(fh.fileno())
             umask = os.umask(0)
@@ -183,8 +191,15 @@ def check_directory(path: str | Path, what: str = "output directory") -> Path:
     return check_writable(path / "probe", what).parent
 
 
-def save_figure(fig, path: str | Path, **kwargs) -> Path:
-    """``fig.savefig`` to ``path`` atomically (the format from the file's suffix)."""
+def save_figure(fig, path: str | Path, out: dict | None = None, **kwargs) -> Path:
+    """``fig.savefig`` to ``path`` atomically (the format from the file's suffix); with
+    ``out``, the figure's bytes go to ``out[path]`` instead, for :func:`write_files` to
+    write with the command's other outputs, all or none."""
     path = Path(path)
     fmt = path.suffix.lstrip(".") or "png"
-    return write_atomic(path, lambda fh: fig.savefig(fh, format=fmt, **kwargs))
+    if out is None:
+        return write_atomic(path, lambda fh: fig.savefig(fh, format=fmt, **kwargs))
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format=fmt, **kwargs)
+    out[path] = buffer.getvalue()
+    return path

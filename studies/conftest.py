@@ -1,13 +1,24 @@
 """``pytest studies``: the research record's tests, outside the default run (``testpaths``
-is ``tests``). Plants built during them are cached in a temporary directory, as in
-``tests/conftest.py``, never in the user's ~/.cache."""
+is ``tests``). Plants built during them are cached in a temporary directory, never in the
+user's ~/.cache, removed when the session ends."""
 
 import os
+import shutil
 import tempfile
 
 import pytest
 
-os.environ.setdefault("ACLD_GYM_CACHE_DIR", tempfile.mkdtemp(prefix="acld-gym-test-cache-"))
+_CACHE = None
+if "ACLD_GYM_CACHE_DIR" not in os.environ:
+    _CACHE = tempfile.mkdtemp(prefix="acld-gym-test-cache-")
+    os.environ["ACLD_GYM_CACHE_DIR"] = _CACHE
+
+
+def pytest_sessionfinish(session, exitstatus):
+    """Remove the session's plant cache (if this file made it)."""
+    if _CACHE is not None:
+        shutil.rmtree(_CACHE, ignore_errors=True)
+
 
 #: Probe tests that no longer run on today's package, by ``module::test``: the probes give
 #: ``model.policy`` a policy class, which :class:`train.config.TrainConfig` refuses since

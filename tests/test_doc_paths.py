@@ -12,7 +12,7 @@ ROOT = Path(__file__).resolve().parent.parent
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md"))]
 #: Top-level directories of the repository whose paths the pages point at.
 _PATH = re.compile(
-    r"(?<![\w./-])((?:acld_gym|baselines|train|benchmarks|tests|docs|\.ci)"
+    r"(?<![\w./-])((?:acld_gym|baselines|train|benchmarks|studies|tests|docs|\.ci)"
     r"/[\w./*<>{},-]*[\w*>}])"
 )
 _PLACEHOLDER = re.compile(r"<[^>]*>|\{[^}]*\}|(?<=/)[A-Z][A-Z_]*(?=[./]|$)")

@@ -23,6 +23,7 @@ import numpy as np
 from acld_gym.design.nominal import SENSOR_NOISE_M
 from acld_gym.design.observer import MODEL_STD
 from acld_gym.envs.conflicts import LOAD_SUBSTEPS, check_config_keywords, check_consistent
+from acld_gym.envs.fixed import FixedSettings
 from acld_gym.envs.presets import check_env_id
 from acld_gym.envs.scale import REWARD_SCALES
 from acld_gym.envs.step import OBS_HIST
@@ -368,10 +369,11 @@ def config_table() -> str:
     return "\n".join(rows)
 
 
-class ConfigAttributes:
+class ConfigAttributes(FixedSettings):
     """The configuration's fields as read-only attributes of an env (``env.dt``,
     ``env.obs_mode``, ...; ``env.observer_kind`` is ``config.observer``), for code that
-    reads them from an env or through SB3's ``get_attr``."""
+    reads them from an env or through SB3's ``get_attr``; none assignable once the env is
+    built (:mod:`acld_gym.envs.fixed`)."""
 
     config: EnvConfig
 

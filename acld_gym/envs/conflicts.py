@@ -29,6 +29,7 @@ from __future__ import annotations
 import math
 import sys
 
+from acld_gym.envs.fixed import FixedSettings
 from acld_gym.envs.presets import PRESETS, check_env_id
 from acld_gym.envs.registration import make_limit, plain_spec
 from acld_gym.physics.loads import Harmonic, Samples, TipLoad, check_load_case
@@ -178,7 +179,10 @@ def made_spec(spec, config, steps: int):
             f"env_id={config.env_id!r} is not the id this env is made as, {spec.id!r}: "
             f"make {config.env_id!r} instead (or pass env_id={spec.id!r})"
         )
-    limit = make_limit(sys._getframe(2))  # this function <- the setter <- its caller
+    caller = sys._getframe(2)  # this function <- the setter <- its caller
+    while caller is not None and caller.f_code is FixedSettings.__setattr__.__code__:
+        caller = caller.f_back  # (the env's __setattr__, between the setter and gym.make)
+    limit = make_limit(caller)
     if limit is not None and limit != -1:
         check_limit(limit, steps)
     return plain_spec(spec, steps)

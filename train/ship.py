@@ -13,7 +13,6 @@ a full disk sees the old agent or the new one. An existing ``NAME`` is replaced 
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import sys
 from pathlib import Path
@@ -21,6 +20,7 @@ from pathlib import Path
 from acld_gym.physics.loads import THESIS_CASES
 from acld_gym.util.atomic import check_directory
 from acld_gym.util.text import plain, prog
+from acld_gym.util.validate import os_error_line
 
 from .agent import CURVE_FILE, TrainedAgent
 from .agent_files import check_replaceable, curve_rows
@@ -43,10 +43,9 @@ def best_seed(out: str | Path, config: str) -> int:
         raise FileNotFoundError(
             f"no benchmark results {str(path)!r} (the --out of python -m train.benchmark)"
         )
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (UnicodeDecodeError, ValueError, RecursionError) as exc:
-        raise ValueError(f"{str(path)!r}: not valid JSON ({str(exc)[:80]})") from None
+    from .bench.records import read_json
+
+    data = read_json(path)  # (a DataFileError, a ValueError, naming it; at most 64 MiB read)
     algos = data.get("algorithms") if isinstance(data, dict) else None
     if not isinstance(algos, dict):
         raise ValueError(f"{str(path)!r}: expected an object with 'algorithms'")
@@ -142,7 +141,9 @@ def main(argv: list[str] | None = None) -> int:
             run = agent_dir(run, args.best, seed)
             print(f"{args.best}: seed {seed} is best on cases 1-3")
         dst = ship(run, args.name, args.agents, force=args.force)
-    except (OSError, ValueError) as exc:
+    except OSError as exc:  # a full disk names the file: the agent folder is left as it was
+        p.error(str(exc) if exc.errno is None else os_error_line(exc))
+    except ValueError as exc:
         p.error(str(exc))
     print(f"shipped {dst}/")
     return 0

@@ -59,6 +59,20 @@ def test_bad_inputs_are_named(tmp_path):
     assert best_seed(tmp_path, "sac") == 1  # a well-formed file still reads
 
 
+@pytest.mark.parametrize(
+    "text, match",
+    [
+        ("[" * 100_000 + "]" * 100_000, "nested too deeply"),
+        ('{"algorithms": {', "not valid JSON"),
+        (" " * (64 * 2**20 + 1), "larger than"),  # not read whole
+    ],
+)
+def test_a_damaged_results_file_is_one_error_naming_it(tmp_path, text, match):
+    (tmp_path / "results.json").write_text(text)
+    with pytest.raises(ValueError, match=rf"{tmp_path / 'results.json'}: .*{match}"):
+        best_seed(tmp_path, "sac")
+
+
 def test_cli_ships_the_best_seed(tmp_path, capsys):
     out = _results(
         tmp_path / "bench",

@@ -118,8 +118,12 @@ class _Reader:
         not recorded), at least ``low``."""
         if isinstance(value, bool) or not isinstance(value, numbers.Real):
             self.fail(field, f"expected a number, got {_shown(value)}")
-        if not math.isfinite(value) and not (nan and math.isnan(value)):
-            self.fail(field, f"expected a finite number, got {value}")
+        try:
+            x = float(value)
+        except OverflowError:  # an integer beyond the float range
+            x = math.inf
+        if not math.isfinite(x) and not (nan and math.isnan(x)):
+            self.fail(field, f"expected a finite number, got {_shown(value)}")
         if low is not None and value < low:
             self.fail(field, f"expected a number >= {low:g}, got {value}")
         return value

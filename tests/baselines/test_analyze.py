@@ -103,6 +103,16 @@ def test_the_oracle_is_analyzed_as_a_dynamic_law_and_scored(tmp_path):
     assert rec["score"]["version"] == 2 and 0.5 < rec["score"]["iqm"] < 1.0
 
 
+@pytest.mark.parametrize("env_id", ["ACLDBeam-v1", "ACLDBeamLab-v1", "ACLDBeamHard-v1"])
+def test_references_stands_for_every_mark_of_the_level(env_id):
+    from baselines.analyze import ALL, resolve_policies
+
+    names = [name for _, name in resolve_policies(ALL, env_id)]
+    assert names == ["passive", "lqr", "smc", "mpc", "lqg", "mpc_rig", "mpc_oracle"]
+    with pytest.raises(ValueError, match="POLICY"):
+        resolve_policies("lqr2", env_id)
+
+
 def test_unwritable_json_fails_up_front(tmp_path, capsys):
     blocker = tmp_path / "file"
     blocker.write_text("x")

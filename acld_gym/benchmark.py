@@ -1,7 +1,8 @@
 r"""The benchmark's published test sets: the episodes a policy's score is computed on.
 
-A policy's score (:mod:`baselines.analysis.score`) is the interquartile mean over these
-episodes of :math:`(ISE_{LQR} - ISE) / (ISE_{LQR} - ISE_{bound})`. Each env id has its test
+A policy's score (:mod:`baselines.analysis.score`, score v2) is the interquartile mean over
+these episodes of :math:`(ISE_{passive} - ISE) / (ISE_{passive} - ISE_{bound})`: the passive
+beam 0, the clairvoyant bound 1 on every level. Each env id has its test
 set, versioned with it: the seeds below, reset as ``env.reset(seed=s)`` with
 ``load_case="random"``, draw the load (and, with ``param_noise``, the plant) and the
 sensor noise of each episode. A change of an env's random-load generator or of the seeds
@@ -14,7 +15,9 @@ The seeds are disjoint from every seed used to train or select the shipped polic
 * model selection: the thesis cases (seed 0), the held-out random loads
   ``train.bench.evaluate.HELDOUT_SEEDS`` = [100_000, 100_020) and the validation loads
   the recipes select their runs on, from ``train.bench.evaluate.VALIDATION_SEED0`` =
-  200_000 (256 at most).
+  200_000 (256 at most);
+* the engineer's designs (:mod:`baselines.engineer`): their filter noise models are chosen
+  offline on the training plants [3_000_000, 3_000_100).
 
 The block [500_000, 600_000) is reserved for test sets: training and model selection must
 not use it. Every registered id (:data:`acld_gym.envs.presets.PRESETS`) has its entry in

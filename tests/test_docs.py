@@ -39,7 +39,7 @@ def _rows(text: str, score: bool = False) -> list[list[str]]:
     rows = [
         line.split()
         for line in (scores if score else cases).splitlines()
-        if re.match(r"^\s+(passive|lqr|smc|mpc|bound)\s", line)
+        if re.match(r"^\s+(passive|lqr|smc|mpc|mpc_reward|lqg|mpc_rig|mpc_oracle|bound)\s", line)
     ]
     return [r[:-1] if len(r) == 9 else r for r in rows]  # (9 columns: a row with ms/step)
 
@@ -58,7 +58,7 @@ def _same_rows(printed: list[list[str]], page: list[list[str]]) -> list[str]:
     for a, b in zip(printed, page, strict=False):
         if a == b:
             continue
-        if a[0] != "mpc" or b[0] != "mpc" or len(a) != len(b):
+        if not a[0].startswith("mpc") or a[0] != b[0] or len(a) != len(b):
             bad.append(f"{a} != {b}")
             continue
         for x, y in zip(a[1:], b[1:], strict=True):

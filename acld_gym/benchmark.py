@@ -13,9 +13,8 @@ The seeds are disjoint from every seed used to train or select the shipped polic
 * training: SB3 runs seed sub-env i with ``seed + i`` (a few thousand at most); the random
   search (``train.bench.search``) draws its episode seeds from [1_000_000, 2**31);
 * model selection: the thesis cases (seed 0), the held-out random loads
-  ``train.bench.evaluate.HELDOUT_SEEDS`` = [100_000, 100_020) and the validation loads
-  the recipes select their runs on, from ``train.bench.evaluate.VALIDATION_SEED0`` =
-  200_000 (256 at most);
+  :data:`HELDOUT_SEEDS` = [100_000, 100_020) and the validation loads the recipes select
+  their runs on, from :data:`VALIDATION_SEED0` = 200_000 (256 at most);
 * the engineer's designs (:mod:`baselines.engineer`): their filter noise models are chosen
   offline on the training plants [3_000_000, 3_000_100).
 
@@ -32,10 +31,36 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["EvaluationSet", "TEST_SETS", "TEST_SEEDS", "RESERVED_SEEDS", "evaluation_set"]
+__all__ = [
+    "EvaluationSet",
+    "TEST_SETS",
+    "TEST_SEEDS",
+    "RESERVED_SEEDS",
+    "HELDOUT_SEEDS",
+    "VALIDATION_SEED0",
+    "validation_seeds",
+    "evaluation_set",
+]
 
 #: Seeds reserved for test sets (never for training or model selection).
 RESERVED_SEEDS = range(500_000, 600_000)
+
+#: Seeds of the held-out random-load episodes every policy's ISE relative to the thesis LQR
+#: is reported on (``python -m train.compare``, the benchmark's ``random`` column,
+#: :func:`train.scoring.score`), beside the thesis cases 1, 2, 3 with seed 0; disjoint from
+#: the validation loads and from :data:`RESERVED_SEEDS`. The same tuple as
+#: ``train.bench.evaluate.HELDOUT_SEEDS`` (kept there too).
+HELDOUT_SEEDS: tuple[int, ...] = tuple(range(100_000, 100_020))
+
+#: First seed of the validation loads (random loads the recipes select checkpoints and runs
+#: on): seeds from here on, disjoint from :data:`HELDOUT_SEEDS` and the test sets. The same
+#: value as ``train.bench.evaluate.VALIDATION_SEED0``.
+VALIDATION_SEED0 = 200_000
+
+
+def validation_seeds(n: int) -> tuple[int, ...]:
+    """The first ``n`` validation seeds (random loads), from :data:`VALIDATION_SEED0`."""
+    return tuple(range(VALIDATION_SEED0, VALIDATION_SEED0 + int(n)))
 
 
 @dataclass(frozen=True)

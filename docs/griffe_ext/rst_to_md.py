@@ -1,0 +1,216 @@
+"""Sphinx roles and numpydoc entry lines rewritten as Markdown, for the docs build only.
+
+The package's docstrings are reStructuredText (numpydoc, Sphinx roles): the command-line
+help strips the roles (:mod:`acld_gym.util.text`), and this module turns them into
+mkdocstrings autorefs when the site is built (:mod:`sphinx_roles` is the griffe extension).
+Nothing here imports the package: a resolver callable maps a role's target to an object's
+full path, or to None when the target is not an object of the site.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable
+
+Resolver = Callable[[str], "str | None"]
+
+#: ``:class:`x```, ``:py:func:`~a.b```, ``:math:`x^2``` (content: no backtick).
+ROLE = re.compile(r":(?:py:)?(?P<role>[a-z]+):`(?P<content>[^`]+)`")
+#: the roles that name a Python object
+OBJECT_ROLES = frozenset({"class", "func", "meth", "mod", "data", "attr", "obj", "exc", "const"})
+#: RST inline literal ``x``; the content holds no backtick
+LITERAL = re.compile(r"``(?P<content>[^`]+?)``")
+#: an explicit title, ``title <target>``
+TITLED = re.compile(r"^(?P<title>.*?)\s*<(?P<target>[^<>]+)>$")
+FENCE = re.compile(r"^\s*(```|~~~)")
+
+SECTIONS_WITH_TYPES = {
+    "parameters": "param",
+    "other parameters": "param",
+    "attributes": "param",
+    "returns": "return",
+    "yields": "return",
+    "receives": "return",
+}
+# Words a numpydoc type is made of; a "type" with several other words is a description.
+TYPE_WORDS = frozenset(
+    "of or and optional default none shape array array_like ndarray int float bool str complex "
+    "tuple list dict sequence callable iterable mapping path bytes object any dtype same length "
+    "instance subclass each per one two the a an in to keyword only positional".split()
+)
+_IDENT = re.compile(r"^\*{0,2}[A-Za-z_][A-Za-z0-9_]*$")
+
+
+def split_target(content: str) -> tuple[str, str, bool]:
+    """Return ``(display, target, linkable)`` of a role's content.
+
+    ``~a.b.c`` shows ``c``; ``title <a.b>`` shows the title; ``!a.b`` is not linked; a
+    trailing ``()`` stays in the display but not the target.
+    """
+    content = " ".join(content.split())
+    titled = TITLED.match(content)
+    if titled and titled["title"]:
+        display, target = titled["title"], titled["target"].replace(" ", "")
+    else:
+        display, target = None, content.replace(" ", "")
+    linkable = not target.startswith("!")
+    target = target.lstrip("!")
+    short = target.startswith("~")
+    target = target.lstrip("~")
+    if display is None:
+        display = target.rsplit(".", 1)[-1] if short else target
+    target = target.removesuffix("()")
+    return display, target, linkable
+
+
+def code(text: str) -> str:
+    """``text`` as a Markdown code span (longer fences when it holds backticks)."""
+    if "`" not in text:
+        return f"`{text}`"
+    return f"`` {text} ``"
+
+
+def role_markdown(role: str, content: str, resolve: Resolver) -> str:
+    """The Markdown for one role: an autoref when the target resolves, else code."""
+    if role == "math":
+        return code(content.strip())
+    if role not in OBJECT_ROLES:
+        return code(content.strip())
+    display, target, linkable = split_target(content)
+    path = resolve(target) if linkable and target else None
+    if path is None:
+        return code(display)
+    return f"[{code(display)}][{path}]"
+
+
+def role_plain(content: str) -> str:
+    """A role in a type position: the plain (short) name, for griffe to parse and link."""
+    display, target, _ = split_target(content)
+    return target if display == target else display
+
+
+def _inline(line: str, resolve: Resolver) -> str:
+    # Roles first (their backticks are single), then RST literals outside code spans.
+    out = ROLE.sub(lambda m: role_markdown(m["role"], m["content"], resolve), line)
+    return LITERAL.sub(lambda m: code(m["content"]), out)
+
+
+def _is_description(text: str) -> bool:
+    """True when a numpydoc 'type' reads as a sentence rather than a type."""
+    plain = ROLE.sub(lambda m: role_plain(m["content"]), text)
+    plain = LITERAL.sub(lambda m: m["content"], plain).strip()
+    if not plain:
+        return False
+    if plain.endswith(".") and not plain.endswith("..."):
+        return True
+    words = re.findall(r"[A-Za-z][A-Za-z_'-]*", re.sub(r"\([^)]*\)|\[[^\]]*\]", " ", plain))
+    prose = [w for w in words if w.islower() and len(w) > 1 and w not in TYPE_WORDS]
+    return len(prose) >= 2
+
+
+def _entry(line: str, kind: str, indent: str) -> list[str] | None:
+    """A ``names : text`` line whose text is a description, rewritten (else None)."""
+    body = line[len(indent) :]
+    if " : " not in body:
+        if kind == "return" and _is_description(body):
+            return [f"{indent}:", f"{indent}    {body.strip()}"]
+        return None
+    names, _, rest = body.partition(" : ")
+    if not _is_description(rest):
+        return None
+    names = names.strip()
+    single = all(_IDENT.match(n.strip()) for n in names.split(","))
+    if kind == "param" and single:
+        return [f"{indent}{names}", f"{indent}    {rest.strip()}"]
+    if kind == "return" and _IDENT.match(names):
+        return [f"{indent}{names} :", f"{indent}    {rest.strip()}"]
+    # several names in Returns, or names griffe cannot read: the names join the text
+    return [f"{indent}:", f"{indent}    {code(names)}: {rest.strip()}"]
+
+
+def _fix_types(line: str, kind: str) -> str:
+    """In a ``names : type`` line, roles become plain names and literals lose backticks."""
+    names, sep, rest = line.partition(" : ")
+    if not sep and kind == "return":  # a Returns line without a name is all type
+        names, sep, rest = "", "", line
+    rest = ROLE.sub(lambda m: role_plain(m["content"]), rest)
+    rest = LITERAL.sub(lambda m: m["content"], rest)
+    return names + sep + rest
+
+
+def rewrite(text: str, resolve: Resolver) -> str:
+    """A numpydoc docstring with its roles as autorefs or code, ready for mkdocstrings.
+
+    Fenced code blocks, doctest lines (``>>>``, ``...`` and their output) and RST literal
+    blocks (the indented lines after a line ending in ``::``) are left as they are.
+    Entries of the typed sections (Parameters, Returns, ...) whose "type" is a sentence
+    are rewritten so the sentence lands in the description.
+    """
+    lines = text.split("\n")
+    out: list[tuple[bool, str]] = []  # (prose, line)
+    fence: str | None = None
+    doctest = False
+    literal_indent: int | None = None
+    section: str | None = None
+    section_indent = ""
+    for i, line in enumerate(lines):
+        stripped = line.strip()
+        indent_len = len(line) - len(line.lstrip())
+        if fence is not None:
+            out.append((False, line))
+            if stripped.startswith(fence):
+                fence = None
+            continue
+        if (opened := FENCE.match(line)) is not None:
+            fence = opened[1]
+            out.append((False, line))
+            continue
+        if literal_indent is not None:
+            if not stripped or indent_len > literal_indent:
+                out.append((False, line))
+                continue
+            literal_indent = None
+        if stripped.startswith(">>>"):
+            doctest = True
+        elif not stripped:
+            doctest = False
+        if doctest:
+            out.append((False, line))
+            continue
+        # numpydoc section header: a title line underlined by dashes
+        nxt = lines[i + 1].strip() if i + 1 < len(lines) else ""
+        if stripped and nxt and set(nxt) == {"-"} and len(nxt) >= 3:
+            section = SECTIONS_WITH_TYPES.get(stripped.lower())
+            section_indent = line[:indent_len]
+        elif section and stripped and indent_len == len(section_indent) and set(stripped) != {"-"}:
+            fixed = _entry(line, section, section_indent)
+            if fixed is not None:
+                out.extend((True, f) for f in fixed)
+                continue
+            out.append((False, _fix_types(line, section)))
+            continue
+        if stripped.startswith(".. math::"):
+            # the display math directive: its expression as an indented code block
+            literal_indent = indent_len
+            expr = stripped.removeprefix(".. math::").strip()
+            out.append((False, ""))
+            if expr:
+                out.append((False, f"{line[:indent_len]}    {expr}"))
+            continue
+        if stripped.endswith("::") and not stripped.startswith(".."):
+            literal_indent = indent_len
+            line = line[: line.rstrip().rfind("::")] + (":" if stripped != "::" else "")
+        out.append((bool(stripped), line))
+    # roles and literals may run over a line break: convert each run of prose lines at once
+    result: list[str] = []
+    run: list[str] = []
+    for prose, line in [*out, (False, None)]:
+        if prose:
+            run.append(line)
+            continue
+        if run:
+            result.extend(_inline("\n".join(run), resolve).split("\n"))
+            run = []
+        if line is not None:
+            result.append(line)
+    return "\n".join(result)

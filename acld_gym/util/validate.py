@@ -176,10 +176,48 @@ def _os_error_file(exc: OSError):
 
 
 def os_error_line(exc: OSError) -> str:
-    """One line for a failed file operation: the file and the system's reason."""
+    """One line for a failed file operation: the file and the system's reason
+    (``standard output`` if the error names no file and stdout is a file that cannot grow:
+    the command's printed output under ``> file`` on a full disk)."""
     path = _os_error_file(exc)
+    if path is None and _stdout_full(exc):
+        path = "standard output"
     reason = exc.strerror or str(exc) or type(exc).__name__
     return f"{os.fspath(path)}: {reason}" if path is not None else reason
+
+
+def _stdout_full(exc: OSError) -> bool:
+    """Whether ``exc`` is a full disk or file-size limit that stdout, a regular file, has
+    reached (then stdout is pointed at the null device: the exit's flush adds no error)."""
+    import errno
+    import stat
+
+    try:
+        fd = sys.stdout.fileno()
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            return False
+        if exc.errno == errno.EFBIG:
+            import resource
+
+            soft = resource.getrlimit(resource.RLIMIT_FSIZE)[0]
+            full = soft != resource.RLIM_INFINITY and info.st_size >= soft
+        else:
+            full = exc.errno in (errno.ENOSPC, errno.EDQUOT) and os.fstatvfs(fd).f_bavail == 0
+    except (AttributeError, ValueError, OSError, ImportError):  # no stdout; not POSIX
+        return False
+    if full:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), fd)
+    return full
+
+
+def _flush_stdout() -> None:
+    """Flush what the command printed (a full disk under ``> file`` fails here, inside
+    :func:`run_main`'s handler, rather than at the exit)."""
+    try:
+        sys.stdout.flush()
+    except (AttributeError, ValueError):  # no stdout, or a closed one
+        pass
 
 
 def _prog(main) -> str:
@@ -205,7 +243,9 @@ def run_main(main, prog: str | None = None) -> int:
 
     with closed_pipe_is_fine(), one_blas_thread():
         try:
-            return main()
+            status = main()
+            _flush_stdout()  # (a full disk under "> file" fails here, not at the exit)
+            return status
         except BrokenPipeError:
             raise  # closed_pipe_is_fine's
         except OSError as exc:

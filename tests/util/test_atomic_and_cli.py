@@ -219,3 +219,33 @@ def test_arg_type_says_what_it_expected():
             arg_type(kind, 1)(text)
     with pytest.raises(argparse.ArgumentTypeError, match=r"expected an integer in \[1, 5\]"):
         arg_type(int, 1, 5)("6")
+
+
+@pytest.mark.parametrize("size", [10, 100_000])  # flushed at the end / written in main
+@pytest.mark.parametrize("unbuffered", ["", "1"])
+def test_a_full_disk_under_stdout_redirection_is_one_line_naming_it(tmp_path, size, unbuffered):
+    """``acld-gym params > file`` with no room: one line naming standard output, status 1
+    (was Python's two-line 'Exception ignored ... OSError' at exit, status 120, or a line
+    naming no file)."""
+    import os
+    import resource
+    import subprocess
+    import sys
+
+    def no_room():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (0, resource.RLIM_INFINITY))
+
+    code = "import sys; from acld_gym.util.validate import run_main; "
+    code += f"sys.exit(run_main(lambda: print('x' * {size}) or 0, 'cmd'))"
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONUNBUFFERED"}
+    with open(tmp_path / "out.md", "wb") as out:
+        run = subprocess.run(
+            [sys.executable, "-c", code],
+            stdout=out,
+            stderr=subprocess.PIPE,
+            text=True,
+            preexec_fn=no_room,
+            timeout=120,
+            env=env | ({"PYTHONUNBUFFERED": unbuffered} if unbuffered else {}),
+        )
+    assert (run.returncode, run.stderr) == (1, "cmd: error: standard output: File too large\n")

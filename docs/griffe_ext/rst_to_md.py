@@ -22,6 +22,14 @@ OBJECT_ROLES = frozenset({"class", "func", "meth", "mod", "data", "attr", "obj",
 LITERAL = re.compile(r"``(?P<content>[^`]+?)``")
 #: an explicit title, ``title <target>``
 TITLED = re.compile(r"^(?P<title>.*?)\s*<(?P<target>[^<>]+)>$")
+#: an RST literal (ends at ``\`\``` not followed by a backtick, so it may hold single
+#: backticks), a role, or a code span already in Markdown form
+INLINE = re.compile(
+    r"``(?P<lit>[^`\s](?:.*?[^\s])??)``(?!`)"
+    r"|:(?:py:)?(?P<role>[a-z]+):`(?P<content>[^`]+)`"
+    r"|`[^`]+`",
+    re.S,
+)
 FENCE = re.compile(r"^\s*(```|~~~)")
 
 SECTIONS_WITH_TYPES = {
@@ -90,9 +98,15 @@ def role_plain(content: str) -> str:
 
 
 def _inline(line: str, resolve: Resolver) -> str:
-    # Roles first (their backticks are single), then RST literals outside code spans.
-    out = ROLE.sub(lambda m: role_markdown(m["role"], m["content"], resolve), line)
-    return LITERAL.sub(lambda m: code(m["content"]), out)
+    # one left-to-right pass: a literal's content (which may hold a role) is never a role
+    def convert(match: re.Match) -> str:
+        if match["lit"] is not None:
+            return code(match["lit"])
+        if match["role"] is not None:
+            return role_markdown(match["role"], match["content"], resolve)
+        return match[0]
+
+    return INLINE.sub(convert, line)
 
 
 def _is_description(text: str) -> bool:

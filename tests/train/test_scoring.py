@@ -236,3 +236,49 @@ def test_seeds_in_one_public_place():
     test = {s for t in bench.TEST_SETS.values() for s in t.seeds}
     assert not held & valid and not held & test and not valid & test
     assert not (held | valid) & set(bench.RESERVED_SEEDS)
+
+
+def test_engineer_lqg_keeps_its_filter_state():
+    """The engineer's LQG (its Kalman filter and commands in flight are SB3's ``state``)
+    scores exactly as baselines.analysis.score scores it; without its state it is another
+    policy."""
+    from baselines.engineer import DelayLQGPolicy
+
+    lab = "ACLDBeamLab-v1"
+    lqg = DelayLQGPolicy.for_env(gym.make(lab))
+    got = score(lqg, lab, episodes=2)
+    want = score_policy(lqg, lab, n_episodes=2)
+    np.testing.assert_array_equal(got.score.ise, want.ise)
+    assert got.iqm == want.iqm and got.ise_rel_lqr["random"] < 1
+
+    class Forgetful:
+        observation_fingerprint = lqg.observation_fingerprint
+
+        def predict(self, obs, state=None, episode_start=None, deterministic=True):
+            return lqg.predict(obs, None, np.ones(1, dtype=bool), deterministic)[0], None
+
+    lost = score(Forgetful(), lab, episodes=2)
+    assert not np.allclose(lost.score.ise, got.score.ise, rtol=1e-3)
+
+
+def test_gymnasium_wrappers(ppo):
+    """Gymnasium's RescaleAction to [-1, 1] is UnitAction's map; a NormalizeObservation is
+    frozen while scoring (its statistics do not move)."""
+    from gymnasium.wrappers import NormalizeObservation, RescaleAction
+
+    model, venv = ppo
+    actor = export_sb3(model, venv)
+    unit = score(actor, V1, wrappers=[UnitAction], episodes=1)
+    one = np.float32(1)
+    rescale = score(actor, V1, wrappers=[lambda e: RescaleAction(e, -one, one)], episodes=1)
+    np.testing.assert_allclose(rescale.score.ise, unit.score.ise, rtol=1e-9)
+    built = []
+
+    def normalize(env):
+        built.append(NormalizeObservation(env))
+        built[-1].obs_rms.mean[:] = 1e-9  # "trained" statistics
+        return built[-1]
+
+    score(lambda obs: np.zeros(1), V1, wrappers=[normalize], episodes=1)
+    assert built and all(not w.update_running_mean for w in built)
+    assert all(np.all(w.obs_rms.mean == 1e-9) and w.obs_rms.count == 1e-4 for w in built)

@@ -249,6 +249,7 @@ def learning_curves_figure(agents: dict):
     from .agent_files import read_curve
     from .bench.evaluate import lqr_ise
     from .bench.report import ratio_log_axis
+    from .figures import sparse_ratio_labels
 
     curves = {}
     for name, agent in agents.items():  # read as the agent was: no link, rows checked
@@ -276,6 +277,7 @@ def learning_curves_figure(agents: dict):
         ax.axhline(1.0, color="k", ls="--", lw=1, label="LQR")
         ax.set_xscale("log")
         ratio_log_axis(ax)
+        sparse_ratio_labels(ax)  # 0.9 beside 1 overlapped
         ax.set_title(f"load case {case}")
         ax.set_xlabel("training env steps")
         ax.grid(alpha=0.3, which="both")

@@ -27,14 +27,19 @@ With one POLICY, ``--json`` writes its record; with several, a list of records, 
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 from pathlib import Path
 
 import acld_gym
 from acld_gym.benchmark import TEST_SETS
 from acld_gym.envs.presets import check_env_id
-from acld_gym.util.atomic import check_directory, check_writable, write_json, write_text
+from acld_gym.util.atomic import (
+    check_directory,
+    check_writable,
+    strict_json,
+    write_json,
+    write_text,
+)
 from acld_gym.util.text import plain, prog
 
 from .analysis.control import Analysis, analyze
@@ -79,17 +84,6 @@ def resolve_policy(spec: str, env_id: str, env_kwargs: dict | None = None):
     if spec == ALL:
         raise ValueError(f"POLICY: {ALL!r} stands for several policies")
     return resolve_policies(spec, env_id, env_kwargs)[0]
-
-
-def _finite(obj):
-    """The record with non-finite floats as None (strict JSON)."""
-    if isinstance(obj, dict):
-        return {k: _finite(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_finite(v) for v in obj]
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    return obj
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -158,7 +152,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"wrote {plot_compliance(result, Path(args.plots) / f'compliance_{name}.png')}")
         results.append(result)
     if args.json:
-        records = [_finite(r.as_dict()) for r in results]
+        records = [strict_json(r.as_dict()) for r in results]
         write_json(args.json, records[0] if len(records) == 1 else records)
         print(f"wrote {args.json}")
     if args.markdown:

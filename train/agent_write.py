@@ -7,13 +7,12 @@ check, made before anything is computed, that a folder may be replaced so
 from __future__ import annotations
 
 import json
-import math
 import os
 from pathlib import Path
 
 import numpy as np
 
-from acld_gym.util.atomic import replace_dir
+from acld_gym.util.atomic import replace_dir, strict_json
 
 from .agent_schema import parse_metadata
 
@@ -80,7 +79,7 @@ def write_folder(
     for name in texts:
         if name in ("policy.npz", "metadata.json") or Path(name).name != name:
             raise ValueError(f"{name!r} is not an extra file name of an agent folder")
-    meta_text = json.dumps(_finite(meta), indent=2, allow_nan=False) + "\n"
+    meta_text = json.dumps(strict_json(meta), indent=2, allow_nan=False) + "\n"
     parse_metadata(meta_text.encode(), str(path / "metadata.json"))  # write only what loads
 
     def fill(tmp: Path) -> None:
@@ -91,14 +90,3 @@ def write_folder(
             (tmp / name).write_text(text, encoding="utf-8")
 
     return replace_dir(path, fill)
-
-
-def _finite(obj):
-    """JSON data with non-finite floats as None (strict JSON, which the reader demands)."""
-    if isinstance(obj, dict):
-        return {k: _finite(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_finite(v) for v in obj]
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    return obj

@@ -17,6 +17,7 @@ import ctypes
 import ctypes.util
 import io
 import json
+import math
 import os
 import shutil
 import tempfile
@@ -28,6 +29,7 @@ __all__ = [
     "write_atomic",
     "write_text",
     "write_json",
+    "strict_json",
     "write_texts",
     "write_files",
     "replace_dir",
@@ -64,6 +66,18 @@ def write_atomic(path: str | Path, write: Callable[[IO[bytes]], Any]) -> Path:
 def write_text(path: str | Path, text: str) -> Path:
     """Write ``text`` (UTF-8) to ``path`` atomically."""
     return write_atomic(path, lambda fh: fh.write(text.encode()))
+
+
+def strict_json(obj: Any) -> Any:
+    """JSON data with every non-finite float as None (strict JSON: ``json.dumps(...,
+    allow_nan=False)`` accepts it and every reader parses it)."""
+    if isinstance(obj, dict):
+        return {k: strict_json(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [strict_json(v) for v in obj]
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    return obj
 
 
 def write_json(path: str | Path, obj: Any) -> Path:

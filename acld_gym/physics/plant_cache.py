@@ -17,16 +17,21 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
+import math
 import os
 import sys
+import zipfile
+import zlib
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
+from acld_gym.physics.elements import TERM_COEFFICIENTS
 from acld_gym.physics.params import BeamParameters
 from acld_gym.physics.plant import Plant
 from acld_gym.util.atomic import write_atomic
+from acld_gym.util.validate import DataFileError, check_real, file_error, os_error_line, shown
 
 __all__ = ["FORMAT", "key", "cached", "save", "load", "SHIPPED_DIR", "user_cache_dir"]
 
@@ -86,36 +91,148 @@ def save(plant: Plant, path: Path) -> None:
     write_atomic(path, lambda fh: np.savez(fh, **arrays))
 
 
+#: The largest plant file :func:`load` reads (its members' declared sizes, in bytes): a
+#: plant at 0.1 ms (86 states) takes about 1 MB.
+MAX_BYTES = 64 * 2**20
+#: The deepest nesting of the JSON ``meta`` member (a written one has 3).
+MAX_DEPTH = 8
+_VECTORS = ("piezo", "Fd", "c")
+_MATRICES = ("physical", "node_x", "node_w")
+
+
+def _depth(obj) -> int:
+    """The nesting depth of JSON data, without recursion."""
+    deepest, stack = 0, [(obj, 1)]
+    while stack:
+        item, d = stack.pop()
+        if isinstance(item, (list, dict)):
+            deepest = max(deepest, d)
+            if d > MAX_DEPTH:
+                return d
+            stack.extend((v, d + 1) for v in (item.values() if isinstance(item, dict) else item))
+    return deepest
+
+
+def _meta(raw: np.ndarray, path: Path) -> dict:
+    """The checked JSON of the ``meta`` member: ``name`` a string, ``provenance`` a mapping,
+    ``params`` every field of :class:`BeamParameters` as a finite number (and nothing else);
+    :class:`DataFileError` naming the field otherwise."""
+    if raw.dtype != np.uint8 or raw.ndim != 1:
+        raise file_error(path, "meta", f"expected bytes, got {raw.dtype} of shape {raw.shape}")
+    try:
+        meta = json.loads(raw.tobytes().decode("utf-8"))
+    except RecursionError:
+        raise file_error(path, "meta", "nested too deeply") from None
+    except (UnicodeDecodeError, ValueError) as exc:  # JSONDecodeError is a ValueError
+        raise file_error(path, "meta", f"not JSON ({shown(str(exc))})") from None
+    if _depth(meta) > MAX_DEPTH:
+        raise file_error(path, "meta", f"nested deeper than {MAX_DEPTH} levels")
+    if not isinstance(meta, dict):
+        raise file_error(path, "meta", f"expected a mapping, got {shown(meta)}")
+    for name, kind in (("name", str), ("provenance", dict), ("params", dict)):
+        if not isinstance(meta.get(name), kind):
+            raise file_error(path, f"meta.{name}", f"expected a {kind.__name__}")
+    fields = {f.name for f in dataclasses.fields(BeamParameters)}
+    if set(meta["params"]) != fields:
+        raise file_error(path, "meta.params", "not the fields of BeamParameters")
+    for name, value in meta["params"].items():
+        try:
+            check_real(name, value)
+        except ValueError as exc:
+            raise file_error(path, f"meta.params.{name}", str(exc)) from None
+    return meta
+
+
+def _array(z, name: str, shape: tuple, path: Path) -> np.ndarray:
+    """The finite float64 member ``name`` of ``shape`` (None: any extent there)."""
+    a = z[name]
+    if a.dtype != np.float64 or a.ndim != len(shape):
+        raise file_error(path, name, f"expected float64 of {len(shape)} dimensions")
+    if any(want is not None and got != want for got, want in zip(a.shape, shape, strict=True)):
+        raise file_error(path, name, f"expected shape {shape}, got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise file_error(path, name, "not finite")
+    return a
+
+
+def _members(path: Path) -> None:
+    """Refuse an archive whose members are not a plant's, whose declared sizes exceed
+    :data:`MAX_BYTES`, or whose array headers declare more data than the member holds,
+    before any array is read (an array's memory is taken from its header)."""
+    with zipfile.ZipFile(path) as archive:
+        infos = archive.infolist()
+        names = {i.filename.removesuffix(".npy") for i in infos}
+        want = {"meta", *_VECTORS, *_MATRICES} | {f"unit:{t}" for t in TERM_COEFFICIENTS}
+        if names != want or len(infos) != len(want):
+            raise file_error(path, None, f"members {sorted(names)[:4]}... are not a plant's")
+        if sum(i.file_size for i in infos) > MAX_BYTES:
+            raise file_error(path, None, f"larger than {MAX_BYTES} bytes: not a plant file")
+        for info in infos:
+            with archive.open(info) as fh:
+                fmt = np.lib.format
+                read = {(1, 0): fmt.read_array_header_1_0, (2, 0): fmt.read_array_header_2_0}
+                reader = read.get(fmt.read_magic(fh))
+                if reader is None:
+                    raise file_error(path, info.filename, "not a numpy array of version 1 or 2")
+                shape, _, dtype = reader(fh)
+            if dtype.hasobject or math.prod(shape) * dtype.itemsize > info.file_size:
+                name = info.filename.removesuffix(".npy")
+                raise file_error(path, name, "its header does not describe its data")
+
+
 def load(path: Path) -> Plant:
-    """Read a plant written by :func:`save` (plain arrays and JSON: nothing executes)."""
-    with np.load(path, allow_pickle=False) as z:
-        meta = json.loads(bytes(z["meta"]).decode())
-        units = {k.split(":", 1)[1]: z[k] for k in z.files if k.startswith("unit:")}
-        return Plant(
-            name=meta["name"],
-            params=BeamParameters(**meta["params"]),
-            units=units,
-            piezo=z["piezo"],
-            Fd=z["Fd"],
-            c=z["c"],
-            physical=z["physical"],
-            node_x=z["node_x"],
-            node_w=z["node_w"],
-            provenance=meta["provenance"],
-        )
+    """Read a plant written by :func:`save` (plain arrays and JSON: nothing executes).
+
+    Every member is checked before use -- the archive's member names and sizes, each
+    array's dtype, shape (r coordinates, from ``Fd``) and finiteness, the JSON ``meta``'s
+    fields -- and a damaged or foreign file is a :class:`DataFileError` naming the file and
+    the member; a missing or unreadable file is the ``OSError`` of reading it."""
+    try:
+        _members(path)
+        with np.load(path, allow_pickle=False) as z:
+            meta = _meta(z["meta"], path)
+            r = _array(z, "Fd", (None,), path).shape[0]
+            if r < 1:
+                raise file_error(path, "Fd", "no coordinates")
+            arrays = {name: _array(z, name, (r,), path) for name in _VECTORS}
+            arrays["physical"] = _array(z, "physical", (None, r), path)
+            arrays["node_x"] = _array(z, "node_x", (None,), path)
+            arrays["node_w"] = _array(z, "node_w", (arrays["node_x"].size, r), path)
+            units = {t: _array(z, f"unit:{t}", (r, r), path) for t in TERM_COEFFICIENTS}
+    except DataFileError:
+        raise
+    except (ValueError, KeyError, EOFError, RuntimeError, zipfile.BadZipFile, zlib.error) as exc:
+        # (RuntimeError, NotImplementedError: an encrypted member, an unknown compression)
+        raise file_error(path, None, f"not a plant file ({shown(str(exc))})") from None
+    try:
+        params = BeamParameters(**meta["params"])
+    except ValueError as exc:
+        raise file_error(path, "meta.params", str(exc)) from None
+    return Plant(
+        name=meta["name"],
+        params=params,
+        units=units,
+        provenance=meta["provenance"],
+        **arrays,
+    )
 
 
 def cached(params: BeamParameters, dt: float, refinement: int, build: Callable[[], Plant]) -> Plant:
     """The plant for these inputs: the shipped file, else the user cache, else ``build()``
-    (then written to the user cache when possible)."""
+        (then written to the user cache when possible). A damaged or foreign file (:func:`load`)
+    is rebuilt, said in one line on stderr."""
     name = _filename(key(params, dt, refinement))
     for directory in (SHIPPED_DIR, user_cache_dir()):
         path = directory / name
         if path.is_file():
             try:
-                return load(path)
-            except (OSError, ValueError, KeyError) as exc:  # a damaged file: rebuild
-                print(f"acld_gym: ignoring unreadable plant file {path}: {exc}", file=sys.stderr)
+                found = load(path)
+                if found.params != params:
+                    raise file_error(path, "meta.params", "not the parameters of its key")
+                return found
+            except (OSError, DataFileError) as exc:  # a damaged file: rebuilt (one line)
+                why = os_error_line(exc) if isinstance(exc, OSError) else str(exc)
+                print(f"acld_gym: rebuilding the plant ({why})", file=sys.stderr)
     plant = build()
     try:
         save(plant, user_cache_dir() / name)

@@ -106,13 +106,13 @@ def test_cache_key_follows_every_parameter(tmp_path, monkeypatch):
     # A built plant goes to the user cache atomically and is read back from it.
     monkeypatch.setenv("ACLD_GYM_CACHE_DIR", str(tmp_path))
     calls = []
-    p = plant("thesis")
+    params = dataclasses.replace(BeamParameters(), ghm_zeta=4.5)
+    p = dataclasses.replace(plant("thesis"), params=params)  # a file holds its key's params
 
     def build():
         calls.append(1)
         return p
 
-    params = dataclasses.replace(BeamParameters(), ghm_zeta=4.5)
     got = plant_cache.cached(params, 1e-3, 128, build)
     again = plant_cache.cached(params, 1e-3, 128, build)
     assert calls == [1] and got is p and again.n_states == p.n_states

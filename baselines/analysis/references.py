@@ -116,6 +116,60 @@ def cache_path(test: EvaluationSet, key: str) -> Path:
     return user_cache_dir() / f"references-{safe}-{len(test.seeds)}-{key}.json"
 
 
+#: The largest references file read (100 episodes take ~7 kB).
+MAX_BYTES = 16 * 2**20
+
+
+def _numbers(value, n: int) -> np.ndarray | None:
+    """``value`` as a float array if it is a list of ``n`` JSON numbers (not bools), each
+    finite and positive; else None."""
+    if not isinstance(value, list) or len(value) != n:
+        return None
+    if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
+        return None
+    try:
+        a = np.array(value, dtype=float)
+    except OverflowError:  # an integer beyond the float range
+        return None
+    return a if np.all(np.isfinite(a)) and np.all(a > 0) else None
+
+
+def _damage(path: Path, test: EvaluationSet, key: str) -> list[np.ndarray] | str:
+    """The file's three ISE arrays (:data:`KINDS`) if it is a record of ``test`` and
+    ``key`` of the checked form, else why not: a structural check of every field the
+    module reads, total on any bytes (size, encoding, nesting, types, lengths)."""
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read(MAX_BYTES + 1)
+    except OSError as exc:
+        return f"unreadable: {exc.strerror or exc}"
+    if len(data) > MAX_BYTES:
+        return f"larger than {MAX_BYTES} bytes"
+    try:
+        rec = json.loads(data.decode("utf-8"))
+    except RecursionError:
+        return "not JSON (nested too deeply)"
+    except (UnicodeDecodeError, ValueError) as exc:  # JSONDecodeError is a ValueError
+        return f"not JSON ({str(exc)[:60]})"
+    if not isinstance(rec, dict):
+        return "not a mapping"
+    fmt, k = rec.get("format"), rec.get("key")
+    if type(fmt) is not int or fmt != FORMAT or not isinstance(k, str) or k != key:
+        return f"another format (score v2's references need format {FORMAT}) or key"
+    seeds = rec.get("seeds")
+    if (
+        not isinstance(seeds, list)
+        or not all(type(s) is int for s in seeds)
+        or seeds != list(test.seeds)
+    ):
+        return "other seeds"
+    arrays = [_numbers(rec.get(kind), len(test.seeds)) for kind in KINDS]
+    for kind, a in zip(KINDS, arrays, strict=True):
+        if a is None:
+            return f"{kind}: expected {len(test.seeds)} finite positive numbers"
+    return arrays
+
+
 def _validated(path: Path, test: EvaluationSet, key: str, env) -> References | None:
     """The file's references if every check of the module docstring passes, else None
     (with the reason on stderr)."""
@@ -125,29 +179,11 @@ def _validated(path: Path, test: EvaluationSet, key: str, env) -> References | N
             f"baselines: recomputing the references of {test.name} ({path}: {why})", file=sys.stderr
         )
 
-    try:
-        rec = json.loads(path.read_text())
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        reject(f"unreadable: {exc}")
+    why = _damage(path, test, key)
+    if isinstance(why, str):
+        reject(why)
         return None
-    if not isinstance(rec, dict) or rec.get("format") != FORMAT or rec.get("key") != key:
-        reject(f"another format (score v2's references need format {FORMAT}) or key")
-        return None
-    if rec.get("seeds") != list(test.seeds):
-        reject("other seeds")
-        return None
-    try:
-        arrays = [np.asarray(rec[kind], dtype=float) for kind in KINDS]
-    except (KeyError, TypeError, ValueError):
-        reject("no ISE arrays")
-        return None
-    n = len(test.seeds)
-    if any(a.shape != (n,) for a in arrays):
-        reject("wrong lengths")
-        return None
-    if not all(np.all(np.isfinite(a)) and np.all(a > 0) for a in arrays):
-        reject("non-finite or non-positive ISE")
-        return None
+    arrays = why
     passive, lqr, bound = arrays
     if np.any(bound > np.minimum(lqr, passive) * (1 + 1e-9)):
         reject("a bound above the passive beam or LQR")

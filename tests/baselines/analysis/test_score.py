@@ -2,6 +2,7 @@
 references."""
 
 import json
+from types import SimpleNamespace
 
 import gymnasium as gym
 import numpy as np
@@ -165,7 +166,15 @@ def test_a_cached_file_is_reused_after_one_spot_check(counted, tmp_path):
 
 @pytest.mark.parametrize(
     "damage",
-    ["not json", "bound above lqr", "stale first episode", "other seeds", "format 1"],
+    [
+        "not json",
+        "bound above lqr",
+        "stale first episode",
+        "other seeds",
+        "format 1",
+        "nested 50000 deep",  # was a RecursionError
+        "ISE as strings",  # numpy would have parsed them
+    ],
 )
 def test_a_damaged_or_stale_file_is_recomputed(counted, tmp_path, damage, capsys):
     test = TEST.first(3)
@@ -174,11 +183,15 @@ def test_a_damaged_or_stale_file_is_recomputed(counted, tmp_path, damage, capsys
     rec = json.loads(path.read_text())
     if damage == "not json":
         path.write_text("{")
+    elif damage == "nested 50000 deep":
+        path.write_text("[" * 50000 + "]" * 50000)
     else:
         if damage == "bound above lqr":
             rec["bound_ise"][1] = 2 * rec["lqr_ise"][1]
         elif damage == "stale first episode":
             rec["lqr_ise"][0] *= 1.001
+        elif damage == "ISE as strings":
+            rec["lqr_ise"] = [str(v) for v in rec["lqr_ise"]]
         elif damage == "format 1":  # score v1's cache: no passive ISE
             del rec["passive_ise"]
             rec["format"] = 1
@@ -202,3 +215,43 @@ def test_other_env_arguments_have_their_own_file(counted, tmp_path):
     references(test)
     references(test, {"param_noise": 0.05})
     assert len(list(tmp_path.glob("references-*.json"))) == 2
+
+
+_RECORD = {"format": FORMAT, "key": "k", "seeds": [5, 6], "passive_ise": [3.0, 4.0]} | {
+    "lqr_ise": [2.0, 3.0],
+    "bound_ise": [1.0, 1.5],
+}
+_JSON = st.recursive(
+    st.none() | st.booleans() | st.integers() | st.floats() | st.text(max_size=5),
+    lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=8), inner),
+    max_leaves=8,
+)
+
+
+@settings(max_examples=150, deadline=None)
+@given(
+    drop=st.sampled_from([None, *_RECORD]),
+    field=st.sampled_from(list(_RECORD)),
+    value=_JSON,
+    cut=st.integers(0, 400),
+)
+def test_the_cache_check_is_total_on_mutated_records(tmp_path_factory, drop, field, value, cut):
+    # deletion, type change and truncation of a record: the check says why or returns the
+    # three arrays of the checked form, never another exception
+    from baselines.analysis.references import _damage
+
+    test = SimpleNamespace(seeds=(5, 6))
+    rec = dict(_RECORD)
+    if drop is not None:
+        rec.pop(drop)
+    rec[field] = value
+    text = json.dumps(rec)
+    if cut % 4 == 0:
+        text = text[: cut % (len(text) + 1)]
+    path = tmp_path_factory.mktemp("refs") / "r.json"
+    path.write_text(text)
+    got = _damage(path, test, "k")
+    if isinstance(got, str):
+        return
+    assert len(got) == 3 and all(a.shape == (2,) and np.all(a > 0) for a in got)
+    assert all(np.all(np.isfinite(a)) for a in got)

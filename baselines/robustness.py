@@ -32,10 +32,15 @@ import numpy as np
 from acld_gym.design.discrete import SampledSystem, discretize
 from acld_gym.design.nominal import NominalDesign, nominal_design
 from acld_gym.design.observer import DiscreteObserver
-from acld_gym.envs.config import PARAM_NOISE_MAX
+from acld_gym.envs.config import PARAM_NOISE_MAX, EnvConfig
 from acld_gym.physics.truth import MESHES
 from acld_gym.physics.uncertainty import PARAM_NOISE_CLIP, RANDOMIZED
 from acld_gym.util.text import plain, prog
+from acld_gym.util.validate import arg_type, check_real
+
+#: The largest ``--param-noise``: the range of the env's ``param_noise_max``
+#: (:class:`acld_gym.envs.config.EnvConfig`), within which every corner is a physical beam.
+PARAM_NOISE_LIMIT = EnvConfig.__dataclass_fields__["param_noise_max"].metadata["high"]
 
 __all__ = ["closed_loop_matrix", "spectral_radius", "corner_plants", "corner_study", "main"]
 
@@ -78,6 +83,7 @@ def spectral_radius(
 def corner_plants(nom: NominalDesign, param_noise: float):
     """The sampled plants at the corners of the parameter box: each of
     :data:`acld_gym.physics.uncertainty.RANDOMIZED` times :math:`e^{\\pm 3\\sigma}` (generator)."""
+    param_noise = check_real("param_noise", param_noise, 0.0, PARAM_NOISE_LIMIT)
     truth = nom.truth
     f = float(np.exp(PARAM_NOISE_CLIP * param_noise))
     for signs in itertools.product((-1, 1), repeat=len(RANDOMIZED)):
@@ -95,6 +101,7 @@ def corner_plants(nom: NominalDesign, param_noise: float):
 def corner_study(nom: NominalDesign, policies: dict, param_noise: float) -> dict[str, dict]:
     """Per policy: ``{"nominal": radius, "worst": radius, "unstable": count, "corners": n}``
     over the corners of the box of ``param_noise`` (:func:`corner_plants`)."""
+    check_real("param_noise", param_noise, 0.0, PARAM_NOISE_LIMIT)  # before any work
     gains = {name: pol.small_signal_gain() for name, pol in policies.items()}
     out = {
         name: {
@@ -126,9 +133,13 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--mesh", choices=MESHES, nargs="+", default=list(MESHES))
     p.add_argument(
         "--param-noise",
-        type=float,
+        type=arg_type(float, 0.0, PARAM_NOISE_LIMIT),
         default=None,
-        help="box half-width in std (default: the env's bound for the mesh)",
+        help=(
+            "relative std of the parameters, the box being +/-3 std (0 to "
+            f"{PARAM_NOISE_LIMIT:g}, the env's param_noise_max range; default: the env's "
+            "bound for the mesh)"
+        ),
     )
     args = p.parse_args(argv)
     print("| mesh | param_noise | policy | nominal | worst corner | unstable corners |")

@@ -21,7 +21,7 @@ from acld_gym.design.observer import discrete_kalman
 from acld_gym.envs.config import PARAM_NOISE_MAX
 from acld_gym.physics.uncertainty import RANDOMIZED
 from baselines.policies import LQRPolicy, MPCPolicy, SMCPolicy
-from baselines.robustness import corner_study, spectral_radius
+from baselines.robustness import corner_plants, corner_study, main, spectral_radius
 
 
 def _plant(nom, **factors):
@@ -82,6 +82,29 @@ def test_cheap_control_mpc_is_not_robust():
     cheap = MPCPolicy(nom=nom, state_weight=0.0).small_signal_gain()
     assert spectral_radius(plant, nom, cheap) > 1.0
     assert spectral_radius(plant, nom, MPCPolicy(nom=nom).small_signal_gain()) < 1.0
+
+
+@pytest.mark.parametrize("value", ["-1", "inf", "1e6", "nan", "1.5", "x"])
+def test_a_bad_param_noise_is_refused_at_parse_time(value, capsys, monkeypatch):
+    # was: -1 printed a table with -1; inf and 1e6 a BeamParameters traceback
+    import baselines.robustness as rob
+
+    monkeypatch.setattr(rob, "corner_study", lambda *a: pytest.fail("computed"))
+    with pytest.raises(SystemExit) as e:
+        main(["--param-noise", value])
+    err = capsys.readouterr().err
+    last = err.strip().splitlines()[-1]  # argparse's usage, then one line
+    assert e.value.code == 2 and last.startswith("python -m baselines.robustness: error: ")
+    assert "argument --param-noise: expected" in last and "Traceback" not in err
+
+
+@pytest.mark.parametrize("value", [-0.1, float("inf"), 1e6, float("nan"), "0.1", True])
+def test_the_library_refuses_a_bad_param_noise_naming_it(value):
+    nom = nominal_design()
+    with pytest.raises(ValueError, match="param_noise"):
+        corner_study(nom, {}, value)
+    with pytest.raises(ValueError, match="param_noise"):
+        next(corner_plants(nom, value))
 
 
 @pytest.mark.slow

@@ -23,16 +23,11 @@ import sys
 from pathlib import Path
 
 from acld_gym.physics.truth import MESHES
-from acld_gym.util.atomic import (
-    check_directory,
-    check_writable,
-    save_figure,
-    write_json,
-    write_text,
-)
+from acld_gym.util.atomic import save_figure, write_json, write_text
 from acld_gym.util.progress import Progress
 from acld_gym.util.text import plain, prog
 from acld_gym.util.validate import arg_type
+from baselines.arguments import folder_name, input_directory, outputs, param_noise
 from baselines.evaluate import (
     EvalRow,
     add_score_episodes_argument,
@@ -356,12 +351,12 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    try:  # unusable output paths and a bad --score-episodes fail now, before any computing
-        for flag, path in (("--json", args.json), ("--markdown", args.markdown)):
-            if path:
-                check_writable(path, flag)
-        if args.plots:
-            check_directory(args.plots, "--plots")
+    try:  # every argument is checked now, before any computing
+        outputs({"--json": args.json, "--markdown": args.markdown}, {"--plots": args.plots})
+        input_directory(args.agents, "--agents")
+        for name in args.only:
+            folder_name(name, "--only")
+        param_noise(args.param_noise, args.mesh)
         check_score_episodes(args.score_episodes)
     except ValueError as exc:
         parser.error(str(exc))
@@ -370,6 +365,8 @@ def main(argv: list[str] | None = None) -> int:
         agents = load_agents(args.agents, names, mesh=args.mesh)
     except (OSError, ValueError) as exc:
         parser.error(str(exc))
+    if not agents:
+        parser.error(f"--agents: no agent trained on --mesh {args.mesh} in {args.agents!r}")
     policies = {**reference_policies(args.mesh), **agents}
     seeds = tuple(range(HELDOUT_SEEDS[0], HELDOUT_SEEDS[0] + args.random_episodes))
     episodes: dict = {}

@@ -44,6 +44,8 @@ from acld_gym.design.discrete import convolution_matrix, impulse_response
 from acld_gym.envs.step import OBS_HIST, Y_SCALE
 from acld_gym.physics.actuator import V_LIMIT
 
+from .qp import solution
+
 __all__ = ["PlantOracleMPC", "ClairvoyantReplay", "tip_measurement", "cost_to_go"]
 
 _Y_UNIT = 1e-3  # the QP's deflection unit [m]
@@ -255,9 +257,7 @@ class PlantOracleMPC:
             hi[self.horizon] += held / V_LIMIT
             self._prob.update(q=q, l=lo, u=hi)
         res = self._prob.solve(raise_error=False)
-        if res.info.status not in ("solved", "solved inaccurate"):
-            raise RuntimeError(f"mpc_oracle: OSQP returned status {res.info.status!r}")
-        command = float(np.clip(V_LIMIT * res.x[0], -V_LIMIT, V_LIMIT))
+        command = float(np.clip(V_LIMIT * solution(res, "mpc_oracle")[0], -V_LIMIT, V_LIMIT))
         if self._delay:
             reaching = float(self._inflight[0])
             self._inflight = np.append(self._inflight[1:], command)

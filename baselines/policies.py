@@ -29,6 +29,8 @@ from acld_gym.envs.config import EnvConfig
 from acld_gym.envs.fingerprint import design_fingerprint
 from acld_gym.physics.actuator import V_LIMIT
 
+from .qp import solution
+
 __all__ = [
     "PassivePolicy",
     "LQRPolicy",
@@ -316,9 +318,7 @@ class MPCPolicy(_Policy):
             prob = self._solver(i)
             prob.update(q=self._linear_term(x))
             res = prob.solve(raise_error=False)
-            if res.info.status not in ("solved", "solved inaccurate"):
-                raise RuntimeError(f"MPC: OSQP returned status {res.info.status!r}")
-            out[i] = V_LIMIT * float(res.x[0])
+            out[i] = V_LIMIT * float(solution(res, "MPC")[0])
         return out
 
 

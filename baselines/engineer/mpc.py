@@ -10,6 +10,7 @@ from acld_gym.design.feedback import THESIS_LQR_WEIGHT
 from acld_gym.physics.actuator import V_LIMIT
 from baselines.policies import MPCPolicy
 
+from ..qp import solution
 from .base import RigPolicy
 from .riccati import lqr
 
@@ -122,9 +123,7 @@ class _RateMPC(MPCPolicy):
                 hi = np.r_[np.ones(H), h + self.slew, self.slew * np.ones(H - 1)]
                 prob.update(q=self._linear_term(x[i]), l=lo, u=hi)
             res = prob.solve(raise_error=False)
-            if res.info.status not in ("solved", "solved inaccurate"):
-                raise RuntimeError(f"MPC: OSQP returned status {res.info.status!r}")
-            out[i] = V_LIMIT * float(res.x[0])
+            out[i] = V_LIMIT * float(solution(res, "MPC")[0])
         return out
 
 

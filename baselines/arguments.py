@@ -19,6 +19,8 @@ __all__ = [
     "horizon",
     "flag",
     "nominal",
+    "design",
+    "matching",
     "acld_env",
     "env_config",
     "model_std",
@@ -69,7 +71,7 @@ def nominal(owner: str, dt=None, nom=None, mesh=None):
     ``dt`` [s] (the env's range of control periods; default :data:`DEFAULT_DT`) and
     ``mesh`` (default ``"converged"``). With ``nom`` a ``dt`` or ``mesh`` that is not the
     design's is a conflict, refused naming both (it would be ignored)."""
-    from acld_gym.design.nominal import NominalDesign, nominal_design
+    from acld_gym.design.nominal import nominal_design
     from acld_gym.physics.truth import MESHES
     from acld_gym.util.validate import check_choice
 
@@ -80,11 +82,7 @@ def nominal(owner: str, dt=None, nom=None, mesh=None):
         check_choice("mesh", mesh, MESHES)
     if nom is None:
         return nominal_design(DEFAULT_DT if dt is None else dt, mesh=mesh or "converged")
-    if not isinstance(nom, NominalDesign):
-        raise ValueError(
-            f"nom must be a NominalDesign (acld_gym.design.nominal.nominal_design), "
-            f"got {type(nom).__name__}"
-        )
+    design(nom)
     if dt is not None and dt != nom.plant.dt:
         raise ValueError(
             f"{owner}: dt={dt!r} conflicts with nom, designed for dt={nom.plant.dt!r}: "
@@ -96,6 +94,28 @@ def nominal(owner: str, dt=None, nom=None, mesh=None):
             "give one of them"
         )
     return nom
+
+
+def design(nom, name: str = "nom"):
+    """``nom`` if it is a :class:`acld_gym.design.nominal.NominalDesign`."""
+    from acld_gym.design.nominal import NominalDesign
+
+    if not isinstance(nom, NominalDesign):
+        raise ValueError(
+            f"{name} must be a NominalDesign (acld_gym.design.nominal.nominal_design), "
+            f"got {type(nom).__name__}"
+        )
+    return nom
+
+
+def matching(owner: str, nom, config) -> None:
+    """Refuse a configuration (``config``) of another plant or control period than the
+    design ``nom``, naming both."""
+    if config.mesh != nom.mesh or config.dt != nom.plant.dt:
+        raise ValueError(
+            f"{owner}: config (mesh={config.mesh!r}, dt={config.dt!r}) conflicts with nom "
+            f"(mesh={nom.mesh!r}, dt={nom.plant.dt!r}): the design must be the config's"
+        )
 
 
 def acld_env(env, name: str = "env"):

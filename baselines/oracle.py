@@ -44,6 +44,7 @@ from acld_gym.design.discrete import convolution_matrix, impulse_response
 from acld_gym.envs.step import OBS_HIST, Y_SCALE
 from acld_gym.physics.actuator import V_LIMIT
 
+from . import arguments
 from .qp import solution
 
 __all__ = ["PlantOracleMPC", "ClairvoyantReplay", "tip_measurement", "cost_to_go"]
@@ -141,16 +142,9 @@ class PlantOracleMPC:
 
         if not mpc_available():
             raise ImportError(MPC_MISSING)
-        if isinstance(horizon, bool) or not isinstance(horizon, int) or horizon < 1:
-            raise ValueError(f"horizon must be a positive integer, got {horizon!r}")
-        if not rho > 0:
-            raise ValueError(f"rho must be positive, got {rho!r}")
-        if not load_std > 0:
-            raise ValueError(f"load_std must be positive [N], got {load_std!r}")
-        if load_tau is not None and not load_tau > 0:
-            raise ValueError(f"load_tau must be positive [s] or None, got {load_tau!r}")
-        self.horizon, self.rho, self.load_std = horizon, float(rho), float(load_std)
-        self.load_tau = None if load_tau is None else float(load_tau)
+        self.horizon, self.rho = arguments.horizon(horizon), arguments.positive("rho", rho)
+        self.load_std = arguments.positive("load_std", load_std, "N")
+        self.load_tau = None if load_tau is None else arguments.positive("load_tau", load_tau, "s")
         self._episode = None
 
     # --- at reset: the episode's plant ---------------------------------------------------

@@ -24,11 +24,12 @@ from acld_gym.design.feedback import (
     discrete_lqr_gain,
     passive,
 )
-from acld_gym.design.nominal import NominalDesign, nominal_design
+from acld_gym.design.nominal import NominalDesign
 from acld_gym.envs.config import EnvConfig
 from acld_gym.envs.fingerprint import design_fingerprint
 from acld_gym.physics.actuator import V_LIMIT
 
+from . import arguments
 from .qp import solution
 
 __all__ = [
@@ -45,20 +46,25 @@ __all__ = [
 
 
 class _Policy:
-    """Common ``predict`` plumbing: batch handling, estimate decoding, clipping."""
+    """Common ``predict`` plumbing: batch handling, estimate decoding, clipping. Built on
+    ``nom``, else on the nominal design of ``dt`` [s] (default 1 ms) and ``mesh`` (default
+    ``"converged"``); :func:`baselines.arguments.nominal` checks them (a conflict refused)."""
 
     name = "policy"
 
-    def __init__(self, dt: float = 1e-3, nom: NominalDesign | None = None, mesh: str = "converged"):
-        self.nom = nominal_design(dt, mesh=mesh) if nom is None else nom
+    def __init__(self, dt: float | None = None, nom=None, mesh: str | None = None):
+        self.nom = self._nominal(dt, nom, mesh)
         self.k = self.nom.design.reduced.order
+
+    def _nominal(self, dt, nom, mesh) -> NominalDesign:
+        return arguments.nominal(type(self).__name__, dt, nom, mesh)
 
     @classmethod
     def for_env(cls, env, **kwargs):
         """The policy designed on ``env``'s nominal model (any Gymnasium wrapper); for an env
         observed through ``obs_mode="measurement"`` wrapped in :class:`MeasurementFeedback`
         (it runs the env's nominal observer itself)."""
-        e = env.unwrapped
+        e = arguments.acld_env(env)
         policy = cls(nom=e.nom, **kwargs)
         if e.obs_mode == "measurement":
             return MeasurementFeedback(policy, e.nom.observer(e.observer_kind))
@@ -106,7 +112,7 @@ class PassivePolicy(_Policy):
 
     name = "passive"
 
-    def __init__(self, dt: float = 1e-3, nom=None, mesh: str = "converged"):
+    def __init__(self, dt: float | None = None, nom=None, mesh: str | None = None):
         super().__init__(dt, nom, mesh)
         self.law = passive(self.k)
 
@@ -118,8 +124,9 @@ class LQRPolicy(_Policy):
     name = "lqr"
 
     def __init__(
-        self, dt: float = 1e-3, weight: float = THESIS_LQR_WEIGHT, nom=None, mesh: str = "converged"
+        self, dt: float | None = None, weight: float = THESIS_LQR_WEIGHT, nom=None, mesh=None
     ):
+        weight = arguments.positive("weight", weight)
         super().__init__(dt, nom, mesh)
         self.law = self.nom.lqr_law(weight)
         self.K = self.law.a[None]
@@ -151,16 +158,16 @@ class SMCPolicy(_Policy):
 
     def __init__(
         self,
-        dt: float = 1e-3,
+        dt: float | None = None,
         weight: float = THESIS_SMC_WEIGHT,
         eta_factor: float = 1.5,
         eps: float = 1000.0,
         nom=None,
-        mesh: str = "converged",
+        mesh: str | None = None,
     ):
+        weight, eps = arguments.positive("weight", weight), arguments.positive("eps", eps, "V")
+        eta_factor = arguments.non_negative("eta_factor", eta_factor)
         super().__init__(dt, nom, mesh)
-        if not eps > 0:
-            raise ValueError(f"eps must be positive [V], got {eps!r}")
         sr = self.nom.reduced
         _, X = discrete_lqr_gain(sr.Ad, sr.Bd, self.nom.design.state_weight(weight), np.eye(1))
         B = sr.Bd[:, 0]
@@ -220,25 +227,21 @@ class MPCPolicy(_Policy):
 
     def __init__(
         self,
-        dt: float = 1e-3,
+        dt: float | None = None,
         horizon: int = 60,
         rho: float = 1e-4,
         state_weight: float = STATE_WEIGHT,
         nom=None,
-        mesh: str = "converged",
+        mesh: str | None = None,
     ):
+        horizon, rho = arguments.horizon(horizon), arguments.non_negative("rho", rho)
+        state_weight = arguments.non_negative("state_weight", state_weight)
         super().__init__(dt, nom, mesh)
         if not mpc_available():
             raise ImportError(MPC_MISSING)
         import osqp
         import scipy.sparse as sp
 
-        if not isinstance(horizon, int) or horizon < 1:
-            raise ValueError(f"horizon must be a positive integer, got {horizon!r}")
-        if not rho >= 0:
-            raise ValueError(f"rho must be non-negative, got {rho!r}")
-        if not state_weight >= 0:
-            raise ValueError(f"state_weight must be non-negative, got {state_weight!r}")
         sr, C = self.nom.reduced, self.nom.design.reduced.C
         A, B = sr.Ad, sr.Bd[:, 0]
         H, n = horizon, A.shape[0]
@@ -343,26 +346,23 @@ class RewardMPCPolicy(MPCPolicy):
 
     def __init__(
         self,
-        dt: float = 1e-3,
+        dt: float | None = None,
         horizon: int = 60,
         lam: float = EnvConfig.lam,
         y_ref: float = EnvConfig.y_ref,
         nom=None,
-        mesh: str = "converged",
+        mesh: str | None = None,
     ):
-        if not lam >= 0:
-            raise ValueError(f"lam must be non-negative, got {lam!r}")
-        if not y_ref > 0:
-            raise ValueError(f"y_ref must be a positive deflection [m], got {y_ref!r}")
-        self.lam, self.y_ref = float(lam), float(y_ref)
+        self.lam = arguments.non_negative("lam", lam)
+        self.y_ref = arguments.positive("y_ref", y_ref, "m")
         rho = self.lam * (self.y_ref / 1e-3) ** 2
         super().__init__(dt, horizon, rho=rho, state_weight=0.0, nom=nom, mesh=mesh)
 
     @classmethod
     def for_env(cls, env, **kwargs):
         """The policy for ``env``'s nominal model and reward (its ``lam`` and ``y_ref``)."""
-        e = env.unwrapped
-        return super().for_env(env, **({"lam": e.lam, "y_ref": e.y_ref} | kwargs))
+        e = arguments.acld_env(env)
+        return super().for_env(e, **({"lam": e.lam, "y_ref": e.y_ref} | kwargs))
 
 
 class MeasurementFeedback:

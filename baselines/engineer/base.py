@@ -37,6 +37,7 @@ from acld_gym.envs.fingerprint import design_fingerprint
 from acld_gym.envs.step import OBS_HIST, Y_SCALE
 from acld_gym.physics.actuator import V_LIMIT
 
+from .. import arguments
 from .model import RigModel, rig_model
 from .riccati import kalman_gain
 
@@ -70,16 +71,25 @@ class RigPolicy:
         load_std: float = 1.0,
         model: RigModel | None = None,
     ):
-        self.nom, self.config = nom, config
+        owner = type(self).__name__
+        self.nom, self.config = arguments.design(nom), arguments.env_config(config)
+        arguments.matching(owner, nom, config)
+        if model is not None and not isinstance(model, RigModel):
+            raise ValueError(f"model must be a RigModel or None, got {type(model).__name__}")
+        model_std = arguments.model_std(model_std)
+        self.load_std = arguments.positive("load_std", load_std, "N")
         #: The design model (:func:`~baselines.engineer.model.rig_model` of ``config``
         #: unless given: the designs are built on whatever coordinates it has).
         self.model: RigModel = rig_model(nom, config) if model is None else model
         self.obs_mode = config.obs_mode
         self._iy = measurement_index(nom, config.obs_mode)
-        ms = config.model_std if model_std is None else model_std
-        self.model_std = float(ms) if np.ndim(ms) == 0 else np.asarray(ms, dtype=float)
-        self.load_std = float(load_std)
+        self.model_std = config.model_std if model_std is None else model_std
         m = self.model
+        if np.ndim(self.model_std) and self.model_std.shape != (m.n_plant,):
+            raise ValueError(
+                f"model_std: expected one value or {m.n_plant} (one per state of the plant "
+                f"part), got {self.model_std.size}"
+            )
         self.M = kalman_gain(
             m.plant.Ad,
             m.c,
@@ -97,7 +107,7 @@ class RigPolicy:
         ``kwargs`` replace them)."""
         from .designs import design_kwargs
 
-        e = env.unwrapped
+        e = arguments.acld_env(env)
         return cls(e.nom, e.config, **(design_kwargs(e.nom, e.config) | kwargs))
 
     @property

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from baselines import arguments
 from baselines.policies import mpc_available
 
 from .lqg import DelayLQGPolicy
@@ -73,7 +74,8 @@ def engineer_policies(env) -> dict:
     """The engineer's references of ``env``'s level (any wrapper of an ``ACLDBeamEnv``),
     name -> policy with SB3's ``predict``: ``"lqg"`` (:class:`DelayLQGPolicy`) and, where
     the QP solver osqp is installed, ``"mpc_rig"`` (:class:`ActuatorMPCPolicy`), both with
-    the level's design (:data:`DESIGNS`)."""
+    the level's design (:data:`DESIGNS`). ``env`` may be one of this package's ids."""
+    env = arguments.acld_env(env)
     out = {"lqg": DelayLQGPolicy.for_env(env)}
     if mpc_available():
         out["mpc_rig"] = ActuatorMPCPolicy.for_env(env)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import arguments
 from .base import RigPolicy
 from .riccati import lqr_gain
 
@@ -61,10 +62,8 @@ class DelayLQGPolicy(RigPolicy):
         load_std: float = 1.0,
         model=None,
     ):
-        if not weight > 0:
-            raise ValueError(f"weight must be positive, got {weight!r}")
+        self.weight = arguments.positive("weight", weight)
         super().__init__(nom, config, model_std=model_std, load_std=load_std, model=model)
-        self.weight = float(weight)
         m = self.model
         A, b = m.augmented()
         Q, R, N = m.reward_weights(deflection=self.weight)

@@ -10,6 +10,7 @@ from acld_gym.design.feedback import THESIS_LQR_WEIGHT
 from acld_gym.physics.actuator import V_LIMIT
 from baselines.policies import MPCPolicy
 
+from .. import arguments
 from ..qp import solution
 from .base import RigPolicy
 from .riccati import lqr
@@ -50,6 +51,9 @@ class _RateMPC(MPCPolicy):
 
     slew = None  # per period, units of 120 V; None: the box alone
     terminal = None  # (Gamma_H, A^H, S): the tail's cost x_H^T S x_H (None: none)
+
+    def _nominal(self, dt, nom, mesh):
+        return nom  # the plant part (_PlantPart), built and checked by ActuatorMPCPolicy
 
     def set_terminal(self, S: np.ndarray, A: np.ndarray, b: np.ndarray) -> None:
         r"""Add the terminal cost :math:`x_{k+H}^T S x_{k+H}`, with
@@ -180,10 +184,10 @@ class ActuatorMPCPolicy(RigPolicy):
         load_std: float = 1.0,
         model=None,
     ):
-        if not weight > 0:
-            raise ValueError(f"weight must be positive, got {weight!r}")
+        horizon, self.weight = arguments.horizon(horizon), arguments.positive("weight", weight)
+        state_weight = arguments.non_negative("state_weight", state_weight)
+        terminal = arguments.flag("terminal", terminal)
         super().__init__(nom, config, model_std=model_std, load_std=load_std, model=model)
-        self.weight = float(weight)
         m = self.model
         k = nom.design.reduced.order
         W = np.zeros((m.n_plant, m.n_plant))
@@ -193,9 +197,7 @@ class ActuatorMPCPolicy(RigPolicy):
             reduced=m.plant, design=_Design(_Reduced(C=m.c[None, :], order=m.n_plant), W)
         )
         rho = m.lam * (m.y_ref / 1e-3) ** 2 / self.weight
-        self.mpc = _RateMPC(
-            m.plant.dt, horizon, rho=rho, state_weight=state_weight, nom=part, mesh=nom.mesh
-        )
+        self.mpc = _RateMPC(horizon=horizon, rho=rho, state_weight=state_weight, nom=part)
         self.mpc.slew = None if m.slew_step is None else m.slew_step / V_LIMIT
         self.horizon = horizon
         if terminal:

@@ -33,16 +33,11 @@ from pathlib import Path
 import acld_gym
 from acld_gym.benchmark import TEST_SETS
 from acld_gym.envs.presets import check_env_id
-from acld_gym.util.atomic import (
-    check_directory,
-    check_writable,
-    strict_json,
-    write_json,
-    write_text,
-)
+from acld_gym.util.atomic import strict_json, write_json, write_text
 from acld_gym.util.text import plain, prog
 
 from .analysis.control import Analysis, analyze
+from .arguments import outputs
 from .evaluate import add_score_episodes_argument, check_score_episodes
 
 __all__ = ["analyze", "Analysis", "BASELINES", "ALL", "resolve_policy", "resolve_policies", "main"]
@@ -118,11 +113,7 @@ def main(argv: list[str] | None = None) -> int:
         check_env_id(args.env_id, "--env-id")
         if args.env_id not in TEST_SETS:
             raise ValueError(f"--env-id: no published test set for {args.env_id!r}")
-        for flag, path in (("--json", args.json), ("--markdown", args.markdown)):
-            if path:
-                check_writable(path, flag)
-        if args.plots:
-            check_directory(args.plots, "--plots")
+        outputs({"--json": args.json, "--markdown": args.markdown}, {"--plots": args.plots})
         check_score_episodes(args.score_episodes, args.env_id)
         policies = [p for spec in args.policy for p in resolve_policies(spec, args.env_id)]
     except (OSError, ValueError) as exc:

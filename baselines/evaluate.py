@@ -339,9 +339,12 @@ def main(argv: list[str] | None = None) -> int:
         if args.plots:
             check_directory(args.plots, "--plots")
         check_score_episodes(args.score_episodes, args.env_id)
+        try:
+            config = preset(args.env_id, **({} if args.mesh is None else {"mesh": args.mesh}))
+        except ValueError as exc:  # a preset's settings made for another mesh
+            raise ValueError(f"--mesh {args.mesh}: {exc}") from None
     except ValueError as exc:
         p.error(str(exc))
-    config = preset(args.env_id, **({} if args.mesh is None else {"mesh": args.mesh}))
     probe = ACLDBeamEnv(config=config)  # build the design once before timing anything
     episodes: dict = {}
     policies = level_references(probe)

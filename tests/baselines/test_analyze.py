@@ -87,6 +87,7 @@ def test_the_library_takes_any_predict():
         (["lqr", "--score-episodes", "101"], "--score-episodes"),
         (["lqr", "--env-id", "ACLDBeam-v9"], "--env-id must be one of this package's ids"),
         (["lqr", "--env-id", "os:system"], "--env-id must be one of this package's ids"),
+        (["lqr", "--json", "o", "--markdown", "./o"], "--json and --markdown name the same"),
     ],
 )
 def test_bad_arguments_exit_2_before_computing(argv, word, capsys):

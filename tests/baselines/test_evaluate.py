@@ -66,6 +66,8 @@ def test_cli_writes_json_with_issue_keys(tmp_path, capsys):
         # an id is checked as data, never imported (issue 65)
         (["--env-id", "ACLDBeam-v9"], "--env-id must be one of this package's ids"),
         (["--env-id", "os:system"], "--env-id must be one of this package's ids"),
+        # a preset whose settings were made for another mesh (was a ValueError traceback)
+        (["--env-id", "ACLDBeam-v0", "--mesh", "converged"], "--mesh converged: mesh="),
     ],
 )
 def test_cli_bad_argument_exits_2(argv, word, capsys, monkeypatch):

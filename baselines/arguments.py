@@ -118,13 +118,13 @@ def matching(owner: str, nom, config) -> None:
         )
 
 
-def acld_env(env, name: str = "env"):
+def acld_env(env, name: str = "env", ids: bool = True):
     """The :class:`acld_gym.envs.beam_env.ACLDBeamEnv` under ``env`` (any Gymnasium
-    wrapper), or made from ``env`` if it is one of this package's ids
+    wrapper), or (``ids``) made from ``env`` if it is one of this package's ids
     (:func:`acld_gym.envs.presets.check_env_id`, checked as data before ``gym.make``)."""
     from acld_gym.envs.beam_env import ACLDBeamEnv
 
-    if isinstance(env, str):
+    if isinstance(env, str) and ids:
         import gymnasium as gym
 
         from acld_gym.envs.presets import check_env_id
@@ -132,10 +132,8 @@ def acld_env(env, name: str = "env"):
         return gym.make(check_env_id(env, name)).unwrapped
     inner = getattr(env, "unwrapped", None)
     if not isinstance(inner, ACLDBeamEnv):
-        raise ValueError(
-            f"{name} must be an ACLDBeam env (any wrapper) or one of this package's ids, "
-            f"got {shown(env)}"
-        )
+        ids_too = " or one of this package's ids" if ids else ""
+        raise ValueError(f"{name} must be an ACLDBeam env (any wrapper){ids_too}, got {shown(env)}")
     return inner
 
 

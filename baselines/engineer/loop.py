@@ -32,7 +32,9 @@ __all__ = ["closed_loop", "spectral_radius", "env_plant"]
 def env_plant(env) -> tuple[SampledSystem, np.ndarray]:
     """The current episode's sampled plant of ``env`` (any wrapper) and its tip row (the
     lag's state, if any, does not reach the tip)."""
-    e = env.unwrapped
+    from .. import arguments
+
+    e = arguments.acld_env(env, ids=False)  # an env in an episode
     plant = e.episode_plant
     c = np.zeros(plant.Ad.shape[0])
     c[: e.nom.output.size] = e.nom.output

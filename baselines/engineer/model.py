@@ -158,6 +158,9 @@ def shift_system(Ap: np.ndarray, bp: np.ndarray, d: int) -> tuple[np.ndarray, np
 def rig_model(nom: NominalDesign, config) -> RigModel:
     """The design model of ``config`` (:class:`acld_gym.envs.config.EnvConfig`) on the
     nominal design ``nom``: what the level's datasheet states, nothing of an episode."""
+    from .. import arguments
+
+    arguments.matching("rig_model", arguments.design(nom), arguments.env_config(config))
     r = nom.design.reduced
     if config.amplifier_bandwidth is None:
         plant, c, scale = nom.reduced, r.C[0], nom.xr_scale

@@ -21,6 +21,7 @@ import numpy as np
 
 from acld_gym.benchmark import RESERVED_SEEDS
 from acld_gym.util.stats import iqm
+from acld_gym.util.validate import check_int
 
 from .loop import env_plant, spectral_radius
 from .lqg import DelayLQGPolicy
@@ -72,9 +73,12 @@ def search(env, candidates, n_episodes: int = 40, n_plants: int = 100) -> list:
     ones first, best first: a list of ``(iqm, radius, design)``. ``env`` is the level's
     env with ``load_case="random"``; a design is a dict of :data:`~baselines.engineer.
     designs.DESIGNS`' form."""
+    from .. import arguments
     from .designs import design_kwargs
 
-    e = env.unwrapped
+    e = arguments.acld_env(env, ids=False)  # an env in an episode
+    n_episodes = check_int("n_episodes", n_episodes, 1, len(TRAINING_SEEDS))
+    n_plants = check_int("n_plants", n_plants, 1, len(TRAINING_SEEDS))
     seeds = list(TRAINING_SEEDS)[:n_episodes]
     pas, bnd = _anchors(env, seeds)
     plants = []

@@ -14,7 +14,14 @@ from hypothesis import strategies as st
 
 import acld_gym  # noqa: F401
 from acld_gym.design.nominal import nominal_design
-from baselines.engineer import ActuatorMPCPolicy, DelayLQGPolicy, engineer_policies
+from baselines.engineer import (
+    ActuatorMPCPolicy,
+    DelayLQGPolicy,
+    engineer_policies,
+    env_plant,
+    rig_model,
+)
+from baselines.engineer.tuning import search
 from baselines.oracle import PlantOracleMPC
 from baselines.policies import (
     LQRPolicy,
@@ -78,6 +85,9 @@ def _cases():
             "terminal must be True or False",
         ),
         "rig mpc horizon": (lambda: ActuatorMPCPolicy(e.nom, e.config, horizon=0), "horizon"),
+        "rig_model conflict": (lambda: rig_model(THESIS, e.config), "rig_model: config (mesh="),
+        "env_plant id": (lambda: env_plant("ACLDBeam-v1"), "env must be an ACLDBeam env (any"),
+        "search episodes": (lambda: search(e, [], n_episodes=0), "n_episodes must be an"),
     }
 
 

@@ -54,6 +54,11 @@ def _check_vrs(model: dict) -> None:
     RandomSearch(**model)
 
 
+#: Model keys that take one number only: never a schedule or a list (a list there reached the
+#: env's reward scale and failed as an env setting, naming none).
+_SCALAR_ONLY = frozenset({"gamma", "gae_lambda", "n_steps", "batch_size", "n_epochs", "tau"})
+
+
 def _check_sb3(cfg) -> None:
     from stable_baselines3.common.vec_env import VecNormalize
 
@@ -82,7 +87,7 @@ def _check_sb3(cfg) -> None:
             isinstance(default, bool)
             or default is None
             or key == "policy"
-            or isinstance(value, (dict, list, tuple))
+            or (isinstance(value, (dict, list, tuple)) and key not in _SCALAR_ONLY)
         ):  # a schedule, a train_freq
             continue
         if isinstance(default, (int, float)) and not isinstance(value, bool):

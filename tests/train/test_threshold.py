@@ -4,7 +4,9 @@ id; on ACLDBeam-v1 to the absolute costs the committed results were run with; a 
 is refused on another level than the one it was calibrated on."""
 
 import functools
+import json
 import math
+from pathlib import Path
 
 import pytest
 from hypothesis import given, settings
@@ -47,10 +49,14 @@ def test_a_recipes_threshold_resolves_between_the_best_reference_and_passive(nam
     assert math.isfinite(t) and min(costs["lqg"], costs["lqr"]) < t < costs["passive"], costs
 
 
-@pytest.mark.parametrize("name, committed", [("ppo", 0.520), ("sac", 0.540)])
-def test_on_v1_the_thresholds_are_the_absolute_ones_the_committed_results_ran_with(name, committed):
-    """acld-gym 0.18-0.19's ``restart_above: 0.520`` (PPO) and ``0.540`` (SAC), to well
+@pytest.mark.parametrize("name", ["ppo", "sac"])
+def test_on_v1_the_thresholds_are_the_absolute_ones_the_committed_results_ran_with(name):
+    """The absolute ``restart_above`` the committed v1 results ran with (acld-gym
+    0.18-0.19: 0.520 PPO, 0.540 SAC, read from ``train/benchmark/results-v1.json``), to well
     within the costs' round-off between machines (~3e-4): v1's results stay valid."""
+    results = Path(__file__).resolve().parents[2] / "train/benchmark/results-v1.json"
+    committed = json.loads(results.read_text())["algorithms"][name]["restart_above"]
+    assert isinstance(committed, float)
     cfg = load_config(name)
     loads = validation_seeds(cfg.select_config.episodes)
     got = RestartRule.parse(cfg.restart_above).resolve(ABSOLUTE_LEVEL, loads)

@@ -55,8 +55,10 @@ lint: $(STAMP)
 	$(BIN)/ruff format --check $(PYSRC)
 
 ## Lint + the test suite (slow tests excluded; see test-slow) + the documentation site.
+## pytest-xdist spreads the tests over the cores; the 15 slowest are listed at the end; the
+## session's temporary files go into one folder it removes (tests/conftest.py).
 test: lint
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n auto --durations=15
 	$(MAKE) docs
 
 ## The core install: the wheel (compiled step, shipped agents as package data) in a clean
@@ -77,7 +79,7 @@ docs: $(STAMP)
 	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict
 
 test-slow: $(STAMP)
-	$(BIN)/python -m pytest -q -m slow
+	$(BIN)/python -m pytest -q -n auto --durations=15 -m slow
 
 format: $(STAMP)
 	$(BIN)/ruff check --fix $(PYSRC)

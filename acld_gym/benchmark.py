@@ -48,13 +48,12 @@ RESERVED_SEEDS = range(500_000, 600_000)
 #: Seeds of the held-out random-load episodes every policy's ISE relative to the thesis LQR
 #: is reported on (``python -m train.compare``, the benchmark's ``random`` column,
 #: :func:`train.scoring.score`), beside the thesis cases 1, 2, 3 with seed 0; disjoint from
-#: the validation loads and from :data:`RESERVED_SEEDS`. The same tuple as
-#: ``train.bench.evaluate.HELDOUT_SEEDS`` (kept there too).
+#: the validation loads and from :data:`RESERVED_SEEDS`. (Also importable from
+#: ``train.bench.evaluate``.)
 HELDOUT_SEEDS: tuple[int, ...] = tuple(range(100_000, 100_020))
 
 #: First seed of the validation loads (random loads the recipes select checkpoints and runs
-#: on): seeds from here on, disjoint from :data:`HELDOUT_SEEDS` and the test sets. The same
-#: value as ``train.bench.evaluate.VALIDATION_SEED0``.
+#: on): seeds from here on, disjoint from :data:`HELDOUT_SEEDS` and the test sets.
 VALIDATION_SEED0 = 200_000
 
 

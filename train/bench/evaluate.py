@@ -27,6 +27,8 @@ import gymnasium as gym
 import numpy as np
 
 import acld_gym  # registers the env ids
+# The seed blocks' public home is acld_gym.benchmark; re-exported here for the training core.
+from acld_gym.benchmark import HELDOUT_SEEDS, VALIDATION_SEED0, validation_seeds  # noqa: F401
 from acld_gym.physics.loads import LOAD_CASES
 from acld_gym.util.atomic import write_text
 
@@ -57,12 +59,6 @@ DEFAULT_ENV_ID = acld_gym.ENV_ID
 CurveCallback = Callable[[int, Any], Mapping | None]
 #: Evaluation cases, in table order (every named load case).
 CASES: tuple = LOAD_CASES
-#: Seeds of the held-out random-load episodes every policy is reported on (``python -m
-#: train.compare``, the benchmark's ``random`` column); disjoint from the validation loads
-#: (:data:`VALIDATION_SEED0` on), from the published test sets
-#: (:data:`acld_gym.benchmark.RESERVED_SEEDS`) and from the random search's episode seeds
-#: (from 1_000_000); an SB3 run seeds sub-env i with its seed + i.
-HELDOUT_SEEDS = tuple(range(100_000, 100_020))
 
 
 def eval_episodes(random_episodes: int | None = None) -> dict:
@@ -140,21 +136,10 @@ def _side_by_side(policy, venvs: list, obs: list, value) -> tuple[list, list]:
     return np.split(total, sizes), np.split(steps, sizes)
 
 
-#: First random-load seed of the validation loads (checkpoint selection,
-#: :class:`train.config.SelectConfig`): seeds from here on, disjoint from the held-out test
-#: loads (:data:`HELDOUT_SEEDS`, 100000-100019).
-VALIDATION_SEED0 = 200_000
-
-
 #: Validation loads of the benchmark's per-seed objective figure (``validation_cost`` in a
 #: trial's record and the report): the 256 the recipes select their runs on
 #: (``select: {episodes: 256}`` in ``train/benchmark/ppo.yaml`` and ``sac.yaml``).
 OBJECTIVE_LOADS = 256
-
-
-def validation_seeds(n: int) -> tuple:
-    """The first ``n`` validation seeds (random loads), from :data:`VALIDATION_SEED0`."""
-    return tuple(range(VALIDATION_SEED0, VALIDATION_SEED0 + int(n)))
 
 
 def validation_cost(policy, env_id: str = DEFAULT_ENV_ID, seeds=None) -> float:

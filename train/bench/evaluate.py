@@ -27,8 +27,11 @@ import gymnasium as gym
 import numpy as np
 
 import acld_gym  # registers the env ids
-# The seed blocks' public home is acld_gym.benchmark; re-exported here for the training core.
-from acld_gym.benchmark import HELDOUT_SEEDS, VALIDATION_SEED0, validation_seeds  # noqa: F401
+from acld_gym.benchmark import (  # noqa: F401 (the seed blocks' home; re-exported)
+    HELDOUT_SEEDS,
+    VALIDATION_SEED0,
+    validation_seeds,
+)
 from acld_gym.physics.loads import LOAD_CASES
 from acld_gym.util.atomic import write_text
 

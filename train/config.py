@@ -461,12 +461,12 @@ def config_path(spec: str | Path) -> Path:
 
 def _read_yaml(path: Path) -> dict:
     """The mapping of one YAML file; :class:`DataFileError` naming the file and the place."""
-    from .config_checks import MAX_BYTES, check_size
+    from .config_checks import MAX_BYTES, UniqueKeyLoader, check_size
 
     try:
         if path.stat().st_size > MAX_BYTES:
             raise DataFileError(f"{path}: larger than {MAX_BYTES} bytes: not a config")
-        data = yaml.safe_load(path.read_text(encoding="utf-8")) or {}
+        data = yaml.load(path.read_text(encoding="utf-8"), Loader=UniqueKeyLoader) or {}  # noqa: S506 (a safe loader)
         check_size(data, path)
     except (yaml.YAMLError, UnicodeDecodeError, RecursionError) as exc:
         where = getattr(exc, "problem_mark", None)

@@ -14,6 +14,8 @@ import io
 import warnings
 from dataclasses import fields
 
+import yaml
+
 from acld_gym.util.validate import check_int, check_real
 
 __all__ = ["check_model", "check_buildable", "check_size", "MAX_VALUES", "MAX_BYTES"]
@@ -57,6 +59,29 @@ def _check_vrs(model: dict) -> None:
 #: Model keys that take one number only: never a schedule or a list (a list there reached the
 #: env's reward scale and failed as an env setting, naming none).
 _SCALAR_ONLY = frozenset({"gamma", "gae_lambda", "n_steps", "batch_size", "n_epochs", "tau"})
+
+
+class UniqueKeyLoader(yaml.SafeLoader):
+    """YAML's safe loader that refuses a key given twice in one mapping (plain YAML keeps the
+    last silently: ``timesteps: 1000`` then ``timesteps: 2000`` would train 2000)."""
+
+    def construct_mapping(self, node, deep=False):
+        if isinstance(node, yaml.MappingNode):
+            seen = set()
+            for key_node, _ in node.value:
+                if key_node.tag == "tag:yaml.org,2002:merge":  # '<<': merged keys may be replaced
+                    continue
+                key = self.construct_object(key_node, deep=deep)
+                try:
+                    duplicate = key in seen
+                    seen.add(key)
+                except TypeError:  # an unhashable key: the base class refuses it
+                    continue
+                if duplicate:
+                    raise yaml.constructor.ConstructorError(
+                        None, None, f"key {key!r} given twice", key_node.start_mark
+                    )
+        return super().construct_mapping(node, deep)
 
 
 def _check_sb3(cfg) -> None:

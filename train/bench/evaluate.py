@@ -19,6 +19,7 @@ Two evaluators:
 from __future__ import annotations
 
 import json
+import sys
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
@@ -34,6 +35,9 @@ from acld_gym.benchmark import (  # noqa: F401 (the seed blocks' home; re-export
 )
 from acld_gym.physics.loads import LOAD_CASES
 from acld_gym.util.atomic import write_text
+from acld_gym.util.validate import DataFileError
+
+from .records import check_references, read_json
 
 __all__ = [
     "CASES",
@@ -204,6 +208,19 @@ def lqr_ise(env_id: str = DEFAULT_ENV_ID, episodes: dict | None = None) -> dict:
     return rollout_ise(lqr, env_id, eval_episodes() if episodes is None else episodes)
 
 
+def _cached_references(cache, bound: bool) -> dict | None:
+    """The references cache file ``cache`` if it is whole (:func:`train.bench.records.
+    check_references`); None when there is none, and when it is damaged (said in one line:
+    it is computed again)."""
+    if cache is None or not Path(cache).is_file():
+        return None
+    try:
+        return check_references(read_json(cache), cache, bound)
+    except DataFileError as exc:
+        print(f"{exc}: computing the references again", file=sys.stderr)
+        return None
+
+
 def references(
     env_id: str = DEFAULT_ENV_ID,
     cache: str | Path | None = None,
@@ -224,8 +241,8 @@ def references(
 
     episodes = eval_episodes(random_episodes)
     key = {str(c): list(s) for c, s in episodes.items()}
-    if cache is not None and Path(cache).is_file():
-        data = json.loads(Path(cache).read_text())
+    data = _cached_references(cache, bound)
+    if data is not None:
         if (
             data.get("env_id") == env_id
             and data.get("episodes") == key

@@ -19,9 +19,8 @@ import numbers
 from pathlib import Path
 from typing import Any
 
+from acld_gym.physics.loads import LOAD_CASES as CASES
 from acld_gym.util.validate import DataFileError, file_error
-
-from .evaluate import CASES
 
 __all__ = [
     "DataFileError",

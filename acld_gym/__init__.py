@@ -15,7 +15,7 @@ holds the tools.
 
 from acld_gym.envs.presets import register_presets
 
-__version__ = "0.19.3"
+__version__ = "0.20.0"
 
 #: The current environment id.
 ENV_ID = "ACLDBeam-v1"

@@ -80,6 +80,11 @@ def test_vec_normalize_from_its_file(ppo, tmp_path):
     assert a.iqm == b.iqm
 
 
+#: Against the committed train/agents/compare.json, written on one machine: another CPU's
+#: BLAS kernels move an ISE ratio by ~4e-9 (OPENBLAS_CORETYPE=Nehalem or Sandybridge, by hand).
+COMMITTED_RTOL = 1e-6
+
+
 def test_trained_agent_prefix_equals_baselines_score(agent):
     got = score(agent, V1, episodes=N)
     want = score_policy(agent, V1, n_episodes=N)
@@ -88,7 +93,7 @@ def test_trained_agent_prefix_equals_baselines_score(agent):
     rows = json.loads(open("train/agents/compare.json").read())
     rel = {r["case"]: r["ise_rel_lqr"] for r in rows if r["policy"] == "ppo"}
     for case in (1, 2, 3):  # seed 0, as train.compare ran them
-        assert got.ise_rel_lqr[case] == pytest.approx(rel[case], rel=1e-9)
+        assert got.ise_rel_lqr[case] == pytest.approx(rel[case], rel=COMMITTED_RTOL)
 
 
 @pytest.mark.slow
@@ -99,9 +104,9 @@ def test_trained_agent_full_set_is_compare_json(agent):
     want = ppo[1]["score"]
     assert got.n_episodes == want["n_episodes"] == len(bench.TEST_SETS[V1].seeds)
     for key in ("iqm", "ci_low", "ci_high", "mean_ise", "ise_rel_thesis_lqr"):
-        assert got.score.as_dict()[key] == pytest.approx(want[key], rel=1e-9), key
+        assert got.score.as_dict()[key] == pytest.approx(want[key], rel=COMMITTED_RTOL), key
     for case in (1, 2, 3, "random"):
-        assert got.ise_rel_lqr[case] == pytest.approx(ppo[case]["ise_rel_lqr"], rel=1e-9)
+        assert got.ise_rel_lqr[case] == pytest.approx(ppo[case]["ise_rel_lqr"], rel=COMMITTED_RTOL)
 
 
 def test_callable_through_the_wrappers_is_the_exported_actor(ppo):

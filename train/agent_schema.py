@@ -18,6 +18,8 @@ import numbers
 
 import numpy as np
 
+from acld_gym.util.validate import json_depth, shown
+
 __all__ = [
     "AgentFileError",
     "FORMAT",
@@ -84,32 +86,12 @@ def is_real(value) -> bool:
 
 def _real(where: str, field: str, value, low: float | None = None, open_low: bool = False):
     if not is_real(value):
-        raise _fail(where, field, f"expected a finite number, got {_short(value)}")
+        raise _fail(where, field, f"expected a finite number, got {shown(value)}")
     v = float(value)
     if low is not None and (v < low or (open_low and v == low)):
         rel = ">" if open_low else ">="
         raise _fail(where, field, f"expected a number {rel} {low:g}, got {v!r}")
     return v
-
-
-def _short(value) -> str:
-    """``repr`` of a value cut to 60 characters (a file's bytes are not echoed in full)."""
-    text = repr(value)
-    return text if len(text) <= 60 else text[:57] + "..."
-
-
-def _depth(obj) -> int:
-    """The nesting depth of JSON data, without recursion."""
-    deepest, stack = 0, [(obj, 1)]
-    while stack:
-        item, d = stack.pop()
-        if isinstance(item, (list, dict)):
-            deepest = max(deepest, d)
-            if d > MAX_DEPTH:
-                return d
-            values = item.values() if isinstance(item, dict) else item
-            stack.extend((v, d + 1) for v in values)
-    return deepest
 
 
 def _refuse_constant(name: str):
@@ -124,8 +106,8 @@ def parse_metadata(data: bytes, where: str) -> dict:
     except RecursionError:
         raise AgentFileError(f"{where}: nested deeper than {MAX_DEPTH} levels") from None
     except (UnicodeDecodeError, ValueError) as exc:  # JSONDecodeError is a ValueError
-        raise AgentFileError(f"{where}: not valid JSON ({_short(str(exc))[1:-1]})") from None
-    if _depth(meta) > MAX_DEPTH:
+        raise AgentFileError(f"{where}: not valid JSON ({shown(str(exc))[1:-1]})") from None
+    if json_depth(meta, MAX_DEPTH) > MAX_DEPTH:
         raise AgentFileError(f"{where}: nested deeper than {MAX_DEPTH} levels")
     return check_metadata(meta, where)
 
@@ -143,7 +125,7 @@ def check_metadata(meta, where: str = "metadata.json") -> dict:
         )
     fmt = meta.get("format", FORMAT)
     if isinstance(fmt, bool) or not isinstance(fmt, int) or not 1 <= fmt <= FORMAT:
-        raise _fail(where, "format", f"expected an agent format 1 to {FORMAT}, got {_short(fmt)}")
+        raise _fail(where, "format", f"expected an agent format 1 to {FORMAT}, got {shown(fmt)}")
     _check_env(meta["env"], where)
     _check_observation(meta["observation"], meta["env"]["id"], where)
     check_ops(meta["actor"], where)
@@ -153,10 +135,10 @@ def check_metadata(meta, where: str = "metadata.json") -> dict:
             isinstance(value, str) and value.isprintable() and len(value) <= MAX_TEXT
         ):
             raise _fail(
-                where, key, f"expected null or one printable line of text, got {_short(value)}"
+                where, key, f"expected null or one printable line of text, got {shown(value)}"
             )
     if meta.get("residual") not in (None, "lqr"):
-        raise _fail(where, "residual", f"expected null or 'lqr', got {_short(meta['residual'])}")
+        raise _fail(where, "residual", f"expected null or 'lqr', got {shown(meta['residual'])}")
     if "action_headroom" in meta:
         from acld_gym.wrappers import MAX_HEADROOM, check_headroom
 
@@ -167,7 +149,7 @@ def check_metadata(meta, where: str = "metadata.json") -> dict:
             raise _fail(
                 where,
                 "action_headroom",
-                f"expected a number in [1, {MAX_HEADROOM:g}], got {_short(headroom)}",
+                f"expected a number in [1, {MAX_HEADROOM:g}], got {shown(headroom)}",
             ) from None
     return meta
 
@@ -178,11 +160,11 @@ def _check_env(env, where: str) -> None:
     from acld_gym.envs.presets import check_env_id
 
     if not isinstance(env, dict):
-        raise _fail(where, "env", f"expected an object with 'id' and 'kwargs', got {_short(env)}")
+        raise _fail(where, "env", f"expected an object with 'id' and 'kwargs', got {shown(env)}")
     if "id" not in env:
         raise _fail(where, "env.id", "missing (the id of the env the agent was trained on)")
     if not isinstance(env["id"], str) or len(env["id"]) > MAX_TEXT:  # (not echoed in full)
-        raise _fail(where, "env.id", f"expected one of this package's ids, got {_short(env['id'])}")
+        raise _fail(where, "env.id", f"expected one of this package's ids, got {shown(env['id'])}")
     try:
         check_env_id(env["id"], "env.id")
     except ValueError as exc:
@@ -192,7 +174,7 @@ def _check_env(env, where: str) -> None:
         raise _fail(where, "env", f"unexpected keys {unknown} (expected 'id' and 'kwargs')")
     kwargs = env.get("kwargs", {})
     if not isinstance(kwargs, dict):
-        raise _fail(where, "env.kwargs", f"expected an object, got {_short(kwargs)}")
+        raise _fail(where, "env.kwargs", f"expected an object, got {shown(kwargs)}")
     import dataclasses
 
     from acld_gym.envs.config import EnvConfig
@@ -206,13 +188,13 @@ def _check_env(env, where: str) -> None:
 def _check_observation(obs, env_id: str, where: str) -> None:
     """The observation fingerprint: every entry, of its type, made for ``env_id``."""
     if not isinstance(obs, dict):
-        raise _fail(where, "observation", f"expected an object, got {_short(obs)}")
+        raise _fail(where, "observation", f"expected an object, got {shown(obs)}")
     for key in (*_FINGERPRINT_TEXT, "dt", *_FINGERPRINT_ARRAYS):
         if key not in obs:
             raise _fail(where, f"observation.{key}", "missing (the observation fingerprint)")
     for key in _FINGERPRINT_TEXT:
         if not isinstance(obs[key], str):
-            raise _fail(where, f"observation.{key}", f"expected a string, got {_short(obs[key])}")
+            raise _fail(where, f"observation.{key}", f"expected a string, got {shown(obs[key])}")
     if obs["env_id"] != env_id:
         raise _fail(
             where, "observation.env_id", f"{obs['env_id']!r} differs from env.id {env_id!r}"
@@ -226,7 +208,7 @@ def _check_observation(obs, env_id: str, where: str) -> None:
             ok = arr.ndim == ndim or (not value and ndim == 1)
         if not ok:
             shape = "a list of numbers" if ndim == 1 else "a list of equal-length lists of numbers"
-            raise _fail(where, f"observation.{key}", f"expected {shape}, got {_short(value)}")
+            raise _fail(where, f"observation.{key}", f"expected {shape}, got {shown(value)}")
     for key, value in obs.items():
         if key not in _FINGERPRINT_TEXT and key not in _FINGERPRINT_ARRAYS and key != "dt":
             scalar = value is None or isinstance(value, (str, bool)) or is_real(value)
@@ -235,7 +217,7 @@ def _check_observation(obs, env_id: str, where: str) -> None:
                 raise _fail(
                     where,
                     f"observation.{key}",
-                    f"expected a string, a number or a list of numbers, got {_short(value)}",
+                    f"expected a string, a number or a list of numbers, got {shown(value)}",
                 )
 
 
@@ -257,17 +239,17 @@ def check_ops(ops, where: str = "metadata.json") -> list[dict]:
     ``eps`` >= 0; ``clip``: ``low`` <= ``high``; ``linear``: ``layer`` an integer >= 0),
     at least one linear layer; :class:`AgentFileError` naming ``where`` and the operation."""
     if not isinstance(ops, list):
-        raise _fail(where, "actor", f"expected a list of operations, got {_short(ops)}")
+        raise _fail(where, "actor", f"expected a list of operations, got {shown(ops)}")
     if len(ops) > MAX_OPS:
         raise _fail(where, "actor", f"{len(ops)} operations, more than {MAX_OPS}")
     for i, op in enumerate(ops):
         field = f"actor[{i}]"
         if not isinstance(op, dict):
-            raise _fail(where, field, f"expected an object with 'op', got {_short(op)}")
+            raise _fail(where, field, f"expected an object with 'op', got {shown(op)}")
         kind = op.get("op")
         if not isinstance(kind, str) or kind not in OP_KEYS:
             raise _fail(
-                where, field, f"unknown operation {_short(kind)}; expected one of {list(OP_KEYS)}"
+                where, field, f"unknown operation {shown(kind)}; expected one of {list(OP_KEYS)}"
             )
         allowed = {"op", *OP_KEYS[kind]}
         extra = sorted(set(op) - allowed)
@@ -287,7 +269,7 @@ def check_ops(ops, where: str = "metadata.json") -> list[dict]:
         elif kind == "linear" and "layer" in op:
             layer = op["layer"]
             if isinstance(layer, bool) or not isinstance(layer, int) or not 0 <= layer < MAX_OPS:
-                want = f"expected an integer in [0, {MAX_OPS}), got {_short(layer)}"
+                want = f"expected an integer in [0, {MAX_OPS}), got {shown(layer)}"
                 raise _fail(where, f"{field}.layer", want)
     if not any(op["op"] == "linear" for op in ops):
         raise _fail(where, "actor", "no linear layer (an actor maps the observation to one action)")

@@ -31,7 +31,14 @@ from acld_gym.physics.elements import TERM_COEFFICIENTS
 from acld_gym.physics.params import BeamParameters
 from acld_gym.physics.plant import Plant
 from acld_gym.util.atomic import write_atomic
-from acld_gym.util.validate import DataFileError, check_real, file_error, os_error_line, shown
+from acld_gym.util.validate import (
+    DataFileError,
+    check_real,
+    file_error,
+    json_depth,
+    os_error_line,
+    shown,
+)
 
 __all__ = ["FORMAT", "key", "cached", "save", "load", "SHIPPED_DIR", "user_cache_dir"]
 
@@ -100,19 +107,6 @@ _VECTORS = ("piezo", "Fd", "c")
 _MATRICES = ("physical", "node_x", "node_w")
 
 
-def _depth(obj) -> int:
-    """The nesting depth of JSON data, without recursion."""
-    deepest, stack = 0, [(obj, 1)]
-    while stack:
-        item, d = stack.pop()
-        if isinstance(item, (list, dict)):
-            deepest = max(deepest, d)
-            if d > MAX_DEPTH:
-                return d
-            stack.extend((v, d + 1) for v in (item.values() if isinstance(item, dict) else item))
-    return deepest
-
-
 def _meta(raw: np.ndarray, path: Path) -> dict:
     """The checked JSON of the ``meta`` member: ``name`` a string, ``provenance`` a mapping,
     ``params`` every field of :class:`BeamParameters` as a finite number (and nothing else);
@@ -125,7 +119,7 @@ def _meta(raw: np.ndarray, path: Path) -> dict:
         raise file_error(path, "meta", "nested too deeply") from None
     except (UnicodeDecodeError, ValueError) as exc:  # JSONDecodeError is a ValueError
         raise file_error(path, "meta", f"not JSON ({shown(str(exc))})") from None
-    if _depth(meta) > MAX_DEPTH:
+    if json_depth(meta, MAX_DEPTH) > MAX_DEPTH:
         raise file_error(path, "meta", f"nested deeper than {MAX_DEPTH} levels")
     if not isinstance(meta, dict):
         raise file_error(path, "meta", f"expected a mapping, got {shown(meta)}")

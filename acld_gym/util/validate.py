@@ -14,6 +14,8 @@ import numpy as np
 
 __all__ = [
     "check_real",
+    "json_depth",
+    "shown",
     "check_int",
     "check_choice",
     "check_seed",
@@ -32,6 +34,21 @@ def shown(value, limit: int = 60) -> str:
     not echo a 400-digit integer or a file's bytes)."""
     text = repr(value)
     return text if len(text) <= limit else f"{text[: limit - 3]}..."
+
+
+def json_depth(obj, limit: int) -> int:
+    """The nesting depth of parsed JSON data (lists and dicts), found without recursion and
+    given up past ``limit`` (a file nested 200,000 deep is measured in ``limit`` steps of
+    depth, not walked whole)."""
+    deepest, stack = 0, [(obj, 1)]
+    while stack:
+        item, d = stack.pop()
+        if isinstance(item, (list, dict)):
+            deepest = max(deepest, d)
+            if d > limit:
+                return d
+            stack.extend((v, d + 1) for v in (item.values() if isinstance(item, dict) else item))
+    return deepest
 
 
 def check_real(

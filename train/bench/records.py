@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from acld_gym.physics.loads import LOAD_CASES as CASES
-from acld_gym.util.validate import DataFileError, file_error
+from acld_gym.util.validate import DataFileError, file_error, shown
 
 __all__ = [
     "DataFileError",
@@ -59,11 +59,6 @@ def read_json(path: str | Path, max_bytes: int = MAX_BYTES) -> Any:
         raise file_error(path, None, "not valid JSON (nested too deeply)") from None
 
 
-def _shown(value) -> str:
-    text = repr(value)
-    return text if len(text) <= 40 else text[:37] + "..."
-
-
 class _Reader:
     """Checks of the fields of one file; every failure a :class:`DataFileError` naming the
     file and the field's dotted place in it."""
@@ -85,29 +80,29 @@ class _Reader:
 
     def mapping(self, value, field: str) -> dict:
         if not isinstance(value, dict):
-            self.fail(field, f"expected a mapping, got {_shown(value)}")
+            self.fail(field, f"expected a mapping, got {shown(value, 40)}")
         return value
 
     def items(self, value, field: str, nonempty: bool = False) -> list:
         if not isinstance(value, list):
-            self.fail(field, f"expected a list, got {_shown(value)}")
+            self.fail(field, f"expected a list, got {shown(value, 40)}")
         if nonempty and not value:
             self.fail(field, "expected a non-empty list")
         return value
 
     def text(self, value, field: str) -> str:
         if not isinstance(value, str):
-            self.fail(field, f"expected a string, got {_shown(value)}")
+            self.fail(field, f"expected a string, got {shown(value, 40)}")
         return value
 
     def flag(self, value, field: str) -> bool:
         if not isinstance(value, bool):
-            self.fail(field, f"expected true or false, got {_shown(value)}")
+            self.fail(field, f"expected true or false, got {shown(value, 40)}")
         return value
 
     def integer(self, value, field: str, low: int = 0, high: int | None = None) -> int:
         if isinstance(value, bool) or not isinstance(value, int):
-            self.fail(field, f"expected an integer, got {_shown(value)}")
+            self.fail(field, f"expected an integer, got {shown(value, 40)}")
         if value < low or (high is not None and value > high):
             self.fail(field, f"expected an integer in [{low}, {high or 'inf'}], got {value}")
         return value
@@ -116,13 +111,13 @@ class _Reader:
         """A JSON number (not a bool), finite unless ``nan`` (a NaN is then allowed: a time
         not recorded), at least ``low``."""
         if isinstance(value, bool) or not isinstance(value, numbers.Real):
-            self.fail(field, f"expected a number, got {_shown(value)}")
+            self.fail(field, f"expected a number, got {shown(value, 40)}")
         try:
             x = float(value)
         except OverflowError:  # an integer beyond the float range
             x = math.inf
         if not math.isfinite(x) and not (nan and math.isnan(x)):
-            self.fail(field, f"expected a finite number, got {_shown(value)}")
+            self.fail(field, f"expected a finite number, got {shown(value, 40)}")
         if low is not None and value < low:
             self.fail(field, f"expected a number >= {low:g}, got {value}")
         return value

@@ -45,7 +45,7 @@ from acld_gym.envs.step import OBS_HIST, Y_SCALE
 from acld_gym.physics.actuator import V_LIMIT
 
 from . import arguments
-from .qp import solution
+from .qp import SETTINGS, solution
 
 __all__ = ["PlantOracleMPC", "ClairvoyantReplay", "tip_measurement", "cost_to_go"]
 
@@ -208,11 +208,7 @@ class PlantOracleMPC:
             A=sp.vstack(rows, format="csc"),
             l=-np.ones(H * len(rows)),
             u=np.ones(H * len(rows)),
-            verbose=False,
-            eps_abs=1e-7,
-            eps_rel=1e-7,
-            polishing=False,
-            max_iter=20000,
+            **SETTINGS,
         )
         return prob
 

@@ -30,7 +30,7 @@ from acld_gym.envs.fingerprint import design_fingerprint
 from acld_gym.physics.actuator import V_LIMIT
 
 from . import arguments
-from .qp import solution
+from .qp import SETTINGS, solution
 
 __all__ = [
     "PassivePolicy",
@@ -126,7 +126,7 @@ class LQRPolicy(_Policy):
     def __init__(
         self, dt: float | None = None, weight: float = THESIS_LQR_WEIGHT, nom=None, mesh=None
     ):
-        weight = arguments.positive("weight", weight)
+        weight = arguments.lqr_weight(weight)
         super().__init__(dt, nom, mesh)
         self.law = self.nom.lqr_law(weight)
         self.K = self.law.a[None]
@@ -306,11 +306,7 @@ class MPCPolicy(_Policy):
                 A=Aeq,
                 l=-np.ones(H),
                 u=np.ones(H),
-                verbose=False,
-                eps_abs=1e-7,
-                eps_rel=1e-7,
-                polishing=False,
-                max_iter=20000,
+                **SETTINGS,
             )
             self._solvers[i] = prob
         return self._solvers[i]

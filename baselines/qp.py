@@ -6,11 +6,21 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["ACCEPTED", "solution"]
+__all__ = ["ACCEPTED", "SETTINGS", "solution"]
 
 #: The statuses whose solution is used (OSQP stops at its tolerance or its iteration limit
 #: with "solved inaccurate": the first move is still the QP's to that accuracy).
 ACCEPTED = ("solved", "solved inaccurate")
+
+
+#: The OSQP settings every MPC of the package solves with (its accuracy: 1e-7, no polishing).
+SETTINGS = {
+    "verbose": False,
+    "eps_abs": 1e-7,
+    "eps_rel": 1e-7,
+    "polishing": False,
+    "max_iter": 20000,
+}
 
 
 def solution(res, who: str) -> np.ndarray:

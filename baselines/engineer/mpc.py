@@ -11,7 +11,7 @@ from acld_gym.physics.actuator import V_LIMIT
 from baselines.policies import MPCPolicy
 
 from .. import arguments
-from ..qp import solution
+from ..qp import SETTINGS, solution
 from .base import RigPolicy
 from .riccati import lqr
 
@@ -103,11 +103,7 @@ class _RateMPC(MPCPolicy):
                 A=sp.vstack([sp.identity(H, format="csc"), D], format="csc"),
                 l=np.r_[-np.ones(H), -self.slew * np.ones(H)],
                 u=np.r_[np.ones(H), self.slew * np.ones(H)],
-                verbose=False,
-                eps_abs=1e-7,
-                eps_rel=1e-7,
-                polishing=False,
-                max_iter=20000,
+                **SETTINGS,
             )
             self._solvers[i] = prob
         return self._solvers[i]

@@ -15,6 +15,8 @@ __all__ = [
     "MAX_HORIZON",
     "DEFAULT_DT",
     "positive",
+    "lqr_weight",
+    "MAX_LQR_WEIGHT",
     "non_negative",
     "horizon",
     "flag",
@@ -39,6 +41,16 @@ DEFAULT_DT = 1e-3
 def positive(name: str, value, unit: str = "") -> float:
     """``value`` as a float if it is a finite real number > 0."""
     return check_real(name, value, 0.0, low_open=True, unit=unit)
+
+
+#: The largest LQR state weight taken: nine decades above the thesis's 1e11; from about 5e28
+#: on the discrete Riccati equation is numerically singular and scipy's solver fails.
+MAX_LQR_WEIGHT = 1e20
+
+
+def lqr_weight(value, name: str = "weight") -> float:
+    """An LQR state weight: a finite real number in (0, :data:`MAX_LQR_WEIGHT`]."""
+    return check_real(name, value, 0.0, MAX_LQR_WEIGHT, low_open=True)
 
 
 def non_negative(name: str, value, unit: str = "") -> float:

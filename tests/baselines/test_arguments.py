@@ -141,3 +141,13 @@ def test_fuzz_a_scalar_argument_builds_or_is_refused_naming_it(which, value):
         build(value)
     except ValueError as exc:
         assert str(exc).startswith(name), exc
+
+
+def test_an_lqr_weight_beyond_a_solvable_riccati_equation_is_refused_naming_it():
+    """Weights from about 5e28 on made scipy's DARE fail (LinAlgError, found by the fuzz
+    above); the bound, nine decades above the thesis's 1e11, still designs."""
+    from baselines.arguments import MAX_LQR_WEIGHT
+
+    assert LQRPolicy(nom=NOM, weight=MAX_LQR_WEIGHT).K.shape[0] == 1
+    with pytest.raises(ValueError, match=r"^weight must be <= 1e\+20"):
+        LQRPolicy(nom=NOM, weight=4.9e28)

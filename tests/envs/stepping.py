@@ -16,6 +16,15 @@ def single_rollout(kw: dict, n: int, acts, seed: int = 11, compiled: bool | None
     if compiled is not None:
         for e in envs:
             e.compiled_step = compiled
+    return drive(envs, acts, seed)
+
+
+def drive(envs, acts, seed: int):
+    """``envs`` (single envs, wrapped or not) driven as a NEXT_STEP vector env drives its
+    sub-envs: env i reset with ``seed + i``, reset again after its episode ends. Returns per
+    step ``(obs, reward, terminated, truncated, infos)``, the first (the resets) with None
+    for reward and flags."""
+    n = len(envs)
     out = [e.reset(seed=seed + i) for i, e in enumerate(envs)]
     steps = [(np.array([o for o, _ in out]), None, None, None, [i for _, i in out])]
     done = [False] * n

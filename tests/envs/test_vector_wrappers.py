@@ -10,6 +10,7 @@ import functools
 import gymnasium as gym
 import numpy as np
 import pytest
+from stepping import drive
 
 import acld_gym  # noqa: F401  (registers the ids)
 from acld_gym import wrappers
@@ -63,23 +64,9 @@ def _stack(rows):
 
 def _single_next_step(env_id, seed):
     """N wrapped single envs driven as a NEXT_STEP vector env drives its sub-envs."""
-    envs = _single_envs(env_id)
-    out = [e.reset(seed=seed + i) for i, e in enumerate(envs)]
-    steps = [(np.array([o for o, _ in out]), [i for _, i in out])]
-    done = [False] * N
-    for a in ACTIONS:
-        rows = []
-        for i, e in enumerate(envs):
-            if done[i]:
-                o, info = e.reset()
-                r, te, tr = 0.0, False, False
-            else:
-                o, r, te, tr, info = e.step(a[i])
-            done[i] = te or tr
-            rows.append((o, r, te, tr, info))
-        o, r, te, tr, info = zip(*rows, strict=True)
-        steps.append((np.array(o), np.array(r), np.array(te), np.array(tr), list(info)))
-    return steps
+    steps = drive(_single_envs(env_id), ACTIONS, seed)
+    obs, _, _, _, infos = steps[0]
+    return [(obs, infos), *steps[1:]]
 
 
 def _same(got, want, exact=True, rtol=0.0):

@@ -29,6 +29,7 @@ into "every run, always" (acld-gym 0.19: 0.520 on the lab rig, where no run reac
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 from dataclasses import dataclass
@@ -103,13 +104,16 @@ class RestartRule:
         out["loads"] = len(seeds)
         if self.reference is None:
             return {"threshold": self.ratio, **out, "reference_cost": None}
-        cost = reference_cost(self.reference, env_id, seeds)
+        cost = reference_cost(self.reference, env_id, tuple(seeds))
         return {"threshold": self.ratio * cost, **out, "reference_cost": cost}
 
 
-def reference_cost(reference: str, env_id: str, seeds) -> float:
+@functools.lru_cache(maxsize=16)
+def reference_cost(reference: str, env_id: str, seeds: tuple) -> float:
     """:func:`train.bench.evaluate.validation_cost` of ``reference`` (:data:`REFERENCES`)
-    designed on ``env_id`` (its nominal model and the level's design), on ``seeds``."""
+    designed on ``env_id`` (its nominal model and the level's design), on ``seeds`` (a
+    tuple); computed once per process for the same arguments (a benchmark resolves the same
+    rule for every seed it runs)."""
     from baselines.engineer import DelayLQGPolicy
     from baselines.policies import LQRPolicy, PassivePolicy
 

@@ -5,25 +5,25 @@ registered id (``ACLDBeam-v1``, ``ACLDBeam-v0`` and the presets are configuratio
 The class composes the layers below it: :mod:`acld_gym.envs.config` validates the
 configuration, :mod:`acld_gym.envs.episode` draws the load and the plant, and
 :mod:`acld_gym.envs.batch` is the step -- the single env is its N = 1 case, compiled where
-it was built.
+it was built (:mod:`acld_gym.envs.single_step`: its state, reset info and 5-tuple read from
+the batch).
 """
 
 from __future__ import annotations
-
-from typing import Any
 
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from acld_gym.envs.batch import COMPILED_STEP, BatchStep, StepResult
+from acld_gym.envs.batch import COMPILED_STEP, BatchStep
 from acld_gym.envs.checks import check_actions, check_render_mode
 from acld_gym.envs.config import ConfigAttributes, EnvConfig, make_config
 from acld_gym.envs.conflicts import made_spec
 from acld_gym.envs.episode import draw_episode, draw_noise, reset_options
 from acld_gym.envs.fingerprint import observation_fingerprint
-from acld_gym.envs.render import FigureOwner
-from acld_gym.envs.step import INFO_KEYS, TERMINATED_BY, load_schedule
+from acld_gym.envs.render import FigureOwner, render_frame, show
+from acld_gym.envs.single_step import BatchView, fast_step, not_reset, reset_info, single
+from acld_gym.envs.step import load_schedule
 from acld_gym.physics.actuator import V_LIMIT
 from acld_gym.physics.loads import case_load, thesis_load
 from acld_gym.util.validate import check_seed
@@ -31,15 +31,7 @@ from acld_gym.util.validate import check_seed
 __all__ = ["ACLDBeamEnv", "COMPILED_STEP"]
 
 
-def _not_reset(action):
-    raise RuntimeError("ACLDBeamEnv: call reset() before step()")
-
-
-def _no_fast_path(action):
-    return None
-
-
-class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
+class ACLDBeamEnv(BatchView, ConfigAttributes, FigureOwner, gym.Env):
     """
     ## Description
 
@@ -248,35 +240,7 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
         self.load = case_load(self.config.load_case) or thesis_load(1)
         self._batch.start_episodes([0], [self.load], [None], np.zeros((1, self.max_steps + 1)))
         self._started = False
-        self._fast = _not_reset  # the compiled step after reset(); None where it declines
-
-    # --- state ----------------------------------------------------------------------------
-    batch = property(
-        lambda self: self._batch,
-        doc="The batched step this env is the N = 1 case of "
-        "(:class:`acld_gym.envs.batch.BatchStep`: its state and step).",
-    )
-    k = property(lambda self: int(self._batch.k[0]), doc="Steps taken in the episode.")
-    v = property(
-        lambda self: float(self._batch.Z[0, self._batch.layout.voltage]),
-        doc="Voltage applied in the last step [V].",
-    )
-    y_meas = property(
-        lambda self: float(self._batch.Z[0, self._batch.layout.y_meas]),
-        doc="Last tip measurement [m].",
-    )
-    x = property(
-        lambda self: self._batch.Z[0, self._batch.layout.x],
-        doc="True plant state [q; dq/dt] (a view).",
-    )
-    xhat = property(
-        lambda self: self._batch.Z[0, self._batch.layout.xhat], doc="Observer state (a view)."
-    )
-    episode_plant = property(
-        lambda self: self._batch.plants[0],
-        doc="The sampled plant of this episode (randomized with ``param_noise``), a "
-        ":class:`acld_gym.design.discrete.SampledSystem`.",
-    )
+        self._fast = not_reset  # the compiled step after reset(); None where it declines
 
     @property
     def spec(self):
@@ -301,7 +265,7 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
 
     def __setstate__(self, state):
         self.__dict__.update(state)
-        self._fast = _not_reset if not self._started else self._fast_step()
+        self._fast = not_reset if not self._started else fast_step(self._batch)
 
     # --- Gymnasium API --------------------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict | None = None):
@@ -320,34 +284,9 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
         self.load = load
         self.history = []
         self._started = True
-        self._fast = self._fast_step()
+        self._fast = fast_step(self._batch)
         b = self._batch
-        info = {
-            "tip_deflection": 0.0,
-            "voltage": 0.0,
-            "requested_voltage": 0.0,
-            "clipped": False,
-            "tip_load": float(b.tip_loads()[0]),
-            "time": 0.0,
-            "xr_true": np.zeros(self.nom.design.reduced.order),
-            "terminated_by": None,
-            "reward_deflection": 0.0,
-            "reward_voltage": 0.0,
-        }
-        if b.scale_cost is not None:
-            info["reward_scale"] = float(b.reward_scale[0])
-        return b.observations()[0], info
-
-    def _fast_step(self):
-        """The compiled step of this env (with the reward scale applied, if set), or
-        :func:`_no_fast_path`."""
-        b = self._batch
-        if b.core is None:
-            return _no_fast_path
-        if b.scale_cost is None:
-            return b.core.step_one
-        step_one, scaled_one = b.core.step_one, b.scaled_one
-        return lambda action: scaled_one(step_one(action))
+        return b.observations()[0], reset_info(b, self.nom.design.reduced.order)
 
     def step(self, action):
         result = self._fast(action)  # the compiled step; None where it does not apply
@@ -365,7 +304,7 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
         of the compiled one, and the path for actions of other types, bad actions and steps
         past the tabulated episode."""
         if not self._started:
-            _not_reset(action)
+            not_reset(action)
         requested, v = check_actions(action, 1, V_LIMIT)
         b, k = self._batch, self.k
         inputs = None
@@ -373,7 +312,7 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
             f = load_schedule(self.nom.plant, self.load, k, k + 1)[0]
             w = self.np_random.normal(0.0, self.sensor_noise) if self.sensor_noise else 0.0
             inputs = np.append(f[0], w)[None]
-        out = _single(b.advance(v, inputs), float(requested[0]), float(v[0]), k + 1, self.dt)
+        out = single(b.advance(v, inputs), float(requested[0]), float(v[0]), k + 1, self.dt)
         if b.scale_cost is not None:
             out[4]["reward_scale"] = float(b.reward_scale[0])
         return out
@@ -382,34 +321,11 @@ class ACLDBeamEnv(ConfigAttributes, FigureOwner, gym.Env):
         if self.render_mode is None:
             gym.logger.warn("render() called without render_mode; pass render_mode= to make()")
             return None
-        from acld_gym.envs.render import render_frame
-
         frame, self._fig = render_frame(self, self._fig)
         if self.render_mode == "human":
-            from acld_gym.envs.render import show
-
             show(self._fig)
             return None
         return frame
 
     def close(self):
         self._close_figure()
-
-
-def _single(res: StepResult, requested: float, command: float, k: int, dt: float):
-    """Gymnasium's 5-tuple of env 0 of a batch step (as the compiled ``step_one`` gives it)."""
-    code = int(res.code[0])
-    values = (
-        float(res.y[0]),
-        float(res.voltage[0]),
-        requested,
-        requested != command,
-        float(res.tip_load[0]),
-        k * dt,
-        res.xr[0],
-        TERMINATED_BY[code],
-        float(res.reward_deflection[0]),
-        float(res.reward_voltage[0]),
-    )
-    info: dict[str, Any] = dict(zip(INFO_KEYS, values, strict=True))
-    return res.obs[0], float(res.reward[0]), code != 0, bool(res.truncated[0]), info

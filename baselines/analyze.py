@@ -8,7 +8,8 @@ POLICY is a reference of the level (:mod:`baselines.marks`: ``passive``; the the
 delay-free ``lqr`` and ``smc`` and the nominal ``mpc``; the engineer's designs for the
 level's actuator, ``lqg`` and ``mpc_rig`` (:mod:`baselines.engineer`); the plant oracle
 ``mpc_oracle`` (:mod:`baselines.oracle`)), ``references`` for all of them, or an agent
-directory (``train.agent.TrainedAgent``). Through the env it
+directory (read by :func:`load_trained_agent`, or by the ``load_agent`` a caller passes to
+:func:`main`). Through the env it
 measures the closed-loop modes 1-3 (frequency, damping ratio) from a small tip pulse, the
 drop of each mode's load-to-tip compliance peak against the passive beam (multisine),
 for a policy linear about rest the exact closed-loop modes of the sampled loop and the
@@ -28,35 +29,70 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Callable
 from pathlib import Path
+
+import gymnasium as gym
 
 import acld_gym
 from acld_gym.benchmark import TEST_SETS
 from acld_gym.envs.presets import check_env_id
 from acld_gym.util.atomic import strict_json, write_json, write_text
 from acld_gym.util.text import plain, prog
+from acld_gym.util.validate import run_main
 
 from .analysis.control import Analysis, analyze
+from .analysis.references import references
+from .analysis.report import format_analysis, markdown_summary, plot_compliance
 from .arguments import outputs
 from .evaluate import add_score_episodes_argument, check_score_episodes
+from .marks import level_references
 
-__all__ = ["analyze", "Analysis", "BASELINES", "ALL", "resolve_policy", "resolve_policies", "main"]
+__all__ = [
+    "analyze",
+    "Analysis",
+    "BASELINES",
+    "ALL",
+    "AgentLoader",
+    "load_trained_agent",
+    "resolve_policy",
+    "resolve_policies",
+    "main",
+]
 
 #: The references of every level by name (:func:`baselines.marks.level_references`; where
 #: the QP solver osqp is missing, a level has no ``mpc``, ``mpc_rig`` or ``mpc_oracle``).
 BASELINES = ("passive", "lqr", "smc", "mpc", "lqg", "mpc_rig", "mpc_oracle")
 #: The POLICY that stands for all of the level's references.
 ALL = "references"
+#: What reads an agent directory into a policy (anything with ``predict``, the package's
+#: policy interface): ``load_agent(path)``.
+AgentLoader = Callable[[Path], object]
 
 
-def resolve_policies(spec: str, env_id: str, env_kwargs: dict | None = None) -> list:
+def load_trained_agent(path: Path):
+    """The agent in the directory ``path``, named after it
+    (``train.agent.TrainedAgent.load``): the ``load_agent`` of :func:`main` and
+    :func:`resolve_policies` when the caller passes none."""
+    # Imported here, not at the top: train sits above baselines (physics -> design -> envs
+    # -> baselines -> train) and owns the agent folder's format, but `python -m
+    # baselines.analyze DIR` must read one. Only this default loader reaches up, and only
+    # when a POLICY is a directory; a caller on train's side passes its own `load_agent`.
+    from train.agent import TrainedAgent
+
+    return TrainedAgent.load(path, path.name)
+
+
+def resolve_policies(
+    spec: str,
+    env_id: str,
+    env_kwargs: dict | None = None,
+    load_agent: AgentLoader | None = None,
+) -> list:
     """``[(policy, name), ...]`` for a reference's name, :data:`ALL` or an agent
-    directory; ``ValueError`` naming ``POLICY`` otherwise."""
-    import gymnasium as gym
-
+    directory (read by ``load_agent``, default :func:`load_trained_agent`); ``ValueError``
+    naming ``POLICY`` otherwise."""
     if spec in BASELINES or spec == ALL:
-        from .marks import level_references
-
         refs = level_references(gym.make(env_id, **(env_kwargs or {})))
         if spec == ALL:
             return [(pol, name) for name, pol in refs.items()]
@@ -68,17 +104,20 @@ def resolve_policies(spec: str, env_id: str, env_kwargs: dict | None = None) -> 
         raise ValueError(
             f"POLICY: expected one of {[*BASELINES, ALL]} or an agent directory, got {spec!r}"
         )
-    from train.agent import TrainedAgent
-
-    return [(TrainedAgent.load(path, path.name), path.name)]
+    return [((load_agent or load_trained_agent)(path), path.name)]
 
 
-def resolve_policy(spec: str, env_id: str, env_kwargs: dict | None = None):
+def resolve_policy(
+    spec: str,
+    env_id: str,
+    env_kwargs: dict | None = None,
+    load_agent: AgentLoader | None = None,
+):
     """``(policy, name)`` for a reference's name or an agent directory (not :data:`ALL`);
     ``ValueError`` naming ``POLICY`` otherwise."""
     if spec == ALL:
         raise ValueError(f"POLICY: {ALL!r} stands for several policies")
-    return resolve_policies(spec, env_id, env_kwargs)[0]
+    return resolve_policies(spec, env_id, env_kwargs, load_agent)[0]
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -106,7 +145,9 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: list[str] | None = None, load_agent: AgentLoader | None = None) -> int:
+    """The command: ``argv`` as on the command line; an agent directory among the POLICY
+    arguments is read by ``load_agent`` (default :func:`load_trained_agent`)."""
     parser = build_parser()
     args = parser.parse_args(argv)
     try:  # a bad id, unusable output paths and a bad POLICY fail now, before any computing
@@ -115,12 +156,11 @@ def main(argv: list[str] | None = None) -> int:
             raise ValueError(f"--env-id: no published test set for {args.env_id!r}")
         outputs({"--json": args.json, "--markdown": args.markdown}, {"--plots": args.plots})
         check_score_episodes(args.score_episodes, args.env_id)
-        policies = [p for spec in args.policy for p in resolve_policies(spec, args.env_id)]
+        policies = [
+            p for spec in args.policy for p in resolve_policies(spec, args.env_id, None, load_agent)
+        ]
     except (OSError, ValueError) as exc:
         parser.error(str(exc))
-    from .analysis.references import references
-    from .analysis.report import format_analysis, markdown_summary, plot_compliance
-
     refs = None
     if args.score_episodes != 0:
         test = TEST_SETS[args.env_id]
@@ -153,6 +193,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    from acld_gym.util.validate import run_main
-
     sys.exit(run_main(main))

@@ -1,6 +1,7 @@
-"""``python -m train.ship RUN NAME``: copy a trained agent into ``train/agents/NAME/``
-(``policy.npz``, ``metadata.json`` with the command, seed, versions, how it was trained
-and the observation fingerprint of the run, and ``learning_curve.csv``).
+"""``python -m train.ship RUN NAME``: copy a trained agent into ``agents/NAME/`` of the
+current directory, or ``DIR/NAME/`` with ``--agents DIR`` (``policy.npz``,
+``metadata.json`` with the command, seed, versions, how it was trained and the observation
+fingerprint of the run, and ``learning_curve.csv``).
 ``python -m train.ship OUT NAME --best CONFIG``: the same for the seed of a benchmark
 config best on the thesis cases (:func:`best_seed`).
 
@@ -8,7 +9,13 @@ The run's files are read as :meth:`train.agent.TrainedAgent.load` reads them (no
 followed out of the run's folder, every field checked); the shipped folder is written
 whole, swapped in with one rename (:meth:`train.agent.TrainedAgent.save`), so a reader or
 a full disk sees the old agent or the new one. An existing ``NAME`` is replaced only with
-``--force``."""
+``--force``.
+
+Nothing is written into the installed package: the agents that ship with it
+(``train/agents/``, :data:`train.compare.AGENTS_DIR`) are read by ``python -m
+train.compare`` and the figures, and a user's agents go where the user works
+(``./agents``, or ``--agents DIR``); ``python -m train.compare --agents agents`` compares
+them."""
 
 from __future__ import annotations
 
@@ -25,13 +32,16 @@ from acld_gym.util.validate import os_error_line
 from .agent import CURVE_FILE, TrainedAgent
 from .agent_files import check_replaceable, curve_rows
 from .agent_schema import is_real
-from .compare import AGENTS_DIR
 
-__all__ = ["best_seed", "ship", "main"]
+__all__ = ["DEFAULT_AGENTS", "best_seed", "ship", "main"]
 
 #: The cases the shipping rule looks at, as results.json keys them: the thesis's (the held-out
 #: random loads take no part).
 RULE_CASES = tuple(str(c) for c in THESIS_CASES)
+
+#: Where agents are shipped by default: ``agents/`` in the current working directory (never
+#: the installed package's ``train/agents/``).
+DEFAULT_AGENTS = "agents"
 
 
 def best_seed(out: str | Path, config: str) -> int:
@@ -80,12 +90,13 @@ def check_name(name) -> str:
 
 
 def ship(
-    run: str | Path, name: str, agents_dir: str | Path = AGENTS_DIR, force: bool = False
+    run: str | Path, name: str, agents_dir: str | Path = DEFAULT_AGENTS, force: bool = False
 ) -> Path:
     """Copy an agent directory (``python -m train`` writes one in its ``--out``,
     ``python -m train.benchmark`` one per trial in ``<out>/agents/<config>-s<seed>``: the
     run's final policy, ``policy.npz`` + ``metadata.json``, nothing pickled) and its
-    learning curve to ``agents_dir/name``, the folder written whole (module docstring);
+    learning curve to ``agents_dir/name`` (default ``agents/name`` in the current
+    directory), the folder written whole (module docstring);
     returns that directory. The agent is read and validated by
     :meth:`train.agent.TrainedAgent.load` (its observation fingerprint included: a shipped
     agent loads) before anything is written; ``FileExistsError`` if ``agents_dir/name``
@@ -124,7 +135,12 @@ def main(argv: list[str] | None = None) -> int:
         "best on the thesis cases (mean ISE / LQR over cases 1-3)",
     )
     p.add_argument("name", help="agent name, e.g. ppo, sac, ppo_robust")
-    p.add_argument("--agents", default=str(AGENTS_DIR), help="destination (default: shipped)")
+    p.add_argument(
+        "--agents",
+        metavar="DIR",
+        default=DEFAULT_AGENTS,
+        help="destination folder of agents (default: ./agents, in the current directory)",
+    )
     p.add_argument("--force", action="store_true", help="replace an existing agent of that name")
     args = p.parse_args(argv)
     try:

@@ -87,8 +87,10 @@ def test_sweep_without_ray_says_how_to_install(capsys, monkeypatch):
     _exit2(sweep_main, ["ppo"], capsys, "[sweep]")
 
 
-def test_ship_cli_bad_input(tmp_path, capsys):
+def test_ship_cli_bad_input(tmp_path, capsys, monkeypatch):
     from train.ship import main as ship_main
+
+    monkeypatch.chdir(tmp_path)  # the default destination is ./agents
 
     _exit2(ship_main, [str(tmp_path), "ppo"], capsys, "lacks")
     (tmp_path / "policy.npz").write_bytes(b"not an npz")

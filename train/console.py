@@ -62,6 +62,9 @@ GROUPS: dict[str, dict[str, Command]] = {
         ),
         "compare": Command("train.compare", "the shipped agents against the reference controllers"),
         "ship": Command("train.ship", "copy a trained agent, checked, into a folder of agents"),
+        "leaderboard": Command(
+            "train.leaderboard.cli", "every level's references and agents, collected and rendered"
+        ),
     },
     "Training (needs pip install 'acld-gym[train]')": {
         "train": Command("train.cli", "train one agent with a recipe (ppo, sac, vrs, ..)", "train"),

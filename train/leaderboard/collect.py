@@ -28,7 +28,7 @@ import acld_gym
 from acld_gym.envs.presets import check_env_id
 from acld_gym.util.atomic import strict_json, write_json
 from acld_gym.util.stats import iqm_with_ci
-from acld_gym.util.validate import file_error
+from acld_gym.util.validate import DataFileError, file_error
 
 from ..bench.records import check_trial, read_json
 from ..bench.trials import agent_dir
@@ -170,7 +170,10 @@ def _agent_seed(folder: Path, rec: dict, env_id: str, episodes: int | None) -> d
     from ..agent import TrainedAgent
 
     where = agent_dir(folder, rec["name"], rec["seed"])
-    agent = TrainedAgent.load(where)
+    try:
+        agent = TrainedAgent.load(where)
+    except ValueError as exc:  # AgentFileError: names the file and the field
+        raise DataFileError(str(exc)) from None
     got = agent.metadata.get("env", {}).get("id")
     if got != env_id:
         raise file_error(where / "metadata.json", "env.id", f"expected {env_id}, got {got!r}")

@@ -13,7 +13,7 @@ environments); :mod:`acld_gym.thesis.table2` reproduces the thesis; :mod:`acld_g
 holds the tools.
 """
 
-from acld_gym.envs.presets import register_presets
+from acld_gym.envs.registration import register_presets
 
 __version__ = "0.20.0"
 

@@ -119,7 +119,7 @@ class BatchStep:
         self.scale_cost = (
             PassiveCost(passive_plant(nom, c), nom.output, self.steps, c.y_ref)
             if c.reward_scale == "passive"
-            else LQRCost(c, self.steps)
+            else LQRCost(c, self.steps, BatchStep)
             if c.reward_scale == "lqr"
             else None
         )

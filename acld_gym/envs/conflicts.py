@@ -30,7 +30,8 @@ import math
 import sys
 
 from acld_gym.envs.fixed import FixedSettings
-from acld_gym.envs.presets import PRESETS, check_env_id
+from acld_gym.envs.ids import PRESETS, check_env_id
+from acld_gym.envs.limits import PARAM_NOISE_MAX
 from acld_gym.envs.registration import make_limit, plain_spec
 from acld_gym.physics.loads import Harmonic, Samples, TipLoad, check_load_case
 from acld_gym.physics.temperature import T_REF
@@ -101,8 +102,6 @@ def check_consistent(config) -> None:
     each field valid) contradict each other: a temperature with a temperature range, a
     field its id set for another mesh, a load or random-load target the integration does
     not resolve."""
-    from acld_gym.envs.config import PARAM_NOISE_MAX
-
     c = config
     if c.temperature_range is not None and c.temperature != T_REF:
         raise ValueError(

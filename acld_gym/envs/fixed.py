@@ -12,28 +12,36 @@ stays settable where the env has a setter for it (the vector env: SB3's ``set_at
 from __future__ import annotations
 
 import dataclasses
-import functools
 
-__all__ = ["fixed_names", "FixedSettings"]
+__all__ = ["DERIVED", "fixed_names", "FixedSettings"]
 
 
-@functools.cache
-def fixed_names() -> frozenset[str]:
-    """The attributes fixed once an env is built: its configuration, every configuration
-    field (but ``load_case``), and what the env derived from them."""
-    from acld_gym.envs.config import EnvConfig  # (config.py's ConfigAttributes uses this)
+#: What an env derives from its configuration, fixed with it.
+DERIVED = frozenset(
+    {"nom", "harmonic_modes", "max_steps", "max_episode_steps", "horizon", "num_envs"}
+)
 
-    fields = {f.name for f in dataclasses.fields(EnvConfig)} - {"load_case"}
-    derived = {"nom", "harmonic_modes", "max_steps", "max_episode_steps", "horizon", "num_envs"}
-    return frozenset(fields | derived | {"config"})
+
+def fixed_names(config_class) -> frozenset[str]:
+    """The attributes fixed once an env of ``config_class`` (a dataclass:
+    :class:`acld_gym.envs.config.EnvConfig`) is built: its configuration, every field of
+    the configuration but ``load_case``, and what the env derived from them
+    (:data:`DERIVED`)."""
+    fields = {f.name for f in dataclasses.fields(config_class)} - {"load_case"}
+    return frozenset(fields | DERIVED | {"config"})
 
 
 class FixedSettings:
     """Mixin: after construction (once ``_batch`` is set), assigning an attribute of
-    :func:`fixed_names` raises ``AttributeError`` naming it."""
+    :attr:`FIXED_NAMES` raises ``AttributeError`` naming it. A subclass sets
+    :attr:`FIXED_NAMES` (:class:`acld_gym.envs.config.ConfigAttributes`:
+    ``fixed_names(EnvConfig)``)."""
+
+    #: The attributes fixed at construction (:func:`fixed_names`).
+    FIXED_NAMES: frozenset[str] = frozenset()
 
     def __setattr__(self, name: str, value) -> None:
-        if "_batch" in self.__dict__ and name in fixed_names():
+        if "_batch" in self.__dict__ and name in type(self).FIXED_NAMES:
             raise AttributeError(
                 f"{type(self).__name__}.{name} is fixed at construction (the env was built "
                 f"for it; a new value would be ignored or unchecked): make a new env with "

@@ -28,7 +28,9 @@ from types import FrameType
 from gymnasium.envs import registration as _gym_registration
 from gymnasium.envs.registration import EnvSpec
 
-__all__ = ["RegisteredSpec", "make_limit", "plain_spec"]
+from acld_gym.envs.ids import ENTRY_POINT, PRESETS, VECTOR_ENTRY_POINT, kwargs_steps
+
+__all__ = ["RegisteredSpec", "register_presets", "make_limit", "plain_spec"]
 
 #: The code of gymnasium's ``make`` and ``make_vec`` (the readers that apply a limit).
 _MAKERS = (_gym_registration.make.__code__, _gym_registration.make_vec.__code__)
@@ -37,7 +39,7 @@ _MAKERS = (_gym_registration.make.__code__, _gym_registration.make_vec.__code__)
 class RegisteredSpec(EnvSpec):
     """An :class:`gymnasium.envs.registration.EnvSpec` whose ``max_episode_steps`` is the
     step count of the episodes its ``kwargs`` give
-    (:func:`acld_gym.envs.presets.kwargs_steps`: 1000 for a registered id; a ``make_vec``
+    (:func:`acld_gym.envs.ids.kwargs_steps`: 1000 for a registered id; a ``make_vec``
     env's spec carries the keywords it was made with) for every reader except gymnasium's
     ``make`` and ``make_vec``, which see the spec's own limit (None for a registered id: the
     env truncates itself)."""
@@ -47,13 +49,30 @@ class RegisteredSpec(EnvSpec):
         limit = self.__dict__.get("_limit")
         if sys._getframe(1).f_code in _MAKERS:
             return limit
-        from acld_gym.envs.presets import kwargs_steps
-
         return kwargs_steps(self.kwargs, limit)
 
     @max_episode_steps.setter
     def max_episode_steps(self, value: int | None) -> None:
         self.__dict__["_limit"] = value
+
+
+def register_presets() -> None:
+    """Register every id of :data:`acld_gym.envs.ids.PRESETS` with gymnasium (once), with
+    its episode's step count as ``gym.spec(id).max_episode_steps`` for the tools that read
+    the registry. The env truncates itself after ``episode_length / dt`` steps, so
+    gymnasium's ``make`` and ``make_vec`` add no ``TimeLimit`` of that count
+    (:class:`RegisteredSpec`): ``gym.make``, ``make_vec`` and the SB3 adapter all follow
+    ``episode_length`` and ``dt``; ``max_episode_steps=`` can still shorten an episode (a
+    longer one is refused)."""
+    registry = _gym_registration.registry
+    for env_id, kwargs in PRESETS.items():
+        if env_id not in registry:
+            registry[env_id] = RegisteredSpec(
+                id=env_id,
+                entry_point=ENTRY_POINT,
+                vector_entry_point=VECTOR_ENTRY_POINT,
+                kwargs=dict(kwargs),
+            )
 
 
 def make_limit(frame: FrameType | None) -> int | None:

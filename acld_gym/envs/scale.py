@@ -40,6 +40,7 @@ import numpy as np
 
 from acld_gym.design.discrete import SampledSystem
 from acld_gym.envs.step import load_schedule
+from acld_gym.physics.actuator import V_LIMIT
 from acld_gym.physics.loads import TipLoad
 
 __all__ = ["REWARD_SCALES", "SCALE_FLOOR", "PassiveCost", "LQRCost"]
@@ -106,9 +107,12 @@ class LQRCost:
         episodes run on it without sensor noise, on its fixed plant (``param_noise`` and
         ``temperature_range`` off), observed through its observer's estimate.
     steps : T, steps per episode.
+    batch_step : the env's step, called as ``batch_step(config, num_envs, steps)``
+        (:class:`acld_gym.envs.batch.BatchStep`, which builds this cost for its
+        ``reward_scale="lqr"`` and passes itself: the episodes run on the env's own step).
     """
 
-    def __init__(self, config, steps: int):
+    def __init__(self, config, steps: int, batch_step):
         self.config = config.replace(
             reward_scale=None,
             observe_reward_scale=False,
@@ -118,6 +122,7 @@ class LQRCost:
             temperature_range=None,
         )
         self.steps = int(steps)
+        self.batch_step = batch_step
         nom = self.config.nominal()
         #: The law (:meth:`acld_gym.design.nominal.NominalDesign.lqr_law`) on the reduced
         #: state, decoded from the estimate observation as obs[:k] * xr_scale.
@@ -129,16 +134,13 @@ class LQRCost:
 
     def __call__(self, loads: list[TipLoad]) -> np.ndarray:
         """c of each load in ``loads`` (len(loads),), at least :data:`SCALE_FLOOR`."""
-        from acld_gym.envs.batch import BatchStep  # the env's own step (batch imports us)
-        from acld_gym.physics.actuator import V_LIMIT
-
         n = len(loads)
         if n == 0:
             return np.empty(0)
         size = 1 << (n - 1).bit_length()
         b = self._batches.get(size)
         if b is None:
-            b = self._batches[size] = BatchStep(self.config, size, self.steps)
+            b = self._batches[size] = self.batch_step(self.config, size, self.steps)
         padded = list(loads) + [loads[-1]] * (size - n)
         b.start_episodes(np.arange(size), padded, [None] * size, np.zeros((size, self.steps + 1)))
         k = self.xr_scale.shape[0]

@@ -41,7 +41,7 @@ from acld_gym.envs.config import (
 )
 from acld_gym.envs.conflicts import check_case, check_limit, made_spec
 from acld_gym.envs.episode import draw_episode, draw_noise, reset_options
-from acld_gym.envs.render import FigureOwner
+from acld_gym.envs.render import FigureOwner, render_frame
 from acld_gym.envs.step import INFO_KEYS
 from acld_gym.physics.actuator import V_LIMIT
 from acld_gym.physics.loads import case_load, thesis_load
@@ -263,8 +263,6 @@ class ACLDBeamVectorEnv(ConfigAttributes, FigureOwner, VectorEnv):
         if self.render_mode is None:
             gym.logger.warn("render() called without render_mode; pass render_mode= to make_vec()")
             return None
-        from acld_gym.envs.render import render_frame
-
         frame, self._fig = render_frame(_EnvView(self, 0), self._fig)
         return frame
 

@@ -44,4 +44,6 @@ def test_what_stays_settable():
     sb3 = SB3VecEnv(num_envs=2)
     sb3.set_attr("load_case", 2)
     assert sb3.venv.load_case == 2
-    assert "load_case" not in fixed_names() and {"dt", "config"} <= fixed_names()
+    names = fixed_names(EnvConfig)
+    assert "load_case" not in names and {"dt", "config"} <= names
+    assert type(env.unwrapped).FIXED_NAMES == type(sb3.venv).FIXED_NAMES == names

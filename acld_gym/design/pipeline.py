@@ -19,7 +19,7 @@ import numpy as np
 from acld_gym.design.feedback import Feedback, lqr, passive, projected_weight, smc
 from acld_gym.design.observer import Observer, kalman_observer, thesis_observer
 from acld_gym.design.reduction import ReducedModel, schur_balanced_truncation
-from acld_gym.physics.model import BeamModel
+from acld_gym.physics.model import BeamModel, resolve
 from acld_gym.physics.plant import Plant, fe_plant
 
 __all__ = ["Design", "design", "REDUCED_ORDER", "DESIGN_ORDER"]
@@ -129,8 +129,6 @@ def design(
             raise ValueError("model_kwargs: give either a model or build_model keywords, not both")
         truth = fe_plant(model.params, model.mesh)
     elif model is None:
-        from acld_gym.physics.model import resolve
-
         truth = fe_plant(*resolve(**model_kwargs))
     else:
         raise ValueError(f"model must be a Plant, a BeamModel or None, got {type(model).__name__}")

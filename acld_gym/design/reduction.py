@@ -61,6 +61,7 @@ from acld_gym.design.numerics import (
     lyap_controllability,
     lyap_observability,
 )
+from acld_gym.physics.interop import statespace
 
 __all__ = [
     "ReducedModel",
@@ -237,8 +238,6 @@ class ReducedModel:
     def to_statespace(self):
         """The reduced model as a ``control.StateSpace`` (inputs voltage [V] and, when
         the reduction kept it, tip load [N]; :mod:`acld_gym.physics.interop`)."""
-        from acld_gym.physics.interop import statespace
-
         return statespace(self.A, self.B, self.E, self.C, f"reduced-{self.order}")
 
     @property

@@ -64,7 +64,7 @@ WHY = np.array(TERMINATED_BY, dtype=object)
 def _dgemm():
     """scipy's BLAS ``dgemm`` as a capsule for the compiled step (None if unavailable)."""
     try:
-        from scipy.linalg.cython_blas import __pyx_capi__
+        from scipy.linalg.cython_blas import __pyx_capi__  # guarded: None if unavailable
     except ImportError:  # pragma: no cover - scipy is a dependency
         return None
     return __pyx_capi__.get("dgemm")

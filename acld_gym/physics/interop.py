@@ -28,7 +28,7 @@ def statespace(
     states: list[str] | None = None,
 ):
     """``control.ss`` of ``x' = A x + B V + E f``, ``y = C x`` (without E: voltage only)."""
-    import control
+    import control  # python-control takes ~2.7 s to import: only a conversion needs it
 
     Bm = np.hstack([B, E]) if E is not None and E.size else B
     inputs = list(INPUTS[: Bm.shape[1]])

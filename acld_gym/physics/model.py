@@ -24,6 +24,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from acld_gym.physics.assembly import AssembledTerms, DofMap, assemble_terms, number_dofs
+from acld_gym.physics.interop import statespace
 from acld_gym.physics.params import PRESETS, BeamParameters, Mesh, split_overrides
 
 __all__ = [
@@ -141,8 +142,6 @@ class BeamModel:
     def to_statespace(self):
         """The model as a ``control.StateSpace`` (inputs voltage [V] and tip load [N],
         output tip deflection [m]; :mod:`acld_gym.physics.interop`)."""
-        from acld_gym.physics.interop import statespace
-
         A, B, E, C = self.state_space()
         return statespace(A, B, E, C, "beam")
 

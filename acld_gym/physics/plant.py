@@ -60,6 +60,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from acld_gym.physics.elements import PIEZO_COEFFICIENT, TERM_COEFFICIENTS
+from acld_gym.physics.interop import statespace
 from acld_gym.physics.model import (
     ParametricModel,
     first_order,
@@ -148,8 +149,6 @@ class Plant:
 
     def to_statespace(self, params: BeamParameters | None = None):
         """The plant as a ``control.StateSpace`` (:mod:`acld_gym.physics.interop`)."""
-        from acld_gym.physics.interop import statespace
-
         A, B, E, C = self.state_space(params)
         return statespace(A, B, E, C, f"plant-{self.name}")
 

@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from acld_gym.physics.elements import TERM_COEFFICIENTS
+from acld_gym.physics.krylov import REFINEMENT, build_converged_plant
 from acld_gym.physics.params import BeamParameters
 from acld_gym.physics.plant import Plant
 from acld_gym.util.atomic import write_atomic
@@ -237,8 +238,6 @@ def cached(params: BeamParameters, dt: float, refinement: int, build: Callable[[
 
 def main() -> int:
     """Regenerate the shipped default plant file (and remove stale ones)."""
-    from acld_gym.physics.krylov import REFINEMENT, build_converged_plant
-
     params, dt = BeamParameters(), 1e-3
     path = SHIPPED_DIR / _filename(key(params, dt, REFINEMENT))
     for old in SHIPPED_DIR.glob("plant-converged-*.npz"):

@@ -56,6 +56,7 @@ from dataclasses import replace
 import numpy as np
 
 from acld_gym.physics.params import BeamParameters
+from acld_gym.util.validate import check_real
 
 __all__ = [
     "T_REF",
@@ -120,8 +121,6 @@ def shift_factor(T: float) -> float:
 
 def check_temperature(name: str, T) -> float:
     """``T`` as a float in :data:`TEMPERATURE_RANGE` [°C]; ``ValueError`` naming ``name``."""
-    from acld_gym.util.validate import check_real
-
     lo, hi = TEMPERATURE_RANGE
     return check_real(name, T, lo, hi, unit="°C")
 

@@ -15,7 +15,8 @@ import numpy as np
 from acld_gym.design.pipeline import design
 from acld_gym.design.simulate import simulate
 from acld_gym.physics.loads import THESIS_CASES, thesis_load
-from acld_gym.physics.params import PRESETS
+from acld_gym.physics.params import PRESETS, parameter_table
+from acld_gym.thesis.mesh_study import format_mesh_report, mesh_report
 from acld_gym.thesis.metrics import peak
 from acld_gym.thesis.reproduce import CONTROLLERS, T_END, format_table2, run_cases
 from acld_gym.util.atomic import check_directory, check_writable, write_files, write_json
@@ -47,7 +48,11 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     plots = Path(args.plots) if args.plots else None
     files: dict[Path, bytes] = {}  # every output, written at the end all or none
     if plots is not None:
-        from acld_gym.thesis.plots import plot_frequency_response, plot_hankel, plot_response
+        from acld_gym.thesis.plots import (  # matplotlib (~0.3 s): only --plots draws
+            plot_frequency_response,
+            plot_hankel,
+            plot_response,
+        )
 
         plot_hankel(plots / "hankel_singular_values.png", d, files)
         plot_frequency_response(plots / "frequency_response.png", d, files)
@@ -118,8 +123,6 @@ def cmd_model(args: argparse.Namespace) -> int:
 
 
 def cmd_mesh(args: argparse.Namespace) -> int:
-    from acld_gym.thesis.mesh_study import format_mesh_report, mesh_report
-
     t0 = time.perf_counter()
     rep = mesh_report()
     print(format_mesh_report(rep))
@@ -131,8 +134,6 @@ def cmd_mesh(args: argparse.Namespace) -> int:
 
 
 def cmd_params(args: argparse.Namespace) -> int:
-    from acld_gym.physics.params import PRESETS, parameter_table
-
     print(parameter_table(PRESETS[args.preset]()))
     return 0
 

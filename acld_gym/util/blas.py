@@ -14,13 +14,13 @@ from __future__ import annotations
 
 from contextlib import contextmanager
 
+from threadpoolctl import threadpool_limits
+
 __all__ = ["one_blas_thread"]
 
 
 @contextmanager
 def one_blas_thread():
     """Limit BLAS (OpenBLAS, MKL, ...) to one thread inside the ``with`` block."""
-    from threadpoolctl import threadpool_limits
-
     with threadpool_limits(limits=1, user_api="blas"):
         yield

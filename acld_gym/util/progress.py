@@ -37,7 +37,7 @@ class Progress:
         self._bar = None
         self._running = False
         if not quiet and stream.isatty():
-            from tqdm import tqdm
+            from tqdm import tqdm  # only on a terminal: a core env runs without it
 
             self._bar = tqdm(
                 total=total, desc=desc, unit="stage", file=stream, leave=False, dynamic_ncols=True

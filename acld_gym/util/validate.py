@@ -5,12 +5,18 @@ types, quiet closed pipes, one BLAS thread, one line for a failed file operation
 
 from __future__ import annotations
 
+import argparse
+import errno
 import math
 import numbers
 import os
+import stat
 import sys
 
 import numpy as np
+
+from acld_gym.util.atomic import check_writable
+from acld_gym.util.blas import one_blas_thread
 
 __all__ = [
     "check_real",
@@ -122,7 +128,6 @@ def arg_type(kind: type, low=None, high=None, *, low_open: bool = False):
     """An argparse ``type=`` that parses ``kind`` (int or float) and applies
     :func:`check_int` / :func:`check_real` with these bounds: one validation for every
     command line of the package."""
-    import argparse
 
     def parse(text: str):
         try:
@@ -151,9 +156,6 @@ class closed_pipe_is_fine:  # noqa: N801 (a context manager used like a function
 
     def __exit__(self, kind, exc, tb) -> bool:
         if kind is not None and issubclass(kind, BrokenPipeError):
-            import os
-            import sys
-
             devnull = os.open(os.devnull, os.O_WRONLY)
             os.dup2(devnull, sys.stdout.fileno())
             return True
@@ -164,9 +166,7 @@ def check_figure_path(path, what: str = "--plot"):
     """``path`` if a figure can be written there: a format matplotlib writes by itself (from
     the suffix; none: PNG) and a writable place (:func:`acld_gym.util.atomic.check_writable`); else
     ``ValueError`` naming ``what``. Call it before computing the figure."""
-    from matplotlib.figure import Figure
-
-    from acld_gym.util.atomic import check_writable
+    from matplotlib.figure import Figure  # ~0.4 s to import: only a figure path needs it
 
     formats = set(Figure().canvas.get_supported_filetypes()) - {"pgf"}  # pgf needs LaTeX
     suffix = os.path.splitext(os.fspath(path))[1].lstrip(".").lower() or "png"  # save_figure's
@@ -206,16 +206,13 @@ def os_error_line(exc: OSError) -> str:
 def _stdout_full(exc: OSError) -> bool:
     """Whether ``exc`` is a full disk or file-size limit that stdout, a regular file, has
     reached (then stdout is pointed at the null device: the exit's flush adds no error)."""
-    import errno
-    import stat
-
     try:
         fd = sys.stdout.fileno()
         info = os.fstat(fd)
         if not stat.S_ISREG(info.st_mode):
             return False
         if exc.errno == errno.EFBIG:
-            import resource
+            import resource  # POSIX only (ImportError below: not POSIX)
 
             soft = resource.getrlimit(resource.RLIMIT_FSIZE)[0]
             full = soft != resource.RLIM_INFINITY and info.st_size >= soft
@@ -256,8 +253,6 @@ def run_main(main, prog: str | None = None) -> int:
     ``<prog>: error: <file>: <reason>``, and exit status 1 (2 for a damaged input, as for
     a bad argument); Ctrl-C (``KeyboardInterrupt``) is one line too, exit status 130 (the
     shell's 128 + SIGINT)."""
-    from acld_gym.util.blas import one_blas_thread
-
     with closed_pipe_is_fine(), one_blas_thread():
         try:
             status = main()

@@ -7,9 +7,16 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import gymnasium as gym
 import numpy as np
 
-from acld_gym.util.validate import check_int, check_real, shown
+from acld_gym.design.nominal import NominalDesign, nominal_design
+from acld_gym.envs.beam_env import ACLDBeamEnv
+from acld_gym.envs.config import EnvConfig, check_param_noise
+from acld_gym.envs.presets import check_env_id
+from acld_gym.physics.truth import MESHES
+from acld_gym.util.atomic import check_directory, check_writable
+from acld_gym.util.validate import check_choice, check_int, check_real, shown
 
 __all__ = [
     "MAX_HORIZON",
@@ -71,8 +78,6 @@ def flag(name: str, value) -> bool:
 
 
 def _dt_range() -> tuple[float, float]:
-    from acld_gym.envs.config import EnvConfig
-
     md = EnvConfig.__dataclass_fields__["dt"].metadata
     return md["low"], md["high"]
 
@@ -83,10 +88,6 @@ def nominal(owner: str, dt=None, nom=None, mesh=None):
     ``dt`` [s] (the env's range of control periods; default :data:`DEFAULT_DT`) and
     ``mesh`` (default ``"converged"``). With ``nom`` a ``dt`` or ``mesh`` that is not the
     design's is a conflict, refused naming both (it would be ignored)."""
-    from acld_gym.design.nominal import nominal_design
-    from acld_gym.physics.truth import MESHES
-    from acld_gym.util.validate import check_choice
-
     low, high = _dt_range()
     if dt is not None:
         dt = check_real("dt", dt, low, high, unit="s")
@@ -110,8 +111,6 @@ def nominal(owner: str, dt=None, nom=None, mesh=None):
 
 def design(nom, name: str = "nom"):
     """``nom`` if it is a :class:`acld_gym.design.nominal.NominalDesign`."""
-    from acld_gym.design.nominal import NominalDesign
-
     if not isinstance(nom, NominalDesign):
         raise ValueError(
             f"{name} must be a NominalDesign (acld_gym.design.nominal.nominal_design), "
@@ -134,13 +133,7 @@ def acld_env(env, name: str = "env", ids: bool = True):
     """The :class:`acld_gym.envs.beam_env.ACLDBeamEnv` under ``env`` (any Gymnasium
     wrapper), or (``ids``) made from ``env`` if it is one of this package's ids
     (:func:`acld_gym.envs.presets.check_env_id`, checked as data before ``gym.make``)."""
-    from acld_gym.envs.beam_env import ACLDBeamEnv
-
     if isinstance(env, str) and ids:
-        import gymnasium as gym
-
-        from acld_gym.envs.presets import check_env_id
-
         return gym.make(check_env_id(env, name)).unwrapped
     inner = getattr(env, "unwrapped", None)
     if not isinstance(inner, ACLDBeamEnv):
@@ -151,8 +144,6 @@ def acld_env(env, name: str = "env", ids: bool = True):
 
 def env_config(config, name: str = "config"):
     """``config`` if it is an :class:`acld_gym.envs.config.EnvConfig`."""
-    from acld_gym.envs.config import EnvConfig
-
     if not isinstance(config, EnvConfig):
         raise ValueError(f"{name} must be an EnvConfig, got {type(config).__name__}")
     return config
@@ -191,8 +182,6 @@ def outputs(files: dict, directories: dict | None = None) -> None:
     """A CLI's output paths, flag -> path (None: not asked for): each file writable, no two
     the same file, each directory usable (:mod:`acld_gym.util.atomic`); else ``ValueError``
     naming the flag. Call it before computing anything."""
-    from acld_gym.util.atomic import check_directory, check_writable
-
     seen: dict = {}
     for what, path in files.items():
         if path:
@@ -208,8 +197,6 @@ def outputs(files: dict, directories: dict | None = None) -> None:
 def param_noise(value, mesh: str, what: str = "--param-noise") -> float:
     """``value`` if it is a ``param_noise`` the env accepts on ``mesh``
     (:func:`acld_gym.envs.config.check_param_noise`), else ``ValueError`` naming ``what``."""
-    from acld_gym.envs.config import check_param_noise
-
     try:
         return check_param_noise(value, mesh)
     except ValueError as exc:

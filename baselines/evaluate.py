@@ -27,10 +27,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-from dataclasses import asdict
 from pathlib import Path
-
-import numpy as np
 
 from acld_gym import ENV_ID
 from acld_gym.benchmark import TEST_SETS
@@ -40,11 +37,14 @@ from acld_gym.physics.loads import THESIS_CASES
 from acld_gym.physics.truth import MESHES
 from acld_gym.thesis.table2 import thesis_row
 from acld_gym.util.atomic import check_directory, check_writable, save_figure, write_json
-from acld_gym.util.progress import Progress
 from acld_gym.util.text import plain, prog
 from acld_gym.util.validate import arg_type
 
+from .analysis.effort import settled_from
+from .analysis.score import format_scores, score_policies
+from .cases import episode_rows, evaluate, mean_rows
 from .marks import level_references, mark_labels
+from .policies import MPC_MISSING, default_policies, policies_for, policy_classes
 from .rollout import (  # the primitives, re-exported: their home is baselines.rollout
     Episode,
     EvalRow,
@@ -77,89 +77,6 @@ __all__ = [
     "check_score_episodes",
     "plot_episodes",
 ]
-
-
-def policy_classes() -> tuple:
-    """Passive, LQR, SMC and MPC; without MPC where its QP solver is not installed (a
-    core install: :data:`baselines.policies.MPC_MISSING`)."""
-    from .policies import LQRPolicy, MPCPolicy, PassivePolicy, SMCPolicy, mpc_available
-
-    return (PassivePolicy, LQRPolicy, SMCPolicy) + ((MPCPolicy,) if mpc_available() else ())
-
-
-def default_policies(mesh: str = "converged", dt: float = 1e-3) -> dict:
-    """Passive, LQR, SMC and MPC (:func:`policy_classes`) designed on the nominal ``mesh``
-    plant."""
-    return {cls.name: cls(dt=dt, mesh=mesh) for cls in policy_classes()}
-
-
-def policies_for(env) -> dict:
-    """Passive, LQR, SMC and MPC (:func:`policy_classes`) designed for ``env`` (its nominal
-    model and observation)."""
-    return {cls.name: cls.for_env(env) for cls in policy_classes()}
-
-
-def episode_rows(
-    policies: dict,
-    case,
-    seed: int = 0,
-    env_kwargs: dict | None = None,
-    episodes: dict | None = None,
-    progress: Progress | None = None,
-    episode: str = "",
-) -> list[EvalRow]:
-    """One episode of ``case`` (seeded: load, parameters, sensor noise) per policy, plus
-    the clairvoyant bound for the same load and plant; fills ``episodes`` if given and
-    reports each policy's episode to ``progress`` (labelled with ``episode``)."""
-    env = ACLDBeamEnv(load_case=case, **(env_kwargs or {}))
-    rows = []
-    for name, pol in policies.items():
-        if progress is not None:
-            progress.stage(f"case {case} · {name}{episode}")
-        ep = rollout(pol, env, seed=seed)
-        rows.append(metrics_row(case, name, ep))
-        if episodes is not None:
-            episodes[case, name] = ep
-    if progress is not None:
-        progress.stage(f"case {case} · bound{episode}")
-    env.reset(seed=seed)
-    ep = bound_episode(env)
-    rows.append(metrics_row(case, "bound", ep))
-    if episodes is not None:
-        episodes[case, "bound"] = ep
-    return rows
-
-
-def evaluate(
-    policies: dict | None = None,
-    cases=THESIS_CASES,
-    seed: int = 0,
-    env_kwargs: dict | None = None,
-    episodes: dict | None = None,
-    quiet: bool = True,
-) -> list[EvalRow]:
-    """Rows for every (case, policy) plus the bound; fills ``episodes`` if given; a
-    progress line on a terminal unless ``quiet``."""
-    if policies is None:
-        policies = policies_for(ACLDBeamEnv(**(env_kwargs or {})))
-    with Progress(len(cases) * (len(policies) + 1), "evaluate", quiet) as progress:
-        return [
-            row
-            for case in cases
-            for row in episode_rows(policies, case, seed, env_kwargs, episodes, progress)
-        ]
-
-
-def mean_rows(rows: list[EvalRow], case) -> list[EvalRow]:
-    """Per policy, the mean of each metric over ``rows`` (several episodes), labelled ``case``."""
-    out = []
-    for name in dict.fromkeys(r.policy for r in rows):
-        sub = [asdict(r) for r in rows if r.policy == name]
-        means = {
-            k: float(np.mean([d[k] for d in sub])) for k in sub[0] if k not in ("case", "policy")
-        }
-        out.append(EvalRow(case=case, policy=name, **means))
-    return out
 
 
 def format_legend(labels: dict) -> str:
@@ -195,7 +112,6 @@ def format_tables(rows: list[EvalRow]) -> str:
 
 def format_effort(rows: list[EvalRow]) -> list[str]:
     """The effort lines of one case's rows (:mod:`baselines.analysis.effort`)."""
-    from .analysis.effort import settled_from
 
     def num(x: float, width: int, prec: int, scale: float = 1.0) -> str:
         return f"{x * scale:{width}.{prec}f}" if math.isfinite(x) else "-".rjust(width)
@@ -267,8 +183,6 @@ def add_scores(
 ) -> dict:
     """Score ``policies`` on the test set of ``env_id`` (the first ``n_episodes``; 0:
     none), print the score table, and return ``{policy: score dict}`` for the JSON rows."""
-    from .analysis.score import format_scores, score_policies
-
     if n_episodes == 0:
         return {}
     scores = score_policies(
@@ -283,10 +197,11 @@ def add_scores(
 
 
 def plot_episodes(episodes: dict, directory: Path) -> None:
-    import matplotlib
+    """One figure per case of ``episodes`` ((case, name) -> Episode) in ``directory``."""
+    import matplotlib  # heavy to import (~0.3 s): only --plots draws
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # (the same)
 
     directory.mkdir(parents=True, exist_ok=True)
     for case in dict.fromkeys(c for c, _ in episodes):
@@ -349,8 +264,6 @@ def main(argv: list[str] | None = None) -> int:
     episodes: dict = {}
     policies = level_references(probe)
     if "mpc" not in policies:
-        from .policies import MPC_MISSING
-
         print(f"mpc skipped (and mpc_rig, mpc_oracle): {MPC_MISSING}")
     labels = mark_labels(policies)
     rows = evaluate(

@@ -18,6 +18,10 @@ tables of :mod:`baselines.evaluate` and :mod:`baselines.analyze` show
 
 from __future__ import annotations
 
+from .engineer import RigPolicy, engineer_policies
+from .oracle import PlantOracleMPC
+from .policies import mpc_available, policies_for
+
 __all__ = ["KINDS", "ENGINEER", "level_references", "marks_for", "mark_labels"]
 
 #: What each reference is, by name (the "what it is" column of the tables).
@@ -36,25 +40,18 @@ ENGINEER = "engineer's design"
 
 def level_references(env) -> dict:
     """Name -> policy (SB3 ``predict``) for ``env``'s level: passive, the thesis's LQR and
-    SMC and the nominal MPC (:func:`baselines.evaluate.policies_for`), the engineer's
+    SMC and the nominal MPC (:func:`baselines.policies.policies_for`), the engineer's
     designs (:func:`baselines.engineer.engineer_policies`) and, where the QP solver osqp is
     installed, the plant oracle ``mpc_oracle``. The bound is not a policy: the tables add
     it."""
-    from .evaluate import policies_for
-
     return {**policies_for(env), **marks_for(env)}
 
 
 def marks_for(env) -> dict:
     """The engineer's designs of ``env``'s level and, where osqp is installed, the plant
     oracle ``mpc_oracle``: the marks :func:`level_references` adds to the thesis's."""
-    from .engineer import engineer_policies
-    from .policies import mpc_available
-
     out = engineer_policies(env)
     if mpc_available():
-        from .oracle import PlantOracleMPC
-
         out[PlantOracleMPC.name] = PlantOracleMPC()
     return out
 
@@ -63,8 +60,6 @@ def mark_labels(policies: dict) -> dict:
     """Name -> what it is, for ``policies`` (name -> policy): :data:`KINDS` by name, the
     engineer's designs (:class:`baselines.engineer.RigPolicy`) as :data:`ENGINEER`, the
     bound too; anything else (a trained agent) left out."""
-    from .engineer import RigPolicy
-
     out = {}
     for name in [*policies, "bound"]:
         if isinstance(policies.get(name), RigPolicy):

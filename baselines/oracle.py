@@ -39,13 +39,16 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.linalg as sla
+import scipy.sparse as sp
 
 from acld_gym.design.discrete import convolution_matrix, impulse_response
 from acld_gym.envs.step import OBS_HIST, Y_SCALE
 from acld_gym.physics.actuator import V_LIMIT
 
 from . import arguments
+from .policies import MPC_MISSING, mpc_available
 from .qp import SETTINGS, solution
+from .rollout import bound_solution
 
 __all__ = ["PlantOracleMPC", "ClairvoyantReplay", "tip_measurement", "cost_to_go"]
 
@@ -138,8 +141,6 @@ class PlantOracleMPC:
         load_std: float = 1.0,
         load_tau: float | None = None,
     ):
-        from .policies import MPC_MISSING, mpc_available
-
         if not mpc_available():
             raise ImportError(MPC_MISSING)
         self.horizon, self.rho = arguments.horizon(horizon), arguments.positive("rho", rho)
@@ -194,8 +195,7 @@ class PlantOracleMPC:
         self._G = Theta.T @ Psi + LG.T @ LA
 
     def _solver(self):
-        import osqp
-        import scipy.sparse as sp
+        import osqp  # optional dependency: the extra acld-gym[baselines]
 
         H = self.horizon
         rows = [sp.identity(H, format="csc")]
@@ -266,8 +266,6 @@ class ClairvoyantReplay:
     observation_fingerprint = None
 
     def start_episode(self, env) -> None:
-        from .rollout import bound_solution
-
         sol, _ = bound_solution(env)
         d = int(env.unwrapped.config.actuator_delay)
         self._commands = np.append(sol.voltage[d:], np.zeros(d)).astype(np.float32)

@@ -13,7 +13,9 @@ for an env with ``LQRPolicy.for_env(env)`` (or pass ``mesh=``); its
 
 The parts: the common plumbing in :mod:`baselines.policy_base`, the MPCs in
 :mod:`baselines.mpc_policy`, the measurement-observation wrapper in
-:mod:`baselines.measurement_feedback`; every name is importable from here.
+:mod:`baselines.measurement_feedback`; every name is importable from here. A level's
+thesis references by name: :func:`policies_for` (an env's), :func:`default_policies` (a
+mesh's).
 """
 
 from __future__ import annotations
@@ -44,6 +46,9 @@ __all__ = [
     "mpc_available",
     "discrete_lqr_gain",
     "STATE_WEIGHT",
+    "policy_classes",
+    "default_policies",
+    "policies_for",
 ]
 
 
@@ -118,3 +123,22 @@ class SMCPolicy(_Policy):
         self.eps = float(eps)
         # the law itself is the continuous design's form (acld_gym.design.feedback)
         self.law = Feedback(a=self.a, s=self.s, c=self.c, eps=self.eps, name="smc")
+
+
+# --- the thesis's references of a level, by name ---------------------------------------
+def policy_classes() -> tuple:
+    """Passive, LQR, SMC and MPC; without MPC where its QP solver is not installed (a
+    core install: :data:`MPC_MISSING`)."""
+    return (PassivePolicy, LQRPolicy, SMCPolicy) + ((MPCPolicy,) if mpc_available() else ())
+
+
+def default_policies(mesh: str = "converged", dt: float = 1e-3) -> dict:
+    """Passive, LQR, SMC and MPC (:func:`policy_classes`) designed on the nominal ``mesh``
+    plant."""
+    return {cls.name: cls(dt=dt, mesh=mesh) for cls in policy_classes()}
+
+
+def policies_for(env) -> dict:
+    """Passive, LQR, SMC and MPC (:func:`policy_classes`) designed for ``env`` (its nominal
+    model and observation)."""
+    return {cls.name: cls.for_env(env) for cls in policy_classes()}

@@ -38,6 +38,9 @@ from acld_gym.physics.uncertainty import PARAM_NOISE_CLIP, RANDOMIZED
 from acld_gym.util.text import plain, prog
 from acld_gym.util.validate import arg_type, check_real
 
+from .analysis.linear import LinearLaw, ObserverLoop
+from .policies import LQRPolicy, MPCPolicy, SMCPolicy
+
 #: The largest ``--param-noise``: the range of the env's ``param_noise_max``
 #: (:class:`acld_gym.envs.config.EnvConfig`), within which every corner is a physical beam.
 PARAM_NOISE_LIMIT = EnvConfig.__dataclass_fields__["param_noise_max"].metadata["high"]
@@ -51,8 +54,6 @@ def closed_loop_matrix(
     """The loop's one-period map on ``[x, xhat]`` (module docstring): the observer loop of
     :class:`baselines.analysis.linear.ObserverLoop` with the law written on the prior
     estimate and the measurement, :math:`V = h_x^T \\hat x + h_y y`."""
-    from .analysis.linear import LinearLaw, ObserverLoop
-
     k = observer.n
     lc, C = observer.Lc[:, 0], observer.C[0]
     h = np.append(-(gain - (gain @ lc) * C), -(gain @ lc))  # V = h . [xhat, y]
@@ -123,8 +124,6 @@ def corner_study(nom: NominalDesign, policies: dict, param_noise: float) -> dict
 
 
 def main(argv: list[str] | None = None) -> int:
-    from .policies import LQRPolicy, MPCPolicy, SMCPolicy
-
     p = argparse.ArgumentParser(
         prog=prog("python -m baselines.robustness"),
         description=plain(__doc__),

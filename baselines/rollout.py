@@ -19,11 +19,14 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from acld_gym.design.discrete import impulse_response
 from acld_gym.envs.beam_env import ACLDBeamEnv
 from acld_gym.envs.fingerprint import fingerprint_differences, observation_fingerprint
 from acld_gym.envs.step import reward_of
 from acld_gym.thesis.metrics import max_abs, peak, settling_time
 from acld_gym.util.blas import one_blas_thread
+
+from .analysis.effort import effort, settled_from
 
 __all__ = [
     "Episode",
@@ -117,7 +120,7 @@ def bound_solution(env: ACLDBeamEnv):
     """The clairvoyant bound of ``env``'s current episode
     (:class:`baselines.bound.BoundSolution`: the amplifier's outputs, the commands
     ``actuator_delay`` periods late, and the tip), and the seconds it took to solve."""
-    from .bound import clairvoyant_bound
+    from .bound import clairvoyant_bound  # scipy.optimize (~0.25 s): only the bound needs it
 
     env = env.unwrapped
     plant, c = env.episode_plant, env.config
@@ -137,8 +140,6 @@ def bound_episode(env: ACLDBeamEnv) -> Episode:
     env's actuator inside: the delay shifts the impulse response, the lag is part of the
     sampled plant, the slew limit is a constraint (:func:`baselines.bound.clairvoyant_bound`).
     Its voltages are the patch's (the amplifier's output through the lag)."""
-    from acld_gym.design.discrete import impulse_response
-
     sol, spent = bound_solution(env)
     env = env.unwrapped
     plant, n = env.episode_plant, env.max_steps
@@ -153,8 +154,6 @@ def bound_episode(env: ACLDBeamEnv) -> Episode:
 
 
 def metrics_row(case, name: str, ep: Episode) -> EvalRow:
-    from .analysis.effort import effort, settled_from
-
     dt = float(ep.t[1] - ep.t[0]) if ep.t.size > 1 else float(ep.t[0])
     e = effort(ep.voltage, ep.y, dt, settled_from(case))
     return EvalRow(

@@ -29,6 +29,7 @@ from acld_gym.envs.presets import preset
 from acld_gym.physics.actuator import patch_capacitance
 from acld_gym.util.blas import one_blas_thread
 from acld_gym.util.progress import Progress
+from baselines.rollout import metrics_row, rollout
 
 from .compliance import ComplianceTest, compliance_test
 from .effort import Effort, effort, settled_from
@@ -105,8 +106,6 @@ class Analysis:
 
 
 def _case_record(policy, env_id: str, case, env_kwargs: dict, capacitance: float) -> dict:
-    from baselines.rollout import metrics_row, rollout
-
     env = gym.make(env_id, load_case=case, **env_kwargs)
     ep = rollout(policy, env, seed=0)
     row = metrics_row(case, "policy", ep)

@@ -55,6 +55,7 @@ from scipy.signal import fftconvolve
 import acld_gym  # noqa: F401  (registers the env ids)
 from acld_gym.physics.loads import thesis_load
 from acld_gym.util.validate import check_int, check_seed
+from baselines.rollout import check_compatible
 
 __all__ = ["Response", "PulseSuperposition", "causal_convolution"]
 
@@ -200,8 +201,6 @@ class PulseSuperposition:
         :class:`baselines.policies.MeasurementFeedback`, gets it back each step as from
         :func:`baselines.rollout.rollout`) in the loop under ``load`` (as many periods as
         it has values, at most ``n_steps``)."""
-        from baselines.rollout import check_compatible
-
         f = self._check_load(load)
         check_compatible(policy, self.env)
         own, gy = self.own_obs, self.g_y

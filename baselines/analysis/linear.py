@@ -303,7 +303,7 @@ def margins(loop: ObserverLoop, law: LinearLaw) -> dict:
       crossover onto -1 (python-control's value, which it signs negative when lead gets
       there first, taken in magnitude).
     """
-    import control
+    import control  # python-control takes ~2.7 s to import: only the margins need it
 
     A, b, cv, _ = loop.open_loop(law)
     dt = loop.plant.dt

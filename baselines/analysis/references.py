@@ -38,6 +38,8 @@ from acld_gym.envs.fingerprint import observation_fingerprint
 from acld_gym.physics.plant_cache import user_cache_dir
 from acld_gym.util.atomic import write_json
 from acld_gym.util.progress import Progress
+from baselines.policies import LQRPolicy, PassivePolicy
+from baselines.rollout import bound_episode, metrics_row, rollout
 
 __all__ = [
     "References",
@@ -81,9 +83,6 @@ KINDS = ("passive_ise", "lqr_ise", "bound_ise")
 def reference_episode(env, seed: int) -> tuple[float, float, float]:
     """``(passive ISE, the thesis LQR's ISE, the bound's ISE)`` of the episode ``seed`` of
     ``env``."""
-    from baselines.policies import LQRPolicy, PassivePolicy
-    from baselines.rollout import bound_episode, metrics_row, rollout
-
     passive, lqr = (
         metrics_row("test", cls.name, rollout(cls.for_env(env), env, seed=seed)).ise
         for cls in (PassivePolicy, LQRPolicy)

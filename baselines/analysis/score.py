@@ -32,6 +32,7 @@ import acld_gym
 from acld_gym.benchmark import TEST_SETS, EvaluationSet, evaluation_set
 from acld_gym.util.progress import Progress
 from acld_gym.util.stats import iqm_with_ci
+from baselines.rollout import metrics_row, rollout
 
 from .references import References, make_env, references
 
@@ -148,8 +149,6 @@ def policy_ises(
     label: str = "",
 ) -> np.ndarray:
     """The policy's ISE [m^2 s] on each episode of ``test`` (:func:`baselines.rollout.rollout`)."""
-    from baselines.rollout import metrics_row, rollout
-
     env = make_env(test, env_kwargs)
     out = np.empty(len(test.seeds))
     for i, s in enumerate(test.seeds):

@@ -23,7 +23,8 @@ loop on a plant: :func:`spectral_radius` (:mod:`baselines.engineer.loop`).
 from __future__ import annotations
 
 from .base import RigPolicy
-from .designs import DESIGNS, design_kwargs, engineer_policies
+from .designs import DESIGNS, design_kwargs
+from .level import engineer_policies
 from .loop import closed_loop, env_plant, spectral_radius
 from .lqg import DelayLQGPolicy
 from .model import RigModel, rig_model

@@ -38,6 +38,7 @@ from acld_gym.envs.step import OBS_HIST, Y_SCALE
 from acld_gym.physics.actuator import V_LIMIT
 
 from .. import arguments
+from .designs import design_kwargs
 from .model import RigModel, rig_model
 from .riccati import kalman_gain
 
@@ -105,8 +106,6 @@ class RigPolicy:
         """The policy for ``env`` (any wrapper): its nominal design and configuration, with
         the level's design parameters (:data:`baselines.engineer.designs.DESIGNS`;
         ``kwargs`` replace them)."""
-        from .designs import design_kwargs
-
         e = arguments.acld_env(env)
         return cls(e.nom, e.config, **(design_kwargs(e.nom, e.config) | kwargs))
 

@@ -1,5 +1,6 @@
 """Each level's engineer's design: the weights and the Kalman noise model, chosen offline
-(:mod:`baselines.engineer.tuning`), and :func:`engineer_policies`.
+(:mod:`baselines.engineer.tuning`); the policies built with them are
+:func:`baselines.engineer.level.engineer_policies`.
 
 * ``ACLDBeam-v1``, ``ACLDBeamLab-v1``: one plant (the nominal beam), so the filter's
   noise model is the load alone (``model_std`` 0: no model error to allow for); the
@@ -30,14 +31,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from baselines import arguments
-from baselines.policies import mpc_available
-
-from .lqg import DelayLQGPolicy
 from .model import rig_model
-from .mpc import ActuatorMPCPolicy
 
-__all__ = ["DESIGNS", "design_kwargs", "engineer_policies"]
+__all__ = ["DESIGNS", "design_kwargs"]
 
 #: Design parameters by env id: ``weight`` (of the deflection term; 1: the reward),
 #: ``model_std`` (the filter's model error for every state), ``mode_std`` (mode number ->
@@ -68,15 +64,3 @@ def design_kwargs(nom, config, design: dict | None = None) -> dict:
             mu[2 * i - 2 : 2 * i] = v
         d["model_std"] = mu
     return d
-
-
-def engineer_policies(env) -> dict:
-    """The engineer's references of ``env``'s level (any wrapper of an ``ACLDBeamEnv``),
-    name -> policy with SB3's ``predict``: ``"lqg"`` (:class:`DelayLQGPolicy`) and, where
-    the QP solver osqp is installed, ``"mpc_rig"`` (:class:`ActuatorMPCPolicy`), both with
-    the level's design (:data:`DESIGNS`). ``env`` may be one of this package's ids."""
-    env = arguments.acld_env(env)
-    out = {"lqg": DelayLQGPolicy.for_env(env)}
-    if mpc_available():
-        out["mpc_rig"] = ActuatorMPCPolicy.for_env(env)
-    return out

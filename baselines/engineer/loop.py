@@ -26,14 +26,14 @@ import numpy as np
 
 from acld_gym.design.discrete import SampledSystem
 
+from .. import arguments
+
 __all__ = ["closed_loop", "spectral_radius", "env_plant"]
 
 
 def env_plant(env) -> tuple[SampledSystem, np.ndarray]:
     """The current episode's sampled plant of ``env`` (any wrapper) and its tip row (the
     lag's state, if any, does not reach the tip)."""
-    from .. import arguments
-
     e = arguments.acld_env(env, ids=False)  # an env in an episode
     plant = e.episode_plant
     c = np.zeros(plant.Ad.shape[0])

@@ -39,7 +39,7 @@ class DelayLQGPolicy(RigPolicy):
     the plant part; as :func:`acld_gym.design.observer.discrete_kalman`), its sensor noise
     the level's ``sensor_noise``. Equivalent to applying the delay-free gain to the
     prediction :math:`\hat x_{k+d|k}`. ``for_env`` (and
-    :func:`~baselines.engineer.designs.engineer_policies`) take the level's noise model
+    :func:`~baselines.engineer.level.engineer_policies`) take the level's noise model
     from :data:`~baselines.engineer.designs.DESIGNS`, chosen offline on training episodes;
     on ``ACLDBeamHard-v1`` it is the design for the level's distribution of plants.
 

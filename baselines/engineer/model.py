@@ -46,6 +46,8 @@ from acld_gym.design.discrete import SampledSystem, discretize
 from acld_gym.design.nominal import NominalDesign
 from acld_gym.physics.actuator import V_LIMIT, with_amplifier
 
+from .. import arguments
+
 __all__ = ["RigModel", "rig_model", "shift_system"]
 
 
@@ -158,8 +160,6 @@ def shift_system(Ap: np.ndarray, bp: np.ndarray, d: int) -> tuple[np.ndarray, np
 def rig_model(nom: NominalDesign, config) -> RigModel:
     """The design model of ``config`` (:class:`acld_gym.envs.config.EnvConfig`) on the
     nominal design ``nom``: what the level's datasheet states, nothing of an episode."""
-    from .. import arguments
-
     arguments.matching("rig_model", arguments.design(nom), arguments.env_config(config))
     r = nom.design.reduced
     if config.amplifier_bandwidth is None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sp
 
 from acld_gym.design.feedback import THESIS_LQR_WEIGHT
 from acld_gym.physics.actuator import V_LIMIT
@@ -58,8 +59,6 @@ class _RateMPC(MPCPolicy):
     def set_terminal(self, S: np.ndarray, A: np.ndarray, b: np.ndarray) -> None:
         r"""Add the terminal cost :math:`x_{k+H}^T S x_{k+H}`, with
         :math:`x_{k+H} = A^H x + \Gamma_H u` (u in units of 120 V), to the QP."""
-        import scipy.sparse as sp
-
         H = self._setup[2]
         gam = np.empty((A.shape[0], H))
         Aj = np.eye(A.shape[0])
@@ -92,8 +91,6 @@ class _RateMPC(MPCPolicy):
         if self.slew is None:
             return super()._solver(i)
         if i not in self._solvers:
-            import scipy.sparse as sp
-
             P, _, H = self._setup
             D = sp.eye(H, format="csc") - sp.eye(H, k=-1, format="csc")
             prob = self._osqp.OSQP()

@@ -23,6 +23,10 @@ from acld_gym.benchmark import RESERVED_SEEDS
 from acld_gym.util.stats import iqm
 from acld_gym.util.validate import check_int
 
+from .. import arguments
+from ..policies import PassivePolicy
+from ..rollout import bound_episode
+from .designs import design_kwargs
 from .loop import env_plant, spectral_radius
 from .lqg import DelayLQGPolicy
 
@@ -52,13 +56,6 @@ def episode_ise(policy, env, seed: int) -> float:
 
 def _anchors(env, seeds) -> tuple[np.ndarray, np.ndarray]:
     """The passive beam's and the clairvoyant bound's ISE on each episode."""
-    from baselines.policies import PassivePolicy
-
-    try:
-        from baselines.rollout import bound_episode
-    except ImportError:  # before baselines.rollout
-        from baselines.evaluate import bound_episode
-
     passive = PassivePolicy.for_env(env)
     pas, bnd = [], []
     for s in seeds:
@@ -73,9 +70,6 @@ def search(env, candidates, n_episodes: int = 40, n_plants: int = 100) -> list:
     ones first, best first: a list of ``(iqm, radius, design)``. ``env`` is the level's
     env with ``load_case="random"``; a design is a dict of :data:`~baselines.engineer.
     designs.DESIGNS`' form."""
-    from .. import arguments
-    from .designs import design_kwargs
-
     e = arguments.acld_env(env, ids=False)  # an env in an episode
     n_episodes = check_int("n_episodes", n_episodes, 1, len(TRAINING_SEEDS))
     n_plants = check_int("n_plants", n_plants, 1, len(TRAINING_SEEDS))

@@ -19,16 +19,8 @@ from hypothesis import strategies as st
 from acld_gym.util.validate import run_main
 from train.leaderboard.cli import main
 from train.leaderboard.collect import merge, seed_stats, write_level
-from train.leaderboard.render import (
-    END,
-    GOAL_MARGIN,
-    START,
-    goal_lines,
-    page,
-    read_levels,
-    readme_block,
-    replace_block,
-)
+from train.leaderboard.readme import END, START, readme_block, replace_block
+from train.leaderboard.render import GOAL_MARGIN, goal_lines, page, read_levels
 from train.leaderboard.schema import CASES, EFFORT_CASES, check_level, empty_level, read_level
 
 ROOT = Path(__file__).resolve().parents[2]

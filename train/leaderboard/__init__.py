@@ -6,13 +6,14 @@
   thesis LQR per case, effort after settling) by the package's own evaluators;
 * :mod:`train.leaderboard.collect`: a level's references and a benchmark folder's agents,
   merged into its file with provenance;
-* :mod:`train.leaderboard.render`: the page ``docs/leaderboard.md`` and the README's
-  block, from the data alone;
+* :mod:`train.leaderboard.render`: the page ``docs/leaderboard.md``, from the data alone;
+* :mod:`train.leaderboard.readme`: the README's block, from the same data;
 * :mod:`train.leaderboard.cli`: ``python -m train.leaderboard collect|render``
   (``acld-gym leaderboard``).
 """
 
-from .render import COMMAND, END, START
+from .readme import END, START
+from .render import COMMAND
 from .schema import FORMAT, check_level, read_level
 
 __all__ = ["FORMAT", "check_level", "read_level", "START", "END", "COMMAND"]

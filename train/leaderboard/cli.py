@@ -118,7 +118,8 @@ def collect(args, parser: argparse.ArgumentParser, argv: list[str]) -> int:
 
 def render(args) -> int:
     """The ``render`` subcommand."""
-    from .render import page, read_levels, readme_block, replace_block
+    from .readme import readme_block, replace_block
+    from .render import page, read_levels
 
     levels = read_levels(args.results)
     page_path, readme = Path(args.page), Path(args.readme)

@@ -8,8 +8,8 @@ and the training time per seed; the three marks named (the engineer's best desig
 plant oracle, the clairvoyant bound); the goal line (does each algorithm's IQM reach the
 best engineer's score minus :data:`GOAL_MARGIN`, and how many seeds beat the thesis LQR and
 SMC on cases 1, 2 and the random loads); a table per seed; the machine and the commands
-that produced the data. :func:`readme_block` is the README's compact table, between
-:data:`START` and :data:`END`. Nothing is computed beyond reading and comparing the data's
+that produced the data (the README's compact table: :mod:`train.leaderboard.readme`).
+Nothing is computed beyond reading and comparing the data's
 numbers; every number has a fixed format, so the same data give the same bytes.
 """
 
@@ -23,26 +23,12 @@ from acld_gym.util.validate import file_error
 
 from .schema import CASES, EFFORT_CASES, read_level
 
-__all__ = [
-    "START",
-    "END",
-    "COMMAND",
-    "GOAL_MARGIN",
-    "README_ALGOS",
-    "read_levels",
-    "page",
-    "readme_block",
-    "replace_block",
-]
+__all__ = ["COMMAND", "GOAL_MARGIN", "read_levels", "marks", "goal_lines", "section", "page"]
 
-START = "<!-- leaderboard:start -->"
-END = "<!-- leaderboard:end -->"
 #: The command that regenerates the page and the README block.
 COMMAND = "python -m train.leaderboard render"
 #: The first goal of issue 67: an algorithm's IQM at least the best engineer's score minus this.
 GOAL_MARGIN = 0.02
-#: The README's algorithm columns: (name in the results, heading).
-README_ALGOS = (("ppo", "PPO"), ("sac", "SAC"), ("vrs", "random search"))
 ENGINEER = "engineer's design"
 ORACLE = "plant oracle"
 
@@ -262,54 +248,3 @@ def page(levels: dict[str, dict]) -> str:
     for env_id in PRESETS:
         lines += section(env_id, levels.get(env_id))
     return "\n".join(lines).rstrip("\n") + "\n"
-
-
-def readme_block(levels: dict[str, dict]) -> str:
-    """The README's block, markers included: per level the best engineer's, the plant
-    oracle's and each algorithm's IQM score ("not run" where there is no data)."""
-    heads = ["level", "best engineer", "plant oracle", *(h for _, h in README_ALGOS)]
-    rows = ["| " + " | ".join(heads) + " |", "|---" * len(heads) + "|"]
-    for env_id in PRESETS:
-        level = levels.get(env_id) or {"references": None, "agents": {}}
-        m = marks(level)
-        cells = [f"`{env_id}`"]
-        full = len(TEST_SETS[env_id].seeds)
-        for key in ("engineer", "oracle"):
-            v = m[key]
-            cells.append(
-                "not run"
-                if v is None
-                else f"{v[1]['score']['iqm']:.3f} (`{v[0]}`){_short(v[1]['score'], full)}"
-            )
-        for name, _ in README_ALGOS:
-            a = level["agents"].get(name)
-            cells.append(
-                "not run"
-                if a is None
-                else f"{a['iqm']['score']['iqm']:.3f} ({len(a['seeds'])} seeds)"
-                f"{_short(a['seeds'][0]['score'], full)}"
-            )
-        rows.append("| " + " | ".join(cells) + " |")
-    lead = (
-        "- **The leaderboard of every level** ([docs/leaderboard.md](docs/leaderboard.md), "
-        f"generated from `results/*.json` by `{COMMAND}`): score v2, the IQM on each "
-        "level's test set (passive 0, clairvoyant bound 1; an algorithm's is the IQM over "
-        "its seeds); every policy with its interval, ISE relative to the thesis LQR, effort "
-        "and training time is on the page."
-    )
-    return "\n".join([START, "", lead, "", *rows, "", END])
-
-
-def _short(score: dict, full: int) -> str:
-    """ " (reduced)" for a score on fewer episodes than the published test set's."""
-    return " (reduced)" if score["n_episodes"] < full else ""
-
-
-def replace_block(text: str, block: str, path: str | Path) -> str:
-    """``text`` with what lies between :data:`START` and :data:`END` (markers included)
-    replaced by ``block``; ``DataFileError`` naming ``path`` unless each marker is there
-    once, in order."""
-    if text.count(START) != 1 or text.count(END) != 1 or text.index(START) > text.index(END):
-        raise file_error(path, None, f"expected one {START} and one {END} after it")
-    head, rest = text.split(START)
-    return head + block + rest.split(END, 1)[1]

@@ -35,8 +35,8 @@ from pathlib import Path
 import gymnasium as gym
 
 import acld_gym
-from acld_gym.benchmark import TEST_SETS
 from acld_gym.envs.presets import check_env_id
+from acld_gym.test_sets import TEST_SETS
 from acld_gym.util.atomic import strict_json, write_json, write_text
 from acld_gym.util.text import plain, prog
 from acld_gym.util.validate import run_main

@@ -1,7 +1,7 @@
 """SAC's training speed with the package's n-step replay buffer
-(:class:`train.bench.buffers.FlatNStepReplayBuffer`) against stable-baselines3's own
+(:class:`train.core.buffers.FlatNStepReplayBuffer`) against stable-baselines3's own
 (``NStepReplayBuffer``), timed in the same run: one batch's sampling from a buffer the
-size of the SAC recipe's (``train/benchmark/sac.yaml``: 1M transitions of 64 sub-envs,
+size of the SAC recipe's (``train/recipes/sac.yaml``: 1M transitions of 64 sub-envs,
 5-step returns, batches of 2048), and the recipe's ``learn`` (collection + updates) for
 ``--timesteps`` env steps after ``learning_starts``, both buffers from the same seed (the
 two runs' parameters are compared: they must be equal, as tests/train/test_buffers.py
@@ -20,8 +20,8 @@ import numpy as np
 import torch
 from stable_baselines3.common.buffers import NStepReplayBuffer
 
-from train.bench.buffers import FlatNStepReplayBuffer
 from train.config import load_config
+from train.core.buffers import FlatNStepReplayBuffer
 
 SB3 = "SB3 NStepReplayBuffer"
 
@@ -95,7 +95,7 @@ def sample_ms(blocks: int = 20, batches: int = 50) -> dict[str, list[float]]:
 def learn(flat: bool, timesteps: int) -> tuple[float, dict]:
     """(env steps/s of the SAC recipe's ``learn`` after ``learning_starts``, its final
     parameters) with the flat buffer or SB3's own."""
-    from train.bench.sb3_train import make_model
+    from train.core.sb3_train import make_model
     from train.vec import make_vec_env
 
     cfg = load_config("sac")

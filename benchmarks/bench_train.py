@@ -1,6 +1,6 @@
 """Training throughput (env steps/s) of PPO on the native batched env through the SB3
 adapter vs SB3's ``SubprocVecEnv`` over single envs, with the PPO recipe
-(``train/benchmark/ppo.yaml``) on fewer sub-envs; both envs from the one factory,
+(``train/recipes/ppo.yaml``) on fewer sub-envs; both envs from the one factory,
 :func:`train.vec.make_vec_env`.
 
 Not a timed test: ``python benchmarks/bench_train.py [--timesteps 40960] [--n-envs 8]``.
@@ -35,7 +35,7 @@ def env_rate(backend: str, n_envs: int, steps: int) -> float:
 
 def train_rate(backend: str, n_envs: int, steps: int) -> float:
     """Env steps/s of PPO's ``learn`` (collection + updates) on the recipe's model."""
-    from train.bench.sb3_train import make_model
+    from train.core.sb3_train import make_model
     from train.vec import make_vec_env
 
     cfg = load_config("ppo")

@@ -18,7 +18,7 @@ measure it saves the trained agent with its ``NormalizeObservation`` statistics 
 instrumentation block, after training), then evaluates the deterministic actor (its mean,
 clipped to [-1, 1], times 120 V, on the observation slots ``ObserveModes`` keeps) on the
 plain env: thesis cases 1, 2, 3 (seed 0) and the held-out random set, divided by LQR's ISE
-(:mod:`train.bench.evaluate`).
+(:mod:`train.core.evaluate`).
 
 Needs ``pip install tyro tensorboard`` (the file's own imports). Not a test::
 
@@ -121,7 +121,7 @@ def main(argv=None) -> int:
     p.add_argument("--json", type=Path, default=None, help="write the figures here")
     own, flags = split_flags(list(sys.argv[1:] if argv is None else argv))
     args = p.parse_args(own)
-    from train.bench.evaluate import ise_rel_lqr
+    from train.core.evaluate import ise_rel_lqr
 
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)

@@ -5,8 +5,8 @@ Loads ``RUN/ACLDBeam-v1.zip`` (an rl-zoo3 log directory, e.g. ``logs/ppo/ACLDBea
 evaluates its deterministic actor on ``ACLDBeam-v1`` as registered (+/-120 V; the actor of
 the asymmetric policies never reads the training env's appended log reward scale): thesis
 cases 1, 2, 3 (seed 0) and the held-out random set, divided by LQR's ISE
-(:mod:`train.bench.evaluate`). With ``--validation N``, also its cost on the first ``N``
-validation loads (:func:`train.bench.evaluate.validation_cost`, disjoint from the held-out
+(:mod:`train.core.evaluate`). With ``--validation N``, also its cost on the first ``N``
+validation loads (:func:`train.core.evaluate.validation_cost`, disjoint from the held-out
 set) and LQR's there, by which the recipes' ``restarts`` choose between runs. Not a test::
 
     python -m rl_zoo3.train --algo ppo --env ACLDBeam-v1 --gym-packages acld_gym \\
@@ -41,13 +41,13 @@ def main(argv=None) -> int:
     args = p.parse_args(argv)
     from stable_baselines3 import PPO, SAC
 
-    from train.bench.evaluate import (
+    from train.core.evaluate import (
         ise_rel_lqr,
         lqr_validation_cost,
         validation_cost,
         validation_seeds,
     )
-    from train.bench.sb3_policies import SB3Policy
+    from train.core.sb3_policies import SB3Policy
 
     path = args.run / ("best_model.zip" if args.best else "ACLDBeam-v1.zip")
     if not path.is_file():

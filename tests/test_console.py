@@ -147,7 +147,7 @@ def test_the_python_m_forms_still_work(module, usage):
 def test_plain_turns_roles_literals_and_math_into_words():
     doc = (
         "Run :func:`~baselines.evaluate.rollout` on :class:`acld_gym.envs.ACLDBeamEnv`\n"
-        "(:mod:`baselines.marks`, :data:`the sets <acld_gym.benchmark.TEST_SETS>`): ``--json``\n"
+        "(:mod:`baselines.marks`, :data:`the sets <acld_gym.test_sets.TEST_SETS>`): ``--json``\n"
         "writes `rows`; :math:`V = -K \\hat x_r` with :math:`e^{\\pm 3\\sigma}`.\n\n"
         ".. math::\n\n    x^+ &= A_d x + B_d V, \\\\\n\n"
         "Examples::\n\n    python -m train.benchmark \\\n        --seeds 0\n\n"

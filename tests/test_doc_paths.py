@@ -9,7 +9,11 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
-PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md"))]
+#: The changelog is left out: it is history, naming each path as it was in its version.
+PAGES = [
+    ROOT / "README.md",
+    *sorted(p for p in (ROOT / "docs").rglob("*.md") if p.name != "changelog.md"),
+]
 #: Top-level directories of the repository whose paths the pages point at.
 _PATH = re.compile(
     r"(?<![\w./-])((?:acld_gym|baselines|train|benchmarks|studies|tests|docs|\.ci)"
@@ -30,12 +34,12 @@ def named_paths(text: str) -> set[str]:
 
 def test_named_paths_parser():
     text = (
-        "see `train/benchmark/ALGO.yaml` and `acld_gym/physics/data/plant-<hash>.npz`,\n"
+        "see `train/recipes/ALGO.yaml` and `acld_gym/physics/data/plant-<hash>.npz`,\n"
         "`python -m train.benchmark --out runs/x` and `tests/{a,b}.py`\n"
         "```bash\ncat train/nothing.yaml\n```\n"
     )
     assert named_paths(text) == {
-        "train/benchmark/*.yaml",
+        "train/recipes/*.yaml",
         "acld_gym/physics/data/plant-*.npz",
         "tests/*.py",
     }

@@ -15,7 +15,7 @@ ROOT = Path(__file__).resolve().parents[1]
 PACKAGES = ("acld_gym", "baselines", "train", "tests")
 ROLE = re.compile(r":(mod|func|class|meth|data|attr|exc):`~?([A-Za-z_][\w.]*)(?:\(\))?`")
 TEST_PATH = re.compile(r"(?<![\w/])tests/[\w/]+(?:\.py)?")
-#: Broken references in ``train/bench/`` (names of sibling modules, unqualified), left to
+#: Broken references in ``train/core/`` (names of sibling modules, unqualified), left to
 #: the change that owns that folder (issue 23's RL recipe). Strict both ways: a new broken
 #: reference fails, and so does one of these once it is mended and still listed here.
 PENDING: dict[str, set[str]] = {}

@@ -1,4 +1,4 @@
-"""acld_gym.benchmark: the published test sets are disjoint from every seed used to train or
+"""acld_gym.test_sets: the published test sets are disjoint from every seed used to train or
 select the shipped policies, and versioned per env id."""
 
 import itertools
@@ -7,11 +7,11 @@ import json
 import pytest
 
 import acld_gym
-from acld_gym.benchmark import RESERVED_SEEDS, TEST_SEEDS, TEST_SETS, EvaluationSet, evaluation_set
-from train.bench.evaluate import HELDOUT_SEEDS, OBJECTIVE_LOADS, validation_seeds
+from acld_gym.test_sets import RESERVED_SEEDS, TEST_SEEDS, TEST_SETS, EvaluationSet, evaluation_set
 from train.compare import AGENTS_DIR
+from train.core.evaluate import HELDOUT_SEEDS, OBJECTIVE_LOADS, validation_seeds
 
-#: The random search draws its episode seeds from [1_000_000, 2**31) (train.bench.search).
+#: The random search draws its episode seeds from [1_000_000, 2**31) (train.core.search).
 SEARCH_SEEDS = range(1_000_000, 2**31)
 
 

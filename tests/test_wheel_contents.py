@@ -56,8 +56,8 @@ def test_no_ablation_probe_speed_script_or_test_in_the_wheel(members):
 
 
 def test_the_recipes_are_in_the_wheel_and_only_they(members):
-    shipped = {m for m in members if m.startswith("train/benchmark/") and m.endswith(".yaml")}
-    in_tree = {f"train/benchmark/{p.name}" for p in (ROOT / "train/benchmark").glob("*.yaml")}
+    shipped = {m for m in members if m.startswith("train/recipes/") and m.endswith(".yaml")}
+    in_tree = {f"train/recipes/{p.name}" for p in (ROOT / "train/recipes").glob("*.yaml")}
     assert shipped == in_tree
     assert {Path(m).stem for m in shipped} >= RECIPES
 

@@ -10,8 +10,8 @@ import pytest
 import acld_gym  # noqa: F401  (registers the envs)
 from acld_gym.wrappers import UnitAction
 from tests.benchmark_scripts import load_script
-from train.bench.evaluate import lqr_validation_cost, validation_cost, validation_seeds
-from train.bench.sb3_policies import SB3Policy
+from train.core.evaluate import lqr_validation_cost, validation_cost, validation_seeds
+from train.core.sb3_policies import SB3Policy
 from train.voltage import VoltageMap
 
 zoo_eval = load_script("zoo_eval")

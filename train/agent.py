@@ -239,7 +239,7 @@ def linear_program(
     :class:`ActorProgram`, with ``theta = [w, b]`` and f the features of
     :math:`u = T^T z` (``transform`` T, identity if None): u itself (``features=None``) or
     ``"direction"``, :math:`[u/|u|, \log|u|]`. The teacher-free random search's actor
-    (:class:`train.bench.search.LinearDirectionActor`)."""
+    (:class:`train.core.search.LinearDirectionActor`)."""
     theta = np.asarray(theta, dtype=np.float64)
     w, b = theta[:-1, None], theta[-1:]
     if features not in (None, "direction"):

@@ -1,11 +1,11 @@
 """``python -m train.benchmark``: reinforcement learning from scratch on ACLDBeam, no teacher.
 
-Trains every algorithm (one YAML file each under ``train/benchmark/``: hyperparameters
+Trains every algorithm (one YAML file each under ``train/recipes/``: hyperparameters
 and a fixed env-step budget, the same for every seed) with every seed, from random
 initialisation, on the env's observation and reward only. Then evaluates each final
 policy deterministically through the env (+/-120 V, 1 ms, default Kalman observer):
 ISE / ISE_LQR on thesis cases 1, 2, 3 (seed 0) and on the held-out random set
-(``train.bench.evaluate.HELDOUT_SEEDS``). LQR, SMC, MPC and the clairvoyant bound are used
+(``train.core.evaluate.HELDOUT_SEEDS``). LQR, SMC, MPC and the clairvoyant bound are used
 only to normalise and report these numbers.
 
 Writes to ``--out`` (default ``runs/<env id>/benchmark``: runs on different levels never
@@ -31,7 +31,7 @@ Examples::
     python -m train.benchmark --env-id ACLDBeamLab-v1 --backend ray --num-cpus 2
 
 The recipes run unchanged on every registered id: a recipe's retry threshold is resolved
-on the level's own reference (:mod:`train.bench.threshold`). While it trains, each trial
+on the level's own reference (:mod:`train.core.threshold`). While it trains, each trial
 says a line per evaluation with its current validation score (``--quiet``: none), the
 threshold, and every retry with its reason, which its record keeps (``retries``).
 
@@ -57,10 +57,13 @@ from acld_gym.util.text import plain, prog
 from acld_gym.util.validate import DataFileError, arg_type, run_main
 
 from .agent_files import check_replaceable
-from .bench.evaluate import DEFAULT_ENV_ID
-from .bench.records import check_references, check_trial, read_json
-from .bench.report import markdown, plot_curves, summarize
-from .bench.trials import (
+from .cli import MAX_SEED, env_id_arg
+from .config import CONFIG_DIR, TrainConfig, config_path, read_config
+from .config_checks import check_buildable
+from .core.evaluate import DEFAULT_ENV_ID
+from .core.records import check_references, check_trial, read_json
+from .core.report import markdown, plot_curves, summarize
+from .core.trials import (
     DEFAULT_ALGOS,
     agent_dir,
     policy_program,
@@ -69,9 +72,6 @@ from .bench.trials import (
     run_trials,
     trial_path,
 )
-from .cli import MAX_SEED, env_id_arg
-from .config import CONFIG_DIR, TrainConfig, config_path, read_config
-from .config_checks import check_buildable
 
 __all__ = [
     "CONFIG_DIR",
@@ -99,7 +99,7 @@ def build_parser() -> argparse.ArgumentParser:
         nargs="+",
         default=None,
         metavar="NAME",
-        help=f"configs under train/benchmark/ (default: {' '.join(DEFAULT_ALGOS)})",
+        help=f"configs under train/recipes/ (default: {' '.join(DEFAULT_ALGOS)})",
     )
     p.add_argument(
         "--config",
@@ -187,7 +187,7 @@ def trial_workers(cpus_per_trial: int | None, num_cpus: int, address: str | None
     """The CPUs of a trial whose recipe has several runs (``--cpus-per-trial``): by default
     every one of ``--num-cpus`` (1 on a cluster, ``address``), so that such trials run one
     at a time and each seed's wall time is bounded by its own runs, whatever else the
-    command trains (a trial with one run takes one CPU, :func:`train.bench.trials.run_trials`).
+    command trains (a trial with one run takes one CPU, :func:`train.core.trials.run_trials`).
 
     Until acld-gym 0.14.0 the CPUs were shared among the command's trials: ``--algos ppo
     sac --seeds N`` gave each trial one, and a SAC seed that needs all four runs took about
@@ -218,7 +218,7 @@ def check_outputs(out: Path, trials: list[dict], backend: str, env_id: str) -> N
 
 def reusable(path: Path, trial: dict, out: Path) -> dict | None:
     """The record at ``path`` of ``trial`` (same name, seed, config, env id and evaluation)
-    if ``--resume`` may reuse it, else None. A damaged record (:func:`train.bench.records.
+    if ``--resume`` may reuse it, else None. A damaged record (:func:`train.core.records.
     check_trial`) or one whose agent folder no longer loads (:meth:`train.agent.
     TrainedAgent.load`) is said in one line and trained again."""
     if not path.is_file():
@@ -246,10 +246,10 @@ def reusable(path: Path, trial: dict, out: Path) -> dict | None:
 
 
 def resumed_references(env_id: str, out: Path, random_episodes: int, bound: bool) -> dict:
-    """The references of :func:`train.bench.evaluate.references`, cached in ``out``; a
-    damaged cache (:func:`train.bench.records.check_references`) is said in one line and
+    """The references of :func:`train.core.evaluate.references`, cached in ``out``; a
+    damaged cache (:func:`train.core.records.check_references`) is said in one line and
     computed again (and replaced)."""
-    from .bench.evaluate import references
+    from .core.evaluate import references
 
     path = out / f"references-{env_id}.json"
     if path.is_file():

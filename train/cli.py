@@ -1,9 +1,9 @@
 """``python -m train ALGO``: train one agent with the benchmark's recipe.
 
-``ALGO`` names a recipe under ``train/benchmark/`` (``ppo``, ``sac``, ``vrs``, ``ars``,
+``ALGO`` names a recipe under ``train/recipes/`` (``ppo``, ``sac``, ``vrs``, ``ars``,
 ``tqc``); ``--config`` gives another file of the same schema (:class:`train.config.TrainConfig`,
-e.g. an ablation or the opt-in DAgger start ``train/benchmark/ppo_dagger.yaml``). The run is
-exactly one trial of ``python -m train.benchmark`` (:func:`train.bench.trials.run_trial`: the
+e.g. an ablation or the opt-in DAgger start ``train/recipes/ppo_dagger.yaml``). The run is
+exactly one trial of ``python -m train.benchmark`` (:func:`train.core.trials.run_trial`: the
 same env factory, training and evaluation), so ``python -m train ppo --seed N`` gives the
 agent that ``python -m train.benchmark --algos ppo --seeds N`` saves in
 ``<out>/agents/ppo-sN``, bit for bit on one machine.
@@ -46,7 +46,7 @@ __all__ = [
     "MAX_SEED",
 ]
 
-#: The recipes ``python -m train`` knows by name (a file ``train/benchmark/<algo>.yaml``).
+#: The recipes ``python -m train`` knows by name (a file ``train/recipes/<algo>.yaml``).
 RECIPES = tuple(a for a in ALGOS if (CONFIG_DIR / f"{a}.yaml").is_file())
 #: Seeds: numpy's legacy seeding (used by SB3) takes integers below 2**32.
 MAX_SEED = 2**32 - 1
@@ -90,7 +90,7 @@ def build_parser() -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument(
-        "algo", choices=RECIPES, help="the algorithm (its recipe: train/benchmark/<algo>.yaml)"
+        "algo", choices=RECIPES, help="the algorithm (its recipe: train/recipes/<algo>.yaml)"
     )
     p.add_argument(
         "--config",
@@ -205,9 +205,9 @@ def main(argv: list[str] | None = None) -> int:
         check_replaceable(out)
     except ValueError as exc:
         parser.error(f"--out: {exc}")
-    from .bench.evaluate import eval_episodes, lqr_ise
-    from .bench.trials import run_trial, save_agent, trained_line
     from .config import TrainConfig
+    from .core.evaluate import eval_episodes, lqr_ise
+    from .core.trials import run_trial, save_agent, trained_line
 
     cfg = TrainConfig.from_dict(data)
     command = "python -m train " + " ".join(

@@ -40,7 +40,7 @@ from baselines.evaluate import (
     plot_episodes,
 )
 
-from .bench.evaluate import HELDOUT_SEEDS  # re-exported (defined with the other eval seeds)
+from .core.evaluate import HELDOUT_SEEDS  # re-exported (defined with the other eval seeds)
 
 __all__ = [
     "AGENTS_DIR",
@@ -242,8 +242,8 @@ def learning_curves_figure(agents: dict):
 
     from .agent import AgentFileError
     from .agent_files import read_curve
-    from .bench.evaluate import lqr_ise
-    from .bench.report import ratio_log_axis
+    from .core.evaluate import lqr_ise
+    from .core.report import ratio_log_axis
     from .figures import sparse_ratio_labels
 
     curves = {}

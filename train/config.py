@@ -1,11 +1,11 @@
-"""The one training configuration: a YAML file per recipe under ``train/benchmark/``
+"""The one training configuration: a YAML file per recipe under ``train/recipes/``
 (``ppo.yaml``, ``sac.yaml``, ``vrs.yaml``, the opt-in DAgger starts; a file of your own may
 be ``base: ppo`` and what it changes, :func:`read_config`; the research record's variants
 are in ``studies/ablations/``, not packaged), validated into a
 :class:`TrainConfig`. ``python -m train`` and ``python -m train.benchmark`` read the same
 files, build the same env (:func:`train.vec.make_vec_env`), train with the same function
-(:func:`train.bench.algos.train_algo`) and evaluate with the same evaluator
-(:mod:`train.bench.evaluate`)."""
+(:func:`train.core.algos.train_algo`) and evaluate with the same evaluator
+(:mod:`train.core.evaluate`)."""
 
 from __future__ import annotations
 
@@ -41,10 +41,10 @@ SB3_ALGOS = {
     "crossq": ("sb3_contrib", "CrossQ"),
     "ars": ("sb3_contrib", "ARS"),
 }
-#: Every algorithm: the random search ``vrs`` (:mod:`train.bench.search`) and the SB3 ones.
+#: Every algorithm: the random search ``vrs`` (:mod:`train.core.search`) and the SB3 ones.
 ALGOS = ("vrs", *SB3_ALGOS)
-#: The recipes: ``train/benchmark/<name>.yaml``.
-CONFIG_DIR = Path(__file__).resolve().parent / "benchmark"
+#: The recipes: ``train/recipes/<name>.yaml``.
+CONFIG_DIR = Path(__file__).resolve().parent / "recipes"
 RESIDUALS = (None, "lqr")
 
 
@@ -53,9 +53,9 @@ class SelectConfig:
     """Checkpoint selection on validation loads (``TrainConfig.select``), as SB3's
     ``EvalCallback`` keeps its best model: every ``every`` env steps from ``start`` on, and
     at the end, the deterministic policy runs ``episodes`` random loads of the validation
-    seeds (:func:`train.bench.evaluate.validation_seeds`, disjoint from the held-out test
+    seeds (:func:`train.core.evaluate.validation_seeds`, disjoint from the held-out test
     loads) and is scored by the env's reward per load
-    (:func:`train.bench.evaluate.validation_cost`: 1 for the passive beam); the run
+    (:func:`train.core.evaluate.validation_cost`: 1 for the passive beam); the run
     returns the best-scoring policy. Its env steps are not counted in the budget (they
     train nothing; the run records them); its time is in the training wall time. The
     learning curve follows the policy being trained (the average, with ``average``), the
@@ -119,7 +119,7 @@ def algo_class(algo: str):
 
 @dataclass(frozen=True)
 class TrainConfig:
-    """One training recipe (a YAML file under ``train/benchmark/``).
+    """One training recipe (a YAML file under ``train/recipes/``).
 
     Attributes
     ----------
@@ -140,16 +140,16 @@ class TrainConfig:
         ``VecNormalize`` keyword arguments (SB3 algorithms).
     model : dict
         The algorithm's keyword arguments (SB3: ``policy`` included; ``vrs``: the
-        fields of :class:`train.bench.search.RandomSearch`). SB3's ``learning_rate`` and
+        fields of :class:`train.core.search.RandomSearch`). SB3's ``learning_rate`` and
         ``clip_range``, and PPO's ``ent_coef``, may be ``{linear: [start, end]}``, linear
         in the progress from ``start`` to ``end`` (``ent_coef``: set before each update,
-        :func:`train.bench.sb3_train.ent_coef_schedule`); ``learning_rate`` also
+        :func:`train.core.sb3_train.ent_coef_schedule`); ``learning_rate`` also
         ``{linear: [start, end], warmup: w}``, scaled up from 0 over the first fraction
-        ``w`` of training (:class:`train.bench.sb3_train.LinearSchedule`);
+        ``w`` of training (:class:`train.core.sb3_train.LinearSchedule`);
         ``policy_kwargs.activation_fn`` is given by name.
     eval_points : int
         Learning-curve points (evaluations) over the budget, besides the one at step 0
-        (log-spaced, :class:`train.bench.evaluate.eval_schedule`).
+        (log-spaced, :class:`train.core.evaluate.eval_schedule`).
     whiten_steps : int
         SB3 algorithms: 0 (default) for none; else the agent first acts with its own
         initial (stochastic) policy for about this many env steps (whole vector steps,
@@ -165,7 +165,7 @@ class TrainConfig:
         (:class:`acld_gym.envs.sb3.SB3VecEnv`'s ``seed_group=2``), so the pair runs the
         same loads and sensor noise: common random numbers, for antithetic exploration
         (``policy_kwargs: {antithetic_noise: true}``,
-        :class:`train.bench.sb3_policies.SplitCriticPolicy`). Needs an even number of
+        :class:`train.core.sb3_policies.SplitCriticPolicy`). Needs an even number of
         sub-envs per load case. Default false: sub-env i gets ``seed + i``.
     env_kwargs : dict
         Options of the *training* env (fields of :class:`acld_gym.envs.config.EnvConfig`,
@@ -173,7 +173,7 @@ class TrainConfig:
         0.05``); the evaluation is always on the env id as registered. With
         ``observe_reward_scale`` (SB3 algorithms only: vrs's actor reads the whole
         observation) the whitening leaves the last entry (log c) alone and the policy must
-        drop it from its actor (:class:`train.bench.sb3_policies.AsymmetricCriticPolicy`).
+        drop it from its actor (:class:`train.core.sb3_policies.AsymmetricCriticPolicy`).
         vrs: its candidates' episodes run on them (with ``reward_scale`` and ``objective:
         return`` an episode's score is its scaled return).
     residual : str or None
@@ -202,17 +202,17 @@ class TrainConfig:
     restarts : int
         SB3 algorithms with ``select``: independent runs of ``timesteps`` each from fresh
         initialisations (the first with the trial's seed, the others with seeds derived
-        from it, :func:`train.bench.algos.restart_seeds`); the trial returns the run whose
+        from it, :func:`train.core.algos.restart_seeds`); the trial returns the run whose
         chosen check has the lowest validation cost (the same validation loads for all).
         The budget is ``restarts * timesteps`` (:attr:`budget`). Default 1: one run.
     restart_above : str, float or None
         With ``restarts`` > 1: a run is followed by the next only if its chosen check's
-        validation cost (:func:`train.bench.evaluate.validation_cost`) is above this:
+        validation cost (:func:`train.core.evaluate.validation_cost`) is above this:
         ``"<ratio> * <reference>"`` (e.g. ``"1.03 * lqg"``; a reference alone: ratio 1),
         the ratio times the reference's cost on the same validation loads of the level
         the run trains on (``lqg``, the level's engineer's LQG; ``lqr``, the thesis LQR;
         ``passive``), resolved before the first run
-        (:class:`train.bench.threshold.RestartRule`), so one recipe carries over to every
+        (:class:`train.core.threshold.RestartRule`), so one recipe carries over to every
         level; a bare number: an absolute cost of ``ACLDBeam-v1``, the level such numbers
         were calibrated on, refused on any other. The first run at or below it is
         returned, and if none is, the lowest; every retry is said, with its reason. Seeds
@@ -252,7 +252,7 @@ class TrainConfig:
             check_int(name, getattr(self, name), 1, most)  # most: what memory allows
         check_int("restarts", self.restarts, 1, 64)
         if self.restart_above is not None:
-            from .bench.threshold import RestartRule
+            from .core.threshold import RestartRule
 
             RestartRule.parse(self.restart_above)
             if self.restarts < 2:
@@ -449,7 +449,7 @@ class TrainConfig:
 
 
 def config_path(spec: str | Path) -> Path:
-    """The file of a config: a recipe name under ``train/benchmark/`` (``"ppo"``) or a
+    """The file of a config: a recipe name under ``train/recipes/`` (``"ppo"``) or a
     YAML path; ``FileNotFoundError`` naming both if there is none."""
     path = Path(spec)
     if not path.suffix:

@@ -1,7 +1,7 @@
 """Checks of a training config's algorithm settings, beyond the fields of
 :class:`train.config.TrainConfig` themselves: :func:`check_model`, the ``model:`` mapping
 (called by the config's validation: every key a keyword of the SB3 algorithm, or a field of
-:class:`train.bench.search.RandomSearch` for ``vrs``, every number in range), and
+:class:`train.core.search.RandomSearch` for ``vrs``, every number in range), and
 :func:`check_buildable`, the algorithm built once on its training env, which a command calls
 before it computes anything, so that a setting only the algorithm's own constructor reads (a
 policy's keyword argument, a schedule) fails in a second, not after the references."""
@@ -45,9 +45,9 @@ def check_model(cfg) -> None:
 
 
 def _check_vrs(model: dict) -> None:
-    """The ``model:`` of ``vrs``: fields of :class:`train.bench.search.RandomSearch`, whose
+    """The ``model:`` of ``vrs``: fields of :class:`train.core.search.RandomSearch`, whose
     own checks then apply (imported lazily: it imports the env)."""
-    from .bench.search import RandomSearch
+    from .core.search import RandomSearch
 
     known = sorted(f.name for f in fields(RandomSearch))
     unknown = sorted(str(k) for k in model if k not in known)
@@ -130,11 +130,11 @@ def check_buildable(cfg, env_id: str | None = None) -> None:
     settings) and drop it: ``ValueError`` naming the setting a constructor refuses, or a
     ``restart_above`` that does not apply to ``env_id`` (a bare number on another level
     than the one it was calibrated on,
-    :meth:`train.bench.threshold.RestartRule.check_level`). A second or two, no env step;
+    :meth:`train.core.threshold.RestartRule.check_level`). A second or two, no env step;
     call it before computing anything."""
     import acld_gym
 
-    from .bench.threshold import RestartRule
+    from .core.threshold import RestartRule
 
     env_id = env_id or acld_gym.ENV_ID
     rule = RestartRule.parse(cfg.restart_above)
@@ -143,7 +143,7 @@ def check_buildable(cfg, env_id: str | None = None) -> None:
     if cfg.algo == "vrs":  # RandomSearch is built by check_model; here its envs, one each
         _check_envs(cfg, env_id)
         return
-    from .bench.sb3_train import first_linear, make_model
+    from .core.sb3_train import first_linear, make_model
     from .vec import make_vec_env
 
     try:

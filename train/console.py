@@ -72,7 +72,7 @@ GROUPS: dict[str, dict[str, Command]] = {
             "train.benchmark", "train every recipe on several seeds and report them", "train"
         ),
         "report": Command(
-            "train.bench.report", "the benchmark's tables and curves from its results", "train"
+            "train.core.report", "the benchmark's tables and curves from its results", "train"
         ),
         "sweep": Command(
             "train.sweep", "seeds x learning rates with Ray Tune (also acld-gym[sweep])", "sweep"

@@ -85,7 +85,7 @@ def hero_data(policies: dict, random_episodes: int = 20, env_kwargs: dict | None
     over the first ``random_episodes`` held-out random loads."""
     from baselines.evaluate import episode_rows
 
-    from .bench.evaluate import HELDOUT_SEEDS
+    from .core.evaluate import HELDOUT_SEEDS
 
     episodes: dict = {}
     ratios = {}

@@ -32,7 +32,7 @@ def actor_parts(model) -> tuple[Any, list, bool]:
     """The deterministic actor of an SB3 model as ``(features extractor, layers in order,
     squash)``: ``squash`` is True where SB3 applies a tanh after the last layer. One walk
     for :func:`export_sb3` and for folding a whitening into the first linear layer
-    (:func:`train.bench.sb3_train.fold_whitening`)."""
+    (:func:`train.core.sb3_train.fold_whitening`)."""
     import torch.nn as nn
 
     pol = model.policy

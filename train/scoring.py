@@ -4,12 +4,12 @@ A policy trained with any library on a level of this benchmark is scored the way
 package scores its own agents and references:
 
 * its **score** (score v2, :mod:`baselines.analysis.score`): the interquartile mean over
-  the level's published test set (:data:`acld_gym.benchmark.TEST_SETS`) of
+  the level's published test set (:data:`acld_gym.test_sets.TEST_SETS`) of
   :math:`(ISE_{passive} - ISE) / (ISE_{passive} - ISE_{bound})` per episode, with its 95 %
   bootstrap interval (passive 0, the clairvoyant bound 1);
 * its **ISE relative to the thesis LQR** (the thesis-facing view of ``python -m
-  train.compare``, :func:`train.bench.evaluate.ise_rel_lqr`): the thesis cases 1, 2, 3
-  (seed 0) and the held-out random loads (:data:`acld_gym.benchmark.HELDOUT_SEEDS`), the
+  train.compare``, :func:`train.core.evaluate.ise_rel_lqr`): the thesis cases 1, 2, 3
+  (seed 0) and the held-out random loads (:data:`acld_gym.test_sets.HELDOUT_SEEDS`), the
   mean ISE per case divided by the LQR's designed on the same level.
 
 The policy may be a stable-baselines3 model (with its ``VecNormalize`` statistics: the
@@ -37,14 +37,14 @@ import gymnasium as gym
 import numpy as np
 
 import acld_gym
-from acld_gym.benchmark import HELDOUT_SEEDS, evaluation_set
 from acld_gym.envs.presets import check_env_id
+from acld_gym.test_sets import HELDOUT_SEEDS, evaluation_set
 from acld_gym.util.validate import check_int, shown
 from baselines.analysis.references import make_env, references
 from baselines.analysis.score import SCORE_VERSION, Score, score_of
 from baselines.rollout import check_compatible, metrics_row, rollout
 
-from .bench.evaluate import eval_episodes, lqr_ise
+from .core.evaluate import eval_episodes, lqr_ise
 from .scoring_inputs import as_policy, check_fits, wrap
 
 __all__ = ["PolicyScore", "score", "policy_ise"]

@@ -53,7 +53,7 @@ def best_seed(out: str | Path, config: str) -> int:
         raise FileNotFoundError(
             f"no benchmark results {str(path)!r} (the --out of python -m train.benchmark)"
         )
-    from .bench.records import read_json
+    from .core.records import read_json
 
     data = read_json(path)  # (a DataFileError, a ValueError, naming it; at most 64 MiB read)
     algos = data.get("algorithms") if isinstance(data, dict) else None
@@ -151,7 +151,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         run = args.run
         if args.best is not None:
-            from .bench.trials import agent_dir
+            from .core.trials import agent_dir
 
             seed = best_seed(run, args.best)
             run = agent_dir(run, args.best, seed)

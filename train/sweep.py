@@ -29,7 +29,7 @@ THESIS = ("1", "2", "3")
 
 def score(rec: dict, lqr: dict) -> float:
     """Mean over the thesis cases of the final ISE / ISE_LQR of a trial record
-    (:func:`train.bench.trials.run_trial`); ``lqr``: ``{case: ise}``, keys as strings."""
+    (:func:`train.core.trials.run_trial`); ``lqr``: ``{case: ise}``, keys as strings."""
     missing = [c for c in THESIS if c not in rec.get("final_ise", {})]
     if missing:
         raise ValueError(f"the trial record has no final ISE on case(s) {missing}")
@@ -40,9 +40,9 @@ def trial(config: dict, out: str | Path) -> dict:
     """Train the recipe ``config["algo"]`` (overridden: seed, timesteps, optional
     learning_rate / n_envs) as one benchmark trial, save the agent in ``out``; returns
     ``{"ise_rel_lqr": score}`` (:func:`score`)."""
-    from .bench.evaluate import lqr_ise
-    from .bench.trials import run_trial, save_agent
     from .config import read_config
+    from .core.evaluate import lqr_ise
+    from .core.trials import run_trial, save_agent
 
     name, data = read_config(config["algo"])
     data = dict(data, timesteps=int(config["timesteps"]))
@@ -134,7 +134,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         from ray import tune
 
-        from train.bench.trials import init_ray
+        from train.core.trials import init_ray
     except ImportError:
         parser.error('Ray Tune is not installed: pip install -e ".[sweep]"')
     try:

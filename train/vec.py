@@ -155,7 +155,7 @@ class VecWhiten(VecEnvWrapper):
     r"""Observation ``z`` -> ``u = T^T z`` with a fixed matrix T (identity until
     :meth:`set_transform`). While ``collect`` is a list, the raw observation directions
     ``z/|z|`` seen (every sub-env, every step) are appended to it, from which
-    :func:`acld_gym.wrappers.whitening` estimates T (:func:`train.bench.sb3_train.train_sb3` with
+    :func:`acld_gym.wrappers.whitening` estimates T (:func:`train.core.sb3_train.train_sb3` with
     ``whiten_steps``)."""
 
     def __init__(self, venv: VecEnv, passthrough: int = 0):
@@ -280,7 +280,7 @@ def make_vec_env(
     per training load case a batched env of ``env_id`` with the config's ``env_kwargs``
     (sub-envs split as ``cfg.envs_per_load``), :class:`VecAgentEnv` with the config's
     ``residual``, ``action_headroom`` and ``shaping``, :class:`VecWhiten` if
-    ``cfg.whiten_steps`` (identity until :func:`train.bench.sb3_train.train_sb3` sets it),
+    ``cfg.whiten_steps`` (identity until :func:`train.core.sb3_train.train_sb3` sets it),
     direction features if ``cfg.features``, and ``VecNormalize`` with ``cfg.normalize``.
 
     ``backend="native"``: :class:`acld_gym.envs.sb3.SB3VecEnv` over ``gym.make_vec``;

@@ -1,4 +1,4 @@
-"""Aggregate statistics of the RL benchmark (``train.bench``) and of the policy score
+"""Aggregate statistics of the RL benchmark (``train.core``) and of the policy score
 (:mod:`baselines.analysis.score`): the interquartile mean (IQM) and 95 %
 stratified-bootstrap confidence intervals (Agarwal et al. 2021, as ``rliable`` 1.2.0
 computes them: IQM = 25 %-trimmed mean of all run x task scores; the bootstrap

@@ -24,9 +24,9 @@ import gymnasium as gym
 import numpy as np
 
 import acld_gym
-from acld_gym.benchmark import evaluation_set
 from acld_gym.envs.presets import preset
 from acld_gym.physics.actuator import patch_capacitance
+from acld_gym.test_sets import evaluation_set
 from acld_gym.util.blas import one_blas_thread
 from acld_gym.util.progress import Progress
 from baselines.rollout import metrics_row, rollout

@@ -1,7 +1,7 @@
 r"""The score's references on a test set: the passive beam's, the thesis LQR's and the
 clairvoyant bound's ISE per episode, computed once per test set and cached.
 
-For each episode of an :class:`acld_gym.benchmark.EvaluationSet` (its seed, through the env
+For each episode of an :class:`acld_gym.test_sets.EvaluationSet` (its seed, through the env
 as :func:`baselines.rollout.rollout` runs it) the references are the passive beam's ISE
 (:class:`baselines.policies.PassivePolicy`: score v2's 0), the thesis LQR's
 (:class:`baselines.policies.LQRPolicy` on the env's nominal design: the thesis-facing
@@ -33,9 +33,9 @@ import gymnasium as gym
 import numpy as np
 
 import acld_gym
-from acld_gym.benchmark import EvaluationSet
 from acld_gym.envs.fingerprint import observation_fingerprint
 from acld_gym.physics.plant_cache import user_cache_dir
+from acld_gym.test_sets import EvaluationSet
 from acld_gym.util.atomic import write_json
 from acld_gym.util.progress import Progress
 from baselines.policies import LQRPolicy, PassivePolicy

@@ -1,7 +1,7 @@
 r"""One number per policy, score v2: where it sits between the passive beam (0) and the
 clairvoyant bound (1).
 
-On each episode i of a published test set (:data:`acld_gym.benchmark.TEST_SETS`: random
+On each episode i of a published test set (:data:`acld_gym.test_sets.TEST_SETS`: random
 loads, seeds disjoint from training and model selection),
 
 .. math::
@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 import acld_gym
-from acld_gym.benchmark import TEST_SETS, EvaluationSet, evaluation_set
+from acld_gym.test_sets import TEST_SETS, EvaluationSet, evaluation_set
 from acld_gym.util.progress import Progress
 from acld_gym.util.stats import iqm_with_ci
 from baselines.rollout import metrics_row, rollout

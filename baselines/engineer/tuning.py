@@ -6,7 +6,7 @@ The search runs each candidate LQG (:class:`~baselines.engineer.lqg.DelayLQGPoli
 deflection weight and a Kalman noise model) on training episodes of the level -- random
 loads and, on a randomized level, plants drawn from the level's distribution (temperature,
 parameter scatter), reset with :data:`TRAINING_SEEDS`, a block disjoint from every test set
-(:data:`acld_gym.benchmark.RESERVED_SEEDS`) and from model selection's seeds -- and scores it
+(:data:`acld_gym.test_sets.RESERVED_SEEDS`) and from model selection's seeds -- and scores it
 as the fixed-anchor score does: per episode (ISE_passive - ISE) / (ISE_passive - ISE_bound),
 the interquartile mean over the episodes. A candidate is admissible when its small-signal
 loop is stable on every plant of the stability seeds, with a margin: a spectral radius at
@@ -19,7 +19,7 @@ import itertools
 
 import numpy as np
 
-from acld_gym.benchmark import RESERVED_SEEDS
+from acld_gym.test_sets import RESERVED_SEEDS
 from acld_gym.util.stats import iqm
 from acld_gym.util.validate import check_int
 
@@ -33,7 +33,7 @@ from .lqg import DelayLQGPolicy
 __all__ = ["TRAINING_SEEDS", "RADIUS_MARGIN", "episode_ise", "search", "grid"]
 
 #: The search's episodes: far from the test sets' reserved block and model selection's
-#: seeds (:mod:`acld_gym.benchmark`).
+#: seeds (:mod:`acld_gym.test_sets`).
 TRAINING_SEEDS = range(3_000_000, 3_000_100)
 assert not set(TRAINING_SEEDS) & set(RESERVED_SEEDS)
 

@@ -39,7 +39,7 @@ import torch
 from probe import one_run, run_recipe, seeds_main  # studies/probes/probe.py, beside this script
 
 from acld_gym.util.validate import check_real
-from train.bench.sb3_policies import AsymmetricCriticPolicy
+from train.core.sb3_policies import AsymmetricCriticPolicy
 
 
 class ScaledAdam(torch.optim.Adam):
@@ -97,7 +97,7 @@ class IsotropicActorPolicy(AsymmetricCriticPolicy):
 
 
 def config(eps: float = 0.1, lr_scale: float = 7.0, weight_decay: float = 0.0):
-    """``train/benchmark/ppo.yaml``'s config with :class:`IsotropicActorPolicy`, one run."""
+    """``train/recipes/ppo.yaml``'s config with :class:`IsotropicActorPolicy`, one run."""
     kwargs = {"actor_eps": eps, "actor_lr_scale": lr_scale, "actor_weight_decay": weight_decay}
     return one_run(IsotropicActorPolicy, kwargs, base="ppo")
 

@@ -11,7 +11,7 @@ This probe seeds sub-envs ``2i`` and ``2i + 1`` alike (``seed + i``; ``paired_lo
 :class:`train.config.TrainConfig`), so the pair draws the same loads and sensor noise
 episode after episode (the native batched env restarts every sub-env after its 1000
 steps), and gives the pair opposite gain noise, ``E`` and ``-E``, per rollout
-(``antithetic_noise`` of :class:`train.bench.sb3_policies.SplitCriticPolicy`). To first
+(``antithetic_noise`` of :class:`train.core.sb3_policies.SplitCriticPolicy`). To first
 order the pair's policy-gradient terms add up to ``(A+ - A-) (E u) u / sigma^2``: what the
 load does to both advantages cancels, as in the random search's difference of returns.
 Everything else is the recipe's, one run per seed (``studies/ablations/
@@ -36,14 +36,14 @@ import sys
 
 from probe import one_run, run_recipe, seeds_main  # studies/probes/probe.py, beside this script
 
-from train.bench.sb3_policies import AsymmetricCriticPolicy
+from train.core.sb3_policies import AsymmetricCriticPolicy
 
 #: PPO keyword arguments the command line may change (``--gamma`` etc.).
 MODEL_OPTIONS = ("gamma", "ent_coef", "clip_range")
 
 
 def config(pairs: bool = True, antithetic: bool = True, reward_scale: str = "passive", **model):
-    """``train/benchmark/ppo.yaml``'s config with the sub-envs seeded in pairs (``pairs``)
+    """``train/recipes/ppo.yaml``'s config with the sub-envs seeded in pairs (``pairs``)
     and antithetic gain noise (``antithetic``), one run; ``model`` replaces PPO keyword
     arguments, ``reward_scale`` the training env's (the recipe's ``"passive"``, or
     ``"lqr"``)."""

@@ -9,7 +9,7 @@ b_a)`` and ``beta = 1 + softplus(w_b' u + b_b)`` on the whitened observation ``u
 above 1: unimodal), the deterministic action its mean ``(alpha - beta) / (alpha + beta)``
 (:class:`BetaDistribution`, :class:`BetaActorPolicy`). The noise is drawn per step: a Beta
 has no counterpart of gSDE's noise on the gains. Everything else is the recipe's
-(``train/benchmark/ppo.yaml``: the asymmetric quadratic critic, whitening, reward per
+(``train/recipes/ppo.yaml``: the asymmetric quadratic critic, whitening, reward per
 load, entropy bonus, schedule), one run per seed.
 
 It prints one JSON line per seed: the run's validation cost and ISE / LQR on cases 1, 2, 3
@@ -37,7 +37,7 @@ import torch.nn.functional as F
 from probe import one_run, run_recipe, seeds_main  # studies/probes/probe.py, beside this script
 from stable_baselines3.common.distributions import Distribution
 
-from train.bench.sb3_policies import AsymmetricCriticPolicy
+from train.core.sb3_policies import AsymmetricCriticPolicy
 
 #: How far from 0 and 1 a sample of x is kept, so that its log-density stays finite.
 EDGE = 1e-6
@@ -100,7 +100,7 @@ class BetaActorPolicy(AsymmetricCriticPolicy):
 
 
 def config(ent_coef: float | None = None):
-    """``train/benchmark/ppo.yaml``'s config with :class:`BetaActorPolicy` and without gSDE,
+    """``train/recipes/ppo.yaml``'s config with :class:`BetaActorPolicy` and without gSDE,
     one run (``ent_coef``: the entropy coefficient, if not the recipe's)."""
     model = {} if ent_coef is None else {"ent_coef": float(ent_coef)}
     return one_run(BetaActorPolicy, drop=("use_sde", "sde_sample_freq", "log_std_init"), **model)

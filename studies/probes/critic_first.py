@@ -32,7 +32,7 @@ import sys
 
 from probe import one_run, run_recipe, seeds_main  # studies/probes/probe.py, beside this script
 
-from train.bench.sb3_policies import AsymmetricCriticPolicy
+from train.core.sb3_policies import AsymmetricCriticPolicy
 
 
 class CriticFirstPolicy(AsymmetricCriticPolicy):
@@ -67,7 +67,7 @@ class CriticFirstPolicy(AsymmetricCriticPolicy):
 
 
 def config(frozen_rollouts: int = 10, candidate: bool = False):
-    """``train/benchmark/ppo.yaml``'s config with :class:`CriticFirstPolicy`, one run
+    """``train/recipes/ppo.yaml``'s config with :class:`CriticFirstPolicy`, one run
     (``candidate``: with ``ablation_ppo_antithetic_ent_05.yaml``'s three changes)."""
     kwargs = {"frozen_rollouts": frozen_rollouts}
     if not candidate:

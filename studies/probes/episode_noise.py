@@ -1,7 +1,7 @@
 """A probe of the PPO recipe with gSDE's noise held for a whole episode (or any number of
 steps), as the random search holds each perturbation of its gains for whole episodes.
 
-The recipe (``train/benchmark/ppo.yaml``) draws gSDE's noise on the actor's gains, a matrix
+The recipe (``train/recipes/ppo.yaml``) draws gSDE's noise on the actor's gains, a matrix
 ``E ~ N(0, sigma^2)`` per sub-env, once per 64-step rollout, so a 1000-step episode sees
 about 16 draws. This probe draws ``eps ~ N(0, 1)`` per sub-env once per episode and acts
 with ``E = eps * sigma`` (``sigma`` the current one, so a PPO update still changes the noise
@@ -37,7 +37,7 @@ from probe import (  # studies/probes/probe.py
 )
 from torch.distributions import Normal
 
-from train.bench.sb3_policies import AsymmetricCriticPolicy, antithetic_pairs
+from train.core.sb3_policies import AsymmetricCriticPolicy, antithetic_pairs
 
 
 class EpisodeNoisePolicy(AsymmetricCriticPolicy):

@@ -10,7 +10,7 @@ script evaluates, for each of the n agents of benchmarks' output directories in 
 the mean law of it and its k - 1 successors (cyclically), and prints the IQM over the n
 groups next to the single agents' IQM (ISE / LQR on cases 1 / 2 / 3 / random on the env
 the agents were trained on, the benchmark's evaluation:
-:func:`train.bench.evaluate.batched_ise`). Not a test, and not a training recipe: an
+:func:`train.core.evaluate.batched_ise`). Not a test, and not a training recipe: an
 analysis of runs already made; a few seconds::
 
     python studies/probes/law_average.py DIR [DIR ...] [--algo ppo] --k 10
@@ -30,7 +30,7 @@ import numpy as np
 
 from acld_gym.util.stats import iqm
 from train.agent import ActorProgram, TrainedAgent
-from train.bench.evaluate import CASES, batched_ise, eval_episodes, lqr_ise, relative_ise
+from train.core.evaluate import CASES, batched_ise, eval_episodes, lqr_ise, relative_ise
 
 #: The actor program of a saturated linear law (:func:`train.agent.linear_program`; an
 #: exported SB3 actor has the first operation only: the program clips its output anyway).

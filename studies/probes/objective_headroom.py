@@ -20,10 +20,10 @@ sweeps ``--rho``.
 
 For LQR, the MPC at each ``--rho`` and each agent given, it prints one JSON line: the
 policy's cost on the random validation loads the recipes select their runs on
-(:func:`train.bench.evaluate.validation_cost`: the env's reward per load scaled by the
+(:func:`train.core.evaluate.validation_cost`: the env's reward per load scaled by the
 passive beam's, so passive 1 and lower is better; ``--loads``, default the recipes' 256)
 and its ISE / LQR on cases 1, 2, 3 and the held-out random loads
-(:func:`train.bench.evaluate.ise_rel_lqr`). Not a test, and not an agent; about 30 s per
+(:func:`train.core.evaluate.ise_rel_lqr`). Not a test, and not an agent; about 30 s per
 MPC on 256 loads::
 
     python studies/probes/objective_headroom.py --agents train/agents/vrs train/agents/ppo
@@ -44,7 +44,7 @@ import gymnasium as gym
 
 from baselines.policies import LQRPolicy, MPCPolicy
 from train.agent import TrainedAgent
-from train.bench.evaluate import (
+from train.core.evaluate import (
     CASES,
     DEFAULT_ENV_ID,
     eval_episodes,
@@ -73,7 +73,7 @@ def row(name: str, policy, env_id: str, seeds, episodes: dict, refs: dict) -> di
     """The JSON line of ``policy``: its validation cost on the loads of ``seeds`` and its ISE
     per case on ``episodes`` relative to ``refs`` (``{"lqr": LQR's ISE per case}``, both
     computed once for all rows), with the seconds both took; the ISE as
-    :func:`train.bench.evaluate.ise_rel_lqr` has it."""
+    :func:`train.core.evaluate.ise_rel_lqr` has it."""
     t0 = time.perf_counter()
     cost = validation_cost(policy, env_id, seeds)
     rel = relative_ise(rollout_ise(policy, env_id, episodes), refs)

@@ -63,7 +63,7 @@ class PairedRolloutBuffer(RolloutBuffer):
 
 
 def config():
-    """``train/benchmark/ppo.yaml``'s config, one run, with :class:`PairedRolloutBuffer`."""
+    """``train/recipes/ppo.yaml``'s config, one run, with :class:`PairedRolloutBuffer`."""
     return one_run(None, base="ppo", rollout_buffer_class=PairedRolloutBuffer)
 
 

@@ -56,7 +56,7 @@ class PhaseScaledRolloutBuffer(RolloutBuffer):
 
 
 def config():
-    """``train/benchmark/ppo.yaml``'s config, one run, with
+    """``train/recipes/ppo.yaml``'s config, one run, with
     :class:`PhaseScaledRolloutBuffer` and SB3's per-minibatch normalization off."""
     return one_run(
         None, base="ppo", rollout_buffer_class=PhaseScaledRolloutBuffer, normalize_advantage=False

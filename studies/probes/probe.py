@@ -9,9 +9,9 @@ and evaluated as the benchmark does (:func:`run_recipe`), and a command line pri
 JSON line per seed (:func:`seeds_main`).
 
 A run's line: its settings, its training wall time, its cost on 256 validation loads (the
-recipe's own check at the run's end, :func:`train.bench.evaluate.validation_cost`; LQR
+recipe's own check at the run's end, :func:`train.core.evaluate.validation_cost`; LQR
 0.535, the shipped random search 0.5129, the +/-120 V limit cycle ~1.94) and ISE / LQR on
-cases 1, 2, 3 and the held-out random loads (:func:`train.bench.evaluate.ise_rel_lqr`).
+cases 1, 2, 3 and the held-out random loads (:func:`train.core.evaluate.ise_rel_lqr`).
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ EPISODE_STEPS = 1000
 BASE = "ablation_ppo_independent"
 
 #: The configs a probe's ``--recipe`` may change: :data:`BASE`, or ``"ppo"``, acld-gym
-#: 0.15.0's recipe (``train/benchmark/ppo.yaml``).
+#: 0.15.0's recipe (``train/recipes/ppo.yaml``).
 RECIPES = (BASE, "ppo")
 
 #: The ablation configs: ``studies/ablations/``.
@@ -73,9 +73,9 @@ def run_recipe(
 ) -> dict:
     """Train one run of ``cfg`` (a :class:`train.config.TrainConfig`) for ``seed`` and
     evaluate it; ``make_env`` is the training env's factory if not the recipe's
-    (:func:`train.bench.sb3_train.train_sb3`); ``settings`` are reported after the seed."""
-    from train.bench.evaluate import ise_rel_lqr
-    from train.bench.sb3_train import train_sb3
+    (:func:`train.core.sb3_train.train_sb3`); ``settings`` are reported after the seed."""
+    from train.core.evaluate import ise_rel_lqr
+    from train.core.sb3_train import train_sb3
 
     t0 = time.perf_counter()
     factory = {} if make_env is None else {"make_env": make_env}

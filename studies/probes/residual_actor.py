@@ -4,7 +4,7 @@ The recipe's actor is linear on the whitened observation ``u = T' z``; its Gauss
 ``w' u + b``. This probe widens the actor's latent to ``[u, h(u)]`` with ``h`` a tanh MLP
 (``--hidden``, default one layer of 64), so the mean is ``w' u + v' h(u) + b``: the linear
 law plus a learned nonlinear correction, both from SB3's usual initialisation (the output
-layer's gain 0.01). Everything else is ``train/benchmark/ppo.yaml``'s (one run per seed: the
+layer's gain 0.01). Everything else is ``train/recipes/ppo.yaml``'s (one run per seed: the
 probe reports each run, failed ones too). gSDE draws its noise on the gains of the whole
 latent, ``[u, h]``, as it does on the recipe's ``u`` (``--noise latent``), or on the linear
 law's gains alone, the correction deterministic (``--noise linear``).
@@ -39,7 +39,7 @@ from probe import (  # studies/probes/probe.py, beside this script
 )
 from stable_baselines3.common.distributions import StateDependentNoiseDistribution
 
-from train.bench.sb3_policies import AsymmetricCriticPolicy
+from train.core.sb3_policies import AsymmetricCriticPolicy
 
 
 class Residual(nn.Module):
@@ -98,7 +98,7 @@ class ResidualActorPolicy(AsymmetricCriticPolicy):
 
     def fold_whitening(self, transform: np.ndarray) -> None:
         """Fold ``u = T' z`` into the residual module, so that the actor takes the raw
-        observation (:func:`train.bench.sb3_train.fold_whitening` calls it, in place of its
+        observation (:func:`train.core.sb3_train.fold_whitening` calls it, in place of its
         fold into a linear actor's first layer)."""
         net = self.mlp_extractor.policy_net
         with torch.no_grad():

@@ -11,7 +11,7 @@ studies/ablations/ablation_ppo_independent.yaml --seed S``; ``ppo`` for today's)
 shipped random-search law (``train/agents/vrs``) at fractions of that ``sigma``, on the same
 validation loads and the same noise draws for both (common random numbers; one gain draw per
 episode, where gSDE draws one per 64-step rollout). ``J`` is
-:func:`train.bench.evaluate.validation_cost`'s (the env's reward per load over the passive
+:func:`train.core.evaluate.validation_cost`'s (the env's reward per load over the passive
 beam's). Last it prints the cost of the trained law acting with its stochastic policy's
 expected action, ``E[clip(mu + eps)]`` at the trained ``sigma`` (:class:`_MeanActionLaw`), the
 other deterministic version of a clipped-Gaussian policy than the clipped mean the agents act
@@ -88,10 +88,10 @@ class _MeanActionLaw:
 
 
 def gain_noise_cost(W, b, dW, seeds, env_id: str = "ACLDBeam-v1") -> float:
-    """:func:`train.bench.evaluate.validation_cost` of the law ``(W + dW_n, b)`` on the
+    """:func:`train.core.evaluate.validation_cost` of the law ``(W + dW_n, b)`` on the
     random loads of ``seeds``, with the gain perturbation ``dW`` (n, d) of episode n (the
     episodes run side by side, sub-env n on load n)."""
-    from train.bench.evaluate import validation_cost
+    from train.core.evaluate import validation_cost
 
     seeds = [int(s) for s in seeds]
     dW = np.asarray(dW, float)
@@ -106,7 +106,7 @@ def main(argv=None) -> int:
     p.add_argument(
         "--config",
         default=BASE,
-        help="the PPO recipe (studies/ablations/NAME.yaml or train/benchmark/NAME.yaml; "
+        help="the PPO recipe (studies/ablations/NAME.yaml or train/recipes/NAME.yaml; "
         "default 0.8.0-0.14.0's)",
     )
     p.add_argument("--loads", type=int, default=256, help="validation loads")
@@ -120,8 +120,8 @@ def main(argv=None) -> int:
     )
     args = p.parse_args(argv)
     from train.agent import TrainedAgent, export_sb3
-    from train.bench.evaluate import validation_cost, validation_seeds
-    from train.bench.sb3_train import train_sb3
+    from train.core.evaluate import validation_cost, validation_seeds
+    from train.core.sb3_train import train_sb3
 
     pol, record = train_sb3(load_study_config(args.config), args.seed, "ACLDBeam-v1")
     T = np.asarray(record["transform"], float)

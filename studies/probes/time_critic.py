@@ -43,7 +43,7 @@ from probe import EPISODE_STEPS, one_run, run_recipe, seeds_main  # studies/prob
 from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 from stable_baselines3.common.vec_env import VecEnvWrapper, VecNormalize
 
-from train.bench.sb3_policies import DropLast, QuadraticFeatures, SplitCriticPolicy
+from train.core.sb3_policies import DropLast, QuadraticFeatures, SplitCriticPolicy
 from train.vec import VecWhiten, make_vec_env
 
 #: Time constants [s] of the critic's time basis b_k(r) = 1 - exp(-r T / tau_k).
@@ -97,7 +97,7 @@ def make_time_vec_env(cfg, seed: int, env_id: str):
 
 class TimeScaledQuadraticFeatures(BaseFeaturesExtractor):
     r"""Features :math:`b_k(r)\,[1, w, w w^T]` of the observation ``[u, log c, r]``,
-    :math:`w = u/\sqrt{c}` (``[w, w w^T]``: :class:`train.bench.sb3_policies.QuadraticFeatures`),
+    :math:`w = u/\sqrt{c}` (``[w, w w^T]``: :class:`train.core.sb3_policies.QuadraticFeatures`),
     for every k (:data:`TAUS`): each vanishes at r = 0."""
 
     def __init__(self, observation_space: spaces.Box):
@@ -132,7 +132,7 @@ class TimeCriticPolicy(SplitCriticPolicy):
 
 
 def config(gamma: float | None = None):
-    """``train/benchmark/ppo.yaml``'s config with :class:`TimeCriticPolicy`, one run."""
+    """``train/recipes/ppo.yaml``'s config with :class:`TimeCriticPolicy`, one run."""
     model = {} if gamma is None else {"gamma": gamma}
     return one_run(TimeCriticPolicy, drop=("critic_features",), **model)
 

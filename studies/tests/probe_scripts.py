@@ -21,7 +21,7 @@ def tiny_model(cfg, env_id: str = "ACLDBeam-v1", make_env=None):
     :func:`train.vec.make_vec_env`, if None), and the training env's observation width."""
     import dataclasses
 
-    import train.bench.sb3_train as sb3_train
+    import train.core.sb3_train as sb3_train
     from train.vec import make_vec_env
 
     cfg = dataclasses.replace(cfg, n_envs=4, model={**cfg.model, "batch_size": 256})

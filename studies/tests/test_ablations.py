@@ -47,7 +47,7 @@ def ablation(name: str) -> tuple[str, dict]:
 
 def test_there_are_ablations_and_no_recipe_among_them():
     assert len(NAMES) > 100
-    recipes = {p.stem for p in (Path(__file__).resolve().parents[2] / "train/benchmark").glob("*")}
+    recipes = {p.stem for p in (Path(__file__).resolve().parents[2] / "train/recipes").glob("*")}
     assert not recipes & set(NAMES)
     assert not any(n.startswith("ablation_") for n in recipes)
 

@@ -5,9 +5,9 @@ parameters are linear in the observation, and folding the whitening keeps the la
 import numpy as np
 import torch
 
-import train.bench.sb3_train as sb3_train
+import train.core.sb3_train as sb3_train
 from studies.tests.probe_scripts import load_probe, tiny_model
-from train.bench.sb3_policies import SB3Policy
+from train.core.sb3_policies import SB3Policy
 
 ba = load_probe("beta_actor")
 

@@ -20,7 +20,7 @@ def tiny(cfg):
 
 @pytest.mark.parametrize(("frozen", "candidate"), [(2, False), (0, False), (1, True)])
 def test_the_actor_waits_for_its_rollouts_while_the_critic_trains(monkeypatch, frozen, candidate):
-    from train.bench.sb3_train import train_sb3
+    from train.core.sb3_train import train_sb3
 
     moved = []
     train = PPO.train

@@ -12,7 +12,7 @@ import pytest
 import acld_gym
 from baselines.policies import LQRPolicy
 from studies.tests.probe_scripts import load_probe
-from train.bench.evaluate import validation_cost, validation_seeds
+from train.core.evaluate import validation_cost, validation_seeds
 
 oh = load_probe("objective_headroom")
 SEEDS = validation_seeds(4)

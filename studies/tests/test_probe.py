@@ -6,8 +6,8 @@ import json
 
 import pytest
 
-import train.bench.evaluate as evaluate
-import train.bench.sb3_train as sb3_train
+import train.core.evaluate as evaluate
+import train.core.sb3_train as sb3_train
 from studies.tests.probe_scripts import load_probe
 
 probe = load_probe("probe")

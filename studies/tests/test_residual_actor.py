@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 import torch
 
-import train.bench.sb3_train as sb3_train
+import train.core.sb3_train as sb3_train
 from studies.tests.probe_scripts import load_probe, tiny_model
-from train.bench.sb3_policies import SB3Policy
+from train.core.sb3_policies import SB3Policy
 
 ra = load_probe("residual_actor")
 

@@ -10,7 +10,7 @@ import pytest
 
 from studies.tests.probe_scripts import load_probe
 from train.agent import TrainedAgent
-from train.bench.evaluate import validation_cost, validation_seeds
+from train.core.evaluate import validation_cost, validation_seeds
 
 so = load_probe("smoothed_objective")
 

@@ -1,4 +1,4 @@
-"""The asymmetric actor-critic of the PPO recipe (train.bench.sb3_policies): the actor never
+"""The asymmetric actor-critic of the PPO recipe (train.core.sb3_policies): the actor never
 reads the privileged log(reward scale), the critic is exactly invariant to the scaling that
 leaves V/c unchanged, the trained actor exports onto the plain env's observation, and the
 recipe runs end to end on a tiny budget."""
@@ -10,7 +10,7 @@ import pytest
 import torch
 import yaml
 
-from train.bench.sb3_policies import AsymmetricCriticPolicy
+from train.core.sb3_policies import AsymmetricCriticPolicy
 
 
 def _model():
@@ -64,11 +64,11 @@ def test_actor_ignores_log_scale_and_critic_is_scale_invariant():
 
 
 def test_recipe_trains_and_exports_onto_the_plain_observation():
-    from train.bench.algos import train_algo
     from train.benchmark import policy_program
     from train.config import TrainConfig
+    from train.core.algos import train_algo
 
-    data = yaml.safe_load(open("train/benchmark/ppo.yaml"))
+    data = yaml.safe_load(open("train/recipes/ppo.yaml"))
     assert data["env_kwargs"] == {"reward_scale": "passive", "observe_reward_scale": True}
     data.update(timesteps=2048, n_envs=4, whiten_steps=256, eval_points=1)
     data["model"] = {**data["model"], "n_steps": 128, "batch_size": 256, "n_epochs": 1}
@@ -96,7 +96,7 @@ def test_env_kwargs_are_validated_by_the_env_config():
 def _sac_config(**policy_kwargs):
     from train.config import TrainConfig
 
-    data = yaml.safe_load(open("train/benchmark/sac.yaml"))
+    data = yaml.safe_load(open("train/recipes/sac.yaml"))
     data.update(n_envs=2)
     model = data["model"]
     data["model"] = {
@@ -111,7 +111,7 @@ def test_make_model_gives_the_sac_critic_the_configs_action_headroom():
     """The SAC critic reads the applied action, so it gets the env's action map: the
     config's ``action_headroom`` (3 in the recipe), once; a second, different value is
     refused by name."""
-    from train.bench.sb3_train import make_model, make_vec_env
+    from train.core.sb3_train import make_model, make_vec_env
 
     cfg = _sac_config()
     venv = make_vec_env(cfg, 0, "ACLDBeam-v1")
@@ -131,7 +131,7 @@ def test_make_model_gives_the_sac_critic_the_configs_action_headroom():
 def test_drop_last_drops_n_privileged_entries_and_predict_pads_them():
     from gymnasium import spaces
 
-    from train.bench.sb3_policies import DropLast, SB3Policy
+    from train.core.sb3_policies import DropLast, SB3Policy
 
     box = spaces.Box(-np.inf, np.inf, (5,), np.float32)
     x = torch.arange(10.0).reshape(2, 5)
@@ -155,7 +155,7 @@ def test_antithetic_noise_comes_in_pairs_and_needs_gsde(tmp_path):
     from stable_baselines3 import PPO
     from stable_baselines3.common.env_util import make_vec_env
 
-    from train.bench.sb3_policies import SplitCriticPolicy
+    from train.core.sb3_policies import SplitCriticPolicy
 
     venv = make_vec_env("ACLDBeam-v1", n_envs=4, env_kwargs={"episode_length": 0.05})
     kw = {"net_arch": {"pi": [], "vf": []}}
@@ -251,8 +251,8 @@ def test_the_sac_negative_critic_is_never_positive_and_saves(tmp_path):
     gives the same critic back."""
     from stable_baselines3 import SAC
 
-    from train.bench.sb3_policies import NegativeSquareForm
-    from train.bench.sb3_train import make_model, make_vec_env
+    from train.core.sb3_policies import NegativeSquareForm
+    from train.core.sb3_train import make_model, make_vec_env
 
     cfg = _sac_config(negative_critic=True)
     venv = make_vec_env(cfg, 0, "ACLDBeam-v1")

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from baselines.policies import LQRPolicy
-from train.bench import evaluate
+from train.core import evaluate
 
 EPISODES = {1: (0,), 3: (0,), "random": (100000, 100001, 100002)}
 

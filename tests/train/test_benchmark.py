@@ -10,7 +10,7 @@ import pytest
 import yaml
 
 from tests.train.tiny_sb3 import tiny_crossq
-from train.bench.stats import iqm, iqm_with_ci, stratified_bootstrap_ci
+from train.core.stats import iqm, iqm_with_ci, stratified_bootstrap_ci
 
 
 def test_iqm_drops_a_quarter_from_each_end():
@@ -48,10 +48,10 @@ def test_bootstrap_is_stratified_by_task():
 
 
 def _tiny_configs(tmp_path):
-    vrs = yaml.safe_load(open("train/benchmark/vrs.yaml"))
+    vrs = yaml.safe_load(open("train/recipes/vrs.yaml"))
     vrs.update(timesteps=8000, loads={1: 1, "random": 1}, eval_points=2)
     vrs["model"] = {**vrs["model"], "n_directions": 2, "top_directions": 1}
-    ppo = yaml.safe_load(open("train/benchmark/ppo.yaml"))
+    ppo = yaml.safe_load(open("train/recipes/ppo.yaml"))
     ppo.update(timesteps=2048, n_envs=4, eval_points=2, whiten_steps=256)
     ppo["model"] = {**ppo["model"], "n_steps": 256, "batch_size": 256, "n_epochs": 1}
     paths = []
@@ -142,10 +142,10 @@ def test_benchmark_runs_end_to_end(tmp_path, capsys):
     ],
 )
 def test_sb3_algorithms_train_and_act_in_volts(name, changes, model):
-    from train.bench.algos import train_algo
     from train.config import TrainConfig
+    from train.core.algos import train_algo
 
-    data = yaml.safe_load(open(f"train/benchmark/{name}.yaml"))
+    data = yaml.safe_load(open(f"train/recipes/{name}.yaml"))
     data.update(changes, eval_points=1)
     data["model"] = {**data["model"], **model}
     seen = []
@@ -164,12 +164,12 @@ def test_ppo_with_whitening_and_quadratic_critic():
     """The linear-quadratic PPO recipe's options on a tiny budget: the whitening is
     estimated from the agent's own first steps (counted in the budget) and folded into
     the final actor, which then takes the raw observation and exports as a plain actor."""
-    from train.bench.algos import train_algo
-    from train.bench.sb3_policies import SplitCriticPolicy
     from train.benchmark import policy_program
     from train.config import TrainConfig
+    from train.core.algos import train_algo
+    from train.core.sb3_policies import SplitCriticPolicy
 
-    data = yaml.safe_load(open("train/benchmark/ppo.yaml"))
+    data = yaml.safe_load(open("train/recipes/ppo.yaml"))
     data.update(timesteps=4000, n_envs=2, whiten_steps=1000, eval_points=1)
     data["model"] = {**data["model"], "n_steps": 500, "batch_size": 500, "n_epochs": 1}
     seen = []
@@ -198,8 +198,8 @@ def test_crossq_trains_and_exports_its_batch_renormalisation():
     deterministic ``predict`` (running statistics, not the batch's)."""
     from sb3_contrib.common.torch_layers import BatchRenorm
 
-    from train.bench.algos import train_algo
     from train.benchmark import policy_program
+    from train.core.algos import train_algo
 
     policy, record = train_algo(tiny_crossq(), 0, "ACLDBeam-v1")
     assert record["steps"] >= 1200 and record["transform"] is None
@@ -220,7 +220,7 @@ def test_whitening_needs_a_first_linear_layer():
     """The whitening folds into the actor's first Linear layer; CrossQ's actor starts with
     batch renormalisation, so a config asking for it fails before the whitening's env
     steps, naming the key."""
-    from train.bench.algos import train_algo
+    from train.core.algos import train_algo
 
     seen = []  # the learning curve's points: the first is due before the whitening
     with pytest.raises(TypeError, match="whiten_steps.*BatchRenorm"):
@@ -232,8 +232,8 @@ def test_fold_whitening_and_quadratic_features():
     import torch
     from stable_baselines3 import PPO, SAC
 
-    from train.bench.sb3_policies import QuadraticFeatures, SB3Policy
-    from train.bench.sb3_train import fold_whitening
+    from train.core.sb3_policies import QuadraticFeatures, SB3Policy
+    from train.core.sb3_train import fold_whitening
 
     feats = QuadraticFeatures(gym.spaces.Box(-1, 1, (3,)))
     x = torch.tensor([[1.0, 2.0, 3.0]])
@@ -258,7 +258,7 @@ def test_a_policy_with_its_own_fold_gets_the_whitening():
     else of it."""
     from types import SimpleNamespace
 
-    from train.bench.sb3_train import fold_whitening
+    from train.core.sb3_train import fold_whitening
 
     got = []
     model = SimpleNamespace(policy=SimpleNamespace(fold_whitening=got.append))
@@ -269,7 +269,7 @@ def test_a_policy_with_its_own_fold_gets_the_whitening():
 
 def test_whitening_and_actor():
     from acld_gym.wrappers import whitening
-    from train.bench.search import LinearDirectionActor
+    from train.core.search import LinearDirectionActor
 
     rng = np.random.default_rng(0)
     u = rng.normal(size=(5000, 3)) @ np.array([[1.0, 0.99, 0.0], [0.0, 0.1, 0.0], [0, 0, 2.0]])
@@ -287,7 +287,7 @@ def test_random_search_episodes_take_the_training_env_options():
     """vrs's candidates run on ``env_kwargs``: with ``reward_scale: passive`` the passive
     law (all gains 0) returns exactly -T on every load (acld_gym.envs.scale), where the
     env's own rewards do not."""
-    from train.bench.search import _CandidateEnvs
+    from train.core.search import _CandidateEnvs
 
     returns = {}
     for kwargs in ({}, {"reward_scale": "passive"}):
@@ -321,8 +321,8 @@ def test_a_multi_run_trial_takes_every_cpu_by_default(tmp_path, monkeypatch, fla
     """``--algos ppo sac --seeds N`` on 2 CPUs: each trial gets both (two runs at once, one
     trial after another), so a SAC seed of four runs keeps within the 15-min goal; the
     trials' own ``workers`` (``run_trials``) are ``min(this, restarts)``."""
-    import train.bench.evaluate as evaluate
     import train.benchmark as benchmark
+    import train.core.evaluate as evaluate
 
     seen = {}
 
@@ -410,20 +410,20 @@ def test_a_multi_run_trial_through_ray_runs_its_workers_quietly(tmp_path, capfd)
         (
             "vrs",
             0.90,
-        ),  # measured (train/benchmark/results-v1.json): seed 0 0.844, 5 seeds 0.83-0.85
+        ),  # measured (studies/results-v1.json): seed 0 0.844, 5 seeds 0.83-0.85
         ("ppo", 0.95),  # measured (results-v1.json): seed 0 0.834; 5 seeds 0.833-0.854
         ("sac", 0.95),  # measured (results-v1.json): seed 0 0.856; 5 seeds 0.839-0.885
     ],
 )
 def test_recipe_seed_on_case1(algo, bound):
-    """One seed of a teacher-free recipe (train/benchmark/<algo>.yaml, full budget) against
+    """One seed of a teacher-free recipe (train/recipes/<algo>.yaml, full budget) against
     LQR on case 1."""
-    from train.bench.algos import train_algo
-    from train.bench.evaluate import lqr_ise, rollout_ise
     from train.config import TrainConfig
+    from train.core.algos import train_algo
+    from train.core.evaluate import lqr_ise, rollout_ise
 
     env_id = "ACLDBeam-v1"
-    cfg = TrainConfig.from_dict(yaml.safe_load(open(f"train/benchmark/{algo}.yaml")))
+    cfg = TrainConfig.from_dict(yaml.safe_load(open(f"train/recipes/{algo}.yaml")))
     policy, record = train_algo(cfg, seed=0, env_id=env_id)
     eps = {1: (0,)}
     agent = rollout_ise(policy, env_id, eps)[1]

@@ -12,7 +12,7 @@ import yaml
 import acld_gym  # noqa: F401  (registers the env ids)
 from acld_gym.wrappers import whitening
 from train.agent import TrainedAgent, linear_program
-from train.bench.search import LinearDirectionActor
+from train.core.search import LinearDirectionActor
 
 
 def _observations(n=64, seed=0):
@@ -51,10 +51,10 @@ def test_benchmark_saves_shippable_agents(tmp_path, capsys):
     from train.compare import agent_names
     from train.ship import ship
 
-    vrs = yaml.safe_load(open("train/benchmark/vrs.yaml"))
+    vrs = yaml.safe_load(open("train/recipes/vrs.yaml"))
     vrs.update(timesteps=8000, loads={"random": 1}, eval_points=1)
     vrs["model"] = {**vrs["model"], "n_directions": 2, "top_directions": 1}
-    ppo = yaml.safe_load(open("train/benchmark/ppo.yaml"))
+    ppo = yaml.safe_load(open("train/recipes/ppo.yaml"))
     ppo.update(timesteps=1024, n_envs=2, eval_points=1, whiten_steps=256)  # the recipe's
     # whitening, folded into the exported actor
     ppo["model"] = {**ppo["model"], "n_steps": 256, "batch_size": 256, "n_epochs": 1}

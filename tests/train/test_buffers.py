@@ -1,4 +1,4 @@
-"""train.bench.buffers.FlatNStepReplayBuffer returns stable-baselines3's n-step samples bit
+"""train.core.buffers.FlatNStepReplayBuffer returns stable-baselines3's n-step samples bit
 for bit, and the SAC recipe's model uses it."""
 
 import gymnasium as gym
@@ -12,7 +12,7 @@ from stable_baselines3.common.running_mean_std import RunningMeanStd
 from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
 from tiny_sb3 import tiny_sac_recipe
 
-from train.bench.buffers import FlatNStepReplayBuffer
+from train.core.buffers import FlatNStepReplayBuffer
 
 OBS = spaces.Box(-np.inf, np.inf, (5,), np.float32)
 
@@ -71,7 +71,7 @@ def test_the_samples_cover_episode_ends_and_the_wrap():
 
 
 def test_sac_recipe_model_uses_it():
-    from train.bench.sb3_train import make_model
+    from train.core.sb3_train import make_model
     from train.vec import make_vec_env
 
     cfg = tiny_sac_recipe(1000)
@@ -86,7 +86,7 @@ def test_sac_recipe_model_uses_it():
 def test_sac_trains_bit_for_bit_as_with_sb3s_buffer(monkeypatch):
     """The tiny SAC recipe trained with the flat buffer and with SB3's own (the buffer swap
     undone) ends at the same parameters, exactly."""
-    from train.bench import sb3_train
+    from train.core import sb3_train
 
     cfg = tiny_sac_recipe(1200)
     ours, _ = sb3_train.train_sb3(cfg, 3, "ACLDBeam-v1")

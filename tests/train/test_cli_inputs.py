@@ -15,8 +15,8 @@ from pathlib import Path
 
 import pytest
 
-import train.bench.evaluate as evaluate
-import train.bench.trials as trials
+import train.core.evaluate as evaluate
+import train.core.trials as trials
 from train.benchmark import main as benchmark_main
 from train.cli import main as train_main
 
@@ -145,16 +145,16 @@ def _limit_file_size():  # ulimit -f 4 (KB); Python ignores SIGXFSZ, so a write 
 def test_report_on_a_full_disk_writes_no_page_and_says_so_in_one_line(tmp_path):
     """Two pages, the second too large to write: neither changes (all or none), and the
     command ends with one line naming the file, exit status 1."""
-    from train.bench.report import MARK_BEGIN, MARK_END
+    from train.core.report import MARK_BEGIN, MARK_END
 
-    results = "train/benchmark/results-v1.json"
+    results = "studies/results-v1.json"
     pages = [tmp_path / "small.md", tmp_path / "large.md"]
     for page, filler in zip(pages, ("", "x" * 3000 + "\n"), strict=True):
         begin = MARK_BEGIN.format(kind="headline", src=results, dst=page)
         page.write_text(f"{filler}{begin}\nold\n{MARK_END.format(kind='headline')}\n")
     before = [p.read_text() for p in pages]
     res = subprocess.run(
-        [sys.executable, "-m", "train.bench.report", results, "--write", *map(str, pages)],
+        [sys.executable, "-m", "train.core.report", results, "--write", *map(str, pages)],
         capture_output=True,
         text=True,
         cwd=ROOT,
@@ -163,16 +163,16 @@ def test_report_on_a_full_disk_writes_no_page_and_says_so_in_one_line(tmp_path):
     assert res.returncode == 1, res.stderr
     lines = res.stderr.strip().splitlines()
     assert len(lines) == 1 and "Traceback" not in res.stderr
-    assert lines[0].startswith("python -m train.bench.report: error: ")
+    assert lines[0].startswith("python -m train.core.report: error: ")
     assert str(pages[1]) in lines[0] and "too large" in lines[0].lower()
     assert [p.read_text() for p in pages] == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["large.md", "small.md"]
 
 
 def test_report_writes_every_page(tmp_path):
-    from train.bench.report import MARK_BEGIN, MARK_END, main
+    from train.core.report import MARK_BEGIN, MARK_END, main
 
-    results = "train/benchmark/results-v1.json"
+    results = "studies/results-v1.json"
     pages = [tmp_path / "a.md", tmp_path / "b.md"]
     for page in pages:
         begin = MARK_BEGIN.format(kind="headline", src=results, dst=page)
@@ -182,9 +182,9 @@ def test_report_writes_every_page(tmp_path):
 
 
 def test_report_refuses_a_page_without_markers_before_writing_any(tmp_path, capsys):
-    from train.bench.report import MARK_BEGIN, MARK_END, main
+    from train.core.report import MARK_BEGIN, MARK_END, main
 
-    results = "train/benchmark/results-v1.json"
+    results = "studies/results-v1.json"
     good, bad = tmp_path / "good.md", tmp_path / "bad.md"
     begin = MARK_BEGIN.format(kind="headline", src=results, dst=good)
     good.write_text(f"{begin}\nold\n{MARK_END.format(kind='headline')}\n")
@@ -194,7 +194,7 @@ def test_report_refuses_a_page_without_markers_before_writing_any(tmp_path, caps
 
 
 def test_report_names_a_missing_results_file(tmp_path, capsys):
-    from train.bench.report import main
+    from train.core.report import main
 
     _refused(main, [str(tmp_path / "none.json")], capsys, "none.json", "No such file")
 
@@ -253,9 +253,9 @@ def test_benchmark_builds_the_training_env_on_the_env_id_first(tmp_path, capsys,
 
 
 def test_report_names_an_undecodable_page(tmp_path, capsys):
-    from train.bench.report import main
+    from train.core.report import main
 
     page = tmp_path / "page.md"
     page.write_bytes(b"\xff\xfe binary")
-    _refused(main, ["train/benchmark/results-v1.json", "--write", str(page)], capsys, str(page))
+    _refused(main, ["studies/results-v1.json", "--write", str(page)], capsys, str(page))
     assert page.read_bytes() == b"\xff\xfe binary"

@@ -1,4 +1,4 @@
-"""train.config: the one training configuration (the recipes under train/benchmark/) and
+"""train.config: the one training configuration (the recipes under train/recipes/) and
 its validation. The research record's variants (``studies/ablations/``) are checked by
 ``studies/tests/test_ablations.py``, outside the default run."""
 

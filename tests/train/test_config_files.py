@@ -4,8 +4,8 @@ the last one silently), and a damaged references cache is computed again, said i
 import pytest
 
 from acld_gym.util.validate import DataFileError
-from train.bench.evaluate import _cached_references
 from train.config import load_config
+from train.core.evaluate import _cached_references
 
 
 def test_a_key_given_twice_is_refused_naming_file_line_and_key(tmp_path):

@@ -11,10 +11,10 @@ from acld_gym.envs.beam_env import ACLDBeamEnv
 from baselines.evaluate import metrics_row, rollout
 from baselines.policies import MPCPolicy
 from train.agent import TrainedAgent
-from train.bench.sb3_policies import SB3Policy
-from train.bench.sb3_train import make_model
-from train.bench.trials import policy_program
 from train.config import TrainConfig, load_config
+from train.core.sb3_policies import SB3Policy
+from train.core.sb3_train import make_model
+from train.core.trials import policy_program
 from train.distill import DistillConfig, distill, fit_sign
 from train.features import DirectionFeatures, direction_features
 from train.vec import make_vec_env

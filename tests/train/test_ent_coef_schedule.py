@@ -6,8 +6,8 @@ import yaml
 from stable_baselines3 import PPO
 
 from tests.train.tiny_sb3 import tiny_ppo
-from train.bench.sb3_train import make_model, train_sb3
 from train.config import TrainConfig
+from train.core.sb3_train import make_model, train_sb3
 
 
 def test_each_update_uses_the_scheduled_coefficient(monkeypatch):
@@ -33,7 +33,7 @@ def test_a_constant_coefficient_is_left_alone(monkeypatch):
 
 
 def test_a_schedule_is_for_ppo_only():
-    data = yaml.safe_load(open("train/benchmark/sac.yaml"))
+    data = yaml.safe_load(open("train/recipes/sac.yaml"))
     data["model"] = {**data["model"], "ent_coef": {"linear": [0.01, 0.0]}}
     with pytest.raises(ValueError, match="model.ent_coef.*ppo only"):
         make_model(TrainConfig(**data), None, 0)

@@ -1,5 +1,5 @@
 """Fuzz of the files the training commands read back (issue 65, deliverable 5): a results
-table (``python -m train.bench.report``), a config YAML (every command), a trial record and a
+table (``python -m train.core.report``), a config YAML (every command), a trial record and a
 references cache (``python -m train.benchmark --resume``), each mutated by deleting a field,
 changing a field's type, or truncating the file. Every mutation must give the package's own
 error (:class:`acld_gym.util.validate.DataFileError`, naming the file) or a correct result
@@ -7,8 +7,8 @@ error (:class:`acld_gym.util.validate.DataFileError`, naming the file) or a corr
 exception.
 
 Provenance: the mutations are the issue's (deletion, type change, truncation); the base files
-are the committed ``train/benchmark/results-v1.json`` and recipes, and a trial record of the
-shape :func:`train.bench.trials.run_trial` writes.
+are the committed ``studies/results-v1.json`` and recipes, and a trial record of the
+shape :func:`train.core.trials.run_trial` writes.
 """
 
 from __future__ import annotations
@@ -25,14 +25,14 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from acld_gym.util.validate import DataFileError
-from train.bench.evaluate import CASES
-from train.bench.records import check_references, check_trial, read_json, read_results
-from train.bench.report import curves_figure, main, render_blocks, summarize
 from train.config import TrainConfig, read_config
 from train.config_checks import check_buildable
+from train.core.evaluate import CASES
+from train.core.records import check_references, check_trial, read_json, read_results
+from train.core.report import curves_figure, main, render_blocks, summarize
 
 ROOT = Path(__file__).resolve().parents[2]
-RESULTS = json.loads((ROOT / "train/benchmark/results-v1.json").read_text())
+RESULTS = json.loads((ROOT / "studies/results-v1.json").read_text())
 #: Values a field's type is changed to (JSON's kinds, and numbers a computation chokes on).
 SWAPS = [None, True, "x", "", [], {}, [1, 2], {"a": 1}, 0, -1, 1.5, 1e308, math.nan, math.inf]
 FUZZ = settings(
@@ -82,7 +82,7 @@ def mutation(base):
 
 # --- the results table ------------------------------------------------------------------
 def test_the_committed_results_pass():
-    assert read_results(ROOT / "train/benchmark/results-v1.json") == RESULTS
+    assert read_results(ROOT / "studies/results-v1.json") == RESULTS
 
 
 @FUZZ
@@ -150,7 +150,7 @@ def test_deep_nesting_and_binary_files_are_refused(tmp_path):
         with pytest.raises(DataFileError, match=str(path)):
             read_json(path)
     with pytest.raises(DataFileError, match="larger than 1000 bytes"):
-        read_json(ROOT / "train/benchmark/results-v1.json", max_bytes=1000)
+        read_json(ROOT / "studies/results-v1.json", max_bytes=1000)
 
 
 # --- configs -------------------------------------------------------------------------------
@@ -248,8 +248,8 @@ REFS = {
 @pytest.fixture(scope="module")
 def resume_out(tmp_path_factory):
     """A benchmark output folder with RECORD's agent saved (a linear vrs actor)."""
-    from train.bench.search import LinearDirectionActor
-    from train.bench.trials import agent_dir, save_agent
+    from train.core.search import LinearDirectionActor
+    from train.core.trials import agent_dir, save_agent
 
     out = tmp_path_factory.mktemp("bench")
     policy = LinearDirectionActor(np.full(10, 0.01), features=None)
@@ -258,8 +258,8 @@ def resume_out(tmp_path_factory):
 
 
 def test_the_base_record_is_reused(resume_out):
-    from train.bench.trials import trial_path
     from train.benchmark import reusable
+    from train.core.trials import trial_path
 
     path = trial_path(resume_out, "vrs", 0)
     path.parent.mkdir(exist_ok=True)
@@ -270,8 +270,8 @@ def test_the_base_record_is_reused(resume_out):
 @FUZZ
 @given(m=mutation(RECORD))
 def test_a_mutated_trial_record_is_trained_again_or_reused_whole(resume_out, capsys, m):
-    from train.bench.trials import trial_path
     from train.benchmark import reusable
+    from train.core.trials import trial_path
 
     path = trial_path(resume_out, "vrs", 0)
     path.parent.mkdir(exist_ok=True)
@@ -293,8 +293,8 @@ def test_a_mutated_trial_record_is_trained_again_or_reused_whole(resume_out, cap
 def test_a_trial_whose_agent_no_longer_loads_is_trained_again(resume_out, tmp_path, capsys):
     import shutil
 
-    from train.bench.trials import agent_dir, trial_path
     from train.benchmark import reusable
+    from train.core.trials import agent_dir, trial_path
 
     out = tmp_path / "out"
     shutil.copytree(resume_out, out)
@@ -323,7 +323,7 @@ def test_a_mutated_references_file_is_refused_or_summarizes(tmp_path, m):
 
 
 def test_a_damaged_references_file_is_computed_again(tmp_path, monkeypatch, capsys):
-    import train.bench.evaluate as evaluate
+    import train.core.evaluate as evaluate
     from train.benchmark import resumed_references
 
     calls = []

@@ -10,10 +10,10 @@ import pytest
 
 from acld_gym.envs.presets import PRESETS
 from tests.train.tiny_sb3 import tiny_ppo
-from train.bench import evaluate, trials
-from train.bench.algos import train_algo
-from train.bench.progress import Progress
 from train.config import load_config
+from train.core import evaluate, trials
+from train.core.algos import train_algo
+from train.core.progress import Progress
 
 LEVELS = sorted(PRESETS)
 

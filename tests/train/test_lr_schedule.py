@@ -8,7 +8,7 @@ import pytest
 from stable_baselines3 import PPO
 
 from tests.train.tiny_sb3 import tiny_ppo
-from train.bench.sb3_train import LinearSchedule, make_model, train_sb3
+from train.core.sb3_train import LinearSchedule, make_model, train_sb3
 
 
 @pytest.mark.parametrize("warmup", [0.0, 0.1, 0.5])

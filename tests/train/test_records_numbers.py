@@ -8,9 +8,9 @@ from pathlib import Path
 import pytest
 
 from acld_gym.util.validate import DataFileError
-from train.bench.records import check_references, check_results
+from train.core.records import check_references, check_results
 
-RESULTS = Path(__file__).resolve().parents[2] / "train" / "benchmark" / "results-v1.json"
+RESULTS = Path(__file__).resolve().parents[2] / "studies" / "results-v1.json"
 HUGE = 10**400
 
 

@@ -1,5 +1,5 @@
 """The benchmark's tables in the docs and the README's headline are generated from the
-committed per-seed results (``python -m train.bench.report train/benchmark/results-v1.json
+committed per-seed results (``python -m train.core.report studies/results-v1.json
 --write docs/training.md README.md``)."""
 
 from __future__ import annotations
@@ -10,7 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from train.bench.report import (
+from train.config import read_config
+from train.core.report import (
     GOALS,
     MARK_BEGIN,
     MARK_END,
@@ -25,10 +26,9 @@ from train.bench.report import (
     stretch_lines,
     write_blocks,
 )
-from train.bench.threshold import RestartRule
-from train.config import read_config
+from train.core.threshold import RestartRule
 
-RESULTS = Path("train/benchmark/results-v1.json")
+RESULTS = Path("studies/results-v1.json")
 PAGE = Path("docs/training.md")
 README = Path("README.md")
 

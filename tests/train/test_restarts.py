@@ -9,8 +9,8 @@ import pytest
 
 import acld_gym  # noqa: F401  (registers the envs)
 from tests.train.tiny_sb3 import tiny_sac, tiny_sac_recipe
-from train.bench import algos, evaluate, threshold
-from train.bench.algos import restart_seeds, train_algo
+from train.core import algos, evaluate, threshold
+from train.core.algos import restart_seeds, train_algo
 
 
 def _cfg(restarts=2, select=True, timesteps=100, **fields):
@@ -266,7 +266,7 @@ def test_runs_at_once_are_the_runs_one_after_another(restart_above, trained):
     import numpy as np
     import torch
 
-    from train.bench.trials import CaseISE
+    from train.core.trials import CaseISE
 
     cfg = tiny_sac_recipe(
         400,
@@ -352,7 +352,7 @@ def test_a_portable_policy_pickles_after_a_training_step_and_acts_the_same():
     import numpy as np
 
     from tests.train.tiny_sb3 import tiny_ppo
-    from train.bench.sb3_train import train_sb3
+    from train.core.sb3_train import train_sb3
 
     policy, _ = train_sb3(tiny_ppo(), 0, "ACLDBeam-v1")
     n_obs = gym.make("ACLDBeam-v1").observation_space.shape[0]

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 import torch
 
-import acld_gym.benchmark as bench
+import acld_gym.test_sets as bench
 from acld_gym.wrappers import ObserveModes, UnitAction
 from baselines.analysis.score import score_policy
 from baselines.policies import LQRPolicy
@@ -231,8 +231,8 @@ def test_trained_agent_on_another_level_or_with_wrappers(agent):
 
 
 def test_seeds_in_one_public_place():
-    from train.bench import evaluate
     from train.compare import HELDOUT_SEEDS
+    from train.core import evaluate
 
     assert bench.HELDOUT_SEEDS == evaluate.HELDOUT_SEEDS == HELDOUT_SEEDS
     assert bench.VALIDATION_SEED0 == evaluate.VALIDATION_SEED0

@@ -9,9 +9,9 @@ import torch
 from baselines.policies import LQRPolicy, PassivePolicy
 from tests.train.tiny_sb3 import LinearModel as _Model
 from tests.train.tiny_sb3 import tiny_sac, tiny_sac_recipe
-from train.bench import evaluate
-from train.bench.sb3_train import Selection
 from train.compare import HELDOUT_SEEDS
+from train.core import evaluate
+from train.core.sb3_train import Selection
 
 
 @pytest.fixture(scope="module")
@@ -75,7 +75,7 @@ def test_selection_off_is_inert():
 def test_a_run_returns_its_best_checkpoint(tmp_path):
     """A tiny SAC run of the recipe with selection: the returned (whitening-folded) policy
     scores the chosen check's validation cost again."""
-    from train.bench.sb3_train import train_sb3
+    from train.core.sb3_train import train_sb3
 
     cfg = tiny_sac_recipe(800, select={"episodes": 2, "every": 200, "start": 0})
     policy, record = train_sb3(cfg, 0, "ACLDBeam-v1")
@@ -93,7 +93,7 @@ def test_the_final_check_sees_the_final_policy():
     gradient step: with the one check at the end, the run returns the policy of the same run
     without selection (SB3 calls the step callback before the update of its rollout, so a
     check there would see the policy one update short of the final one)."""
-    from train.bench.sb3_train import train_sb3
+    from train.core.sb3_train import train_sb3
 
     plain, _ = train_sb3(tiny_sac_recipe(800, restarts=1, select=None), 0, "ACLDBeam-v1")
     cfg = tiny_sac_recipe(800, restarts=1, select={"episodes": 1, "every": 800, "start": 800})

@@ -11,7 +11,7 @@ from train.agent import TrainedAgent
 from train.compare import AGENTS_DIR
 from train.ship import best_seed, main
 
-RESULTS = "train/benchmark/results-v1.json"
+RESULTS = "studies/results-v1.json"
 
 
 def _results(tmp_path, per_seed):

@@ -1,4 +1,4 @@
-"""A short training run per algorithm through the one stack (train.bench.algos.train_algo on
+"""A short training run per algorithm through the one stack (train.core.algos.train_algo on
 the env of train.vec.make_vec_env): it updates the networks, repeats bit for bit with the
 same seed, and the opt-in DAgger start is recorded. Marked slow: ``make test-slow``."""
 
@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 import torch
 
-from train.bench.algos import train_algo
-from train.bench.sb3_train import make_model
 from train.config import load_config
+from train.core.algos import train_algo
+from train.core.sb3_train import make_model
 from train.vec import make_vec_env
 
 pytestmark = pytest.mark.slow

@@ -15,7 +15,7 @@ from train.cli import build_parser, configure
 
 
 def _tiny(tmp_path, algo):
-    data = yaml.safe_load(open(f"train/benchmark/{algo}.yaml"))
+    data = yaml.safe_load(open(f"train/recipes/{algo}.yaml"))
     if algo == "ppo":
         data.update(timesteps=1536, n_envs=4, eval_points=1, whiten_steps=256)
         data["model"] = {**data["model"], "n_steps": 128, "batch_size": 256, "n_epochs": 1}
@@ -40,7 +40,7 @@ def test_the_default_config_is_the_benchmark_recipe():
         assert (
             configure(args)
             == read_config(algo)
-            == (algo, yaml.safe_load(open(f"train/benchmark/{algo}.yaml")))
+            == (algo, yaml.safe_load(open(f"train/recipes/{algo}.yaml")))
         )
 
 
@@ -168,7 +168,7 @@ def test_train_sb3_trains_on_the_env_its_factory_builds_and_checks_its_layers():
     env id, and a factory that does not return the recipe's outer ``VecNormalize`` is
     refused by name."""
     from tests.train.tiny_sb3 import tiny_ppo
-    from train.bench.sb3_train import train_sb3
+    from train.core.sb3_train import train_sb3
     from train.vec import make_vec_env
 
     calls = []

@@ -1,4 +1,4 @@
-"""The recipes' retry thresholds (``restart_above``, :mod:`train.bench.threshold`): relative
+"""The recipes' retry thresholds (``restart_above``, :mod:`train.core.threshold`): relative
 to the level's reference on the same validation loads, so they resolve on every registered
 id; on ACLDBeam-v1 to the absolute costs the committed results were run with; a bare number
 is refused on another level than the one it was calibrated on."""
@@ -13,10 +13,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from acld_gym.envs.presets import PRESETS
-from train.bench import threshold
-from train.bench.evaluate import validation_seeds
-from train.bench.threshold import ABSOLUTE_LEVEL, REFERENCES, RestartRule
 from train.config import CONFIG_DIR, load_config
+from train.core import threshold
+from train.core.evaluate import validation_seeds
+from train.core.threshold import ABSOLUTE_LEVEL, REFERENCES, RestartRule
 
 LEVELS = sorted(PRESETS)  # every registered id
 #: The recipes with several runs per seed and a retry threshold.
@@ -52,9 +52,9 @@ def test_a_recipes_threshold_resolves_between_the_best_reference_and_passive(nam
 @pytest.mark.parametrize("name", ["ppo", "sac"])
 def test_on_v1_the_thresholds_are_the_absolute_ones_the_committed_results_ran_with(name):
     """The absolute ``restart_above`` the committed v1 results ran with (acld-gym
-    0.18-0.19: 0.520 PPO, 0.540 SAC, read from ``train/benchmark/results-v1.json``), to well
+    0.18-0.19: 0.520 PPO, 0.540 SAC, read from ``studies/results-v1.json``), to well
     within the costs' round-off between machines (~3e-4): v1's results stay valid."""
-    results = Path(__file__).resolve().parents[2] / "train/benchmark/results-v1.json"
+    results = Path(__file__).resolve().parents[2] / "studies/results-v1.json"
     committed = json.loads(results.read_text())["algorithms"][name]["restart_above"]
     assert isinstance(committed, float)
     cfg = load_config(name)

@@ -23,7 +23,7 @@ ZOO_ONLY = {
 @pytest.mark.parametrize("algo", ["ppo", "sac"])
 def test_zoo_file_is_the_benchmark_recipe(algo):
     zoo = yaml.safe_load(open(f"train/zoo/{algo}.yml"))["ACLDBeam-v1"]
-    bench = yaml.safe_load(open(f"train/benchmark/{algo}.yaml"))
+    bench = yaml.safe_load(open(f"train/recipes/{algo}.yaml"))
     headroom = bench.get("action_headroom", 1.0)
     if headroom == 1.0:
         assert zoo["env_wrapper"] == ["acld_gym.wrappers.UnitAction"]
@@ -32,7 +32,7 @@ def test_zoo_file_is_the_benchmark_recipe(algo):
     assert zoo["env_kwargs"] == {"load_case": "random", **bench["env_kwargs"]}
     assert bench["loads"] == {"random": 1}
     assert zoo["n_envs"] == bench["n_envs"] and zoo["n_timesteps"] == bench["timesteps"]
-    assert zoo["policy"] == f"train.bench.sb3_policies.{bench['model']['policy']}"
+    assert zoo["policy"] == f"train.core.sb3_policies.{bench['model']['policy']}"
     model = {k: v for k, v in bench["model"].items() if k not in ZOO_ONLY}
     assert {k: zoo[k] for k in model} == model
     lr = bench["model"]["learning_rate"]

@@ -33,18 +33,18 @@ def shrink_ppo(cfg: TrainConfig, model: dict | None = None, **fields) -> TrainCo
 
 
 def tiny_ppo(model: dict | None = None, **fields) -> TrainConfig:
-    """The PPO recipe (train/benchmark/ppo.yaml) shrunk by :func:`shrink_ppo`."""
+    """The PPO recipe (train/recipes/ppo.yaml) shrunk by :func:`shrink_ppo`."""
     return shrink_ppo(
-        TrainConfig(**yaml.safe_load(open("train/benchmark/ppo.yaml"))), model, **fields
+        TrainConfig(**yaml.safe_load(open("train/recipes/ppo.yaml"))), model, **fields
     )
 
 
 def tiny_sac_recipe(timesteps: int, **fields) -> TrainConfig:
-    """The SAC recipe (train/benchmark/sac.yaml) shrunk to ``timesteps`` env steps on 4
+    """The SAC recipe (train/recipes/sac.yaml) shrunk to ``timesteps`` env steps on 4
     sub-envs (128 of whitening, learning from 200 on, a 2000-step buffer, minibatches of
     64) and without the recipe's retry threshold (``restart_above``: a tiny run never gets
     near it, and ``restarts=1`` needs none), with ``fields`` changed on top."""
-    data = yaml.safe_load(open("train/benchmark/sac.yaml"))
+    data = yaml.safe_load(open("train/recipes/sac.yaml"))
     data.update(timesteps=timesteps, n_envs=4, eval_points=1, whiten_steps=128)
     data.update({"restart_above": None, **fields})
     data["model"] = {**data["model"], "learning_starts": 200, "buffer_size": 2000, "batch_size": 64}

@@ -4,7 +4,7 @@ score (the benchmark's own checks against scipy are in tests/train/test_benchmar
 import numpy as np
 import pytest
 
-import train.bench.stats as bench_stats
+import train.core.stats as bench_stats
 from acld_gym.util import stats
 
 

@@ -1,38 +1,73 @@
-r"""The teacher-free benchmark (``python -m train.benchmark``).
+"""Deprecated: the training core is :mod:`train.core` (renamed in acld-gym 0.20.0).
 
-Every algorithm learns from the env's observation and reward only: no controller,
-demonstration or controller-derived reward anywhere in training, and nothing read
-from the env's internals. :func:`~train.bench.algos.train_algo` trains one for a fixed
-env-step budget,
-reports learning-curve points through a callback, and returns a policy with SB3's
-``predict`` in volts.
-
-* ``vrs`` (the recipe): vectorised random search (ARS, Mania et al. 2018, "V1-t") on
-  the linear direction actor :class:`train.bench.search.LinearDirectionActor`,
-  :math:`V = 120\,\mathrm{clip}(w \cdot [u/|u|, \log|u|] + b, -1, 1)` (11
-  parameters for the 9-value observation z: 10 weights and a bias), :math:`u = T^T z`
-  with T a whitening matrix the
-  agent estimates from its own first round of episodes (:func:`acld_gym.wrappers.whitening`). All
-  2 x ``n_directions`` perturbed actors run side by side in the native batched env
-  on the same episodes (common random numbers), and each episode's return R is
-  scored as :math:`-\log(-R)` (``objective: log``), which makes loads whose returns
-  differ by three decades weigh alike (reward normalisation per load).
-* ``ars``: sb3-contrib's ``ARS`` (linear policy, clipped) on the direction features.
-* ``ppo``, ``sac``, ``td3``, ``tqc``, ``crossq``: stable-baselines3 / sb3-contrib
-  on the env of :func:`train.vec.make_vec_env`: the native batched env (``SB3VecEnv``),
-  actions in [-1, 1] (:class:`train.vec.VecAgentEnv`; no residual, no shaping in the
-  from-scratch recipes), optionally the direction features as the observation
-  (:class:`train.vec.VecDirectionFeatures`), and ``VecNormalize``. Options for them
-  (fields of :class:`train.config.TrainConfig`): ``whiten_steps``,
-  a ZCA whitening of the observation estimated from the agent's own first rollouts
-  (:class:`train.vec.VecWhiten`, the steps counted in the budget); for PPO the policy
-  ``SplitCriticPolicy`` (the critic on its own features, e.g. quadratic ones,
-  :class:`train.bench.sb3_policies.SplitCriticPolicy`).
-
-Modules, in the order of a run (the config is :mod:`train.config`, the env
-:mod:`train.vec`): ``search`` (``vrs``), ``sb3_policies`` and ``sb3_train`` (the SB3
-algorithms),
-``algos`` (:func:`~train.bench.algos.train_algo`), ``evaluate`` (ISE / LQR through the
-env), ``trials`` (one run, many runs, Ray Tune), ``stats`` (IQM, bootstrap) and
-``report`` (tables and learning curves). The command is :mod:`train.benchmark`.
+``train.bench`` and its submodules (``train.bench.evaluate``, ``train.bench.trials``, ...)
+are the modules of :mod:`train.core` under their old names, for one more version: importing
+one warns once (a ``DeprecationWarning`` naming the new path) and gives the very module
+object of ``train.core``; ``python -m train.bench.report`` still runs
+``python -m train.core.report``.
 """
+
+from __future__ import annotations
+
+import importlib
+import importlib.abc
+import importlib.machinery
+import importlib.util
+import sys
+import warnings
+
+OLD, NEW = __name__, "train.core"
+
+
+def _warn(old: str, new: str) -> None:
+    warnings.warn(
+        f"{old} is deprecated and will be removed in the next version: use {new}",
+        DeprecationWarning,
+        stacklevel=3,
+    )
+
+
+class _Alias(importlib.abc.MetaPathFinder, importlib.abc.Loader):
+    """Finds ``train.bench.X`` as the module ``train.core.X`` (the same object)."""
+
+    def find_spec(self, fullname, path=None, target=None):
+        if not fullname.startswith(OLD + "."):
+            return None
+        new = NEW + fullname[len(OLD) :]
+        if importlib.util.find_spec(new) is None:
+            return None
+        return importlib.machinery.ModuleSpec(fullname, self, is_package=False)
+
+    def __init__(self):
+        self._specs = {}
+
+    def create_module(self, spec):
+        new = NEW + spec.name[len(OLD) :]
+        _warn(spec.name, new)
+        module = importlib.import_module(new)
+        self._specs[spec.name] = module.__spec__  # the import system overwrites it next
+        return module
+
+    def exec_module(self, module):
+        """Nothing to run (the module is ``train.core``'s, already imported): its own spec
+        back, so that it stays ``train.core.X`` for reloads and reprs."""
+        module.__spec__ = self._specs.pop(module.__spec__.name)
+
+    def get_code(self, fullname):
+        """The code of ``train.core``'s module, for ``python -m train.bench.X``."""
+        new = NEW + fullname[len(OLD) :]
+        _warn(f"python -m {fullname}", f"python -m {new}")
+        return importlib.util.find_spec(new).loader.get_code(new)
+
+
+if not any(isinstance(f, _Alias) for f in sys.meta_path):
+    sys.meta_path.append(_Alias())
+
+_warn(OLD, NEW)
+
+
+def __getattr__(name: str):
+    """``train.bench.X`` as an attribute: ``train.core.X`` (through the alias, warning once)."""
+    if importlib.util.find_spec(f"{NEW}.{name}") is None:
+        raise AttributeError(f"module {OLD!r} has no attribute {name!r}")
+    return importlib.import_module(f"{OLD}.{name}")

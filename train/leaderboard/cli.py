@@ -70,8 +70,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 def collect(args, parser: argparse.ArgumentParser, argv: list[str]) -> int:
     """The ``collect`` subcommand (arguments checked before anything is computed)."""
-    from acld_gym.benchmark import evaluation_set
     from acld_gym.envs.presets import check_env_id
+    from acld_gym.test_sets import evaluation_set
 
     from .collect import (
         collect_benchmark,

@@ -8,7 +8,7 @@ records and ``agents/<name>-s<seed>/`` folders), per algorithm every seed and th
 the seeds with its 95 % stratified-bootstrap interval. :func:`merge` puts either part into
 the level's file without touching the others (the references, each algorithm), and
 :func:`write_level` writes it atomically, keys sorted. Every file read is checked first
-(:func:`train.bench.records.check_trial`, :meth:`train.agent.TrainedAgent.load`,
+(:func:`train.core.records.check_trial`, :meth:`train.agent.TrainedAgent.load`,
 :func:`train.leaderboard.schema.read_level`): a damaged one is one line naming it, and
 nothing is written.
 """
@@ -30,8 +30,8 @@ from acld_gym.util.atomic import strict_json, write_json
 from acld_gym.util.stats import iqm_with_ci
 from acld_gym.util.validate import DataFileError, file_error
 
-from ..bench.records import check_trial, read_json
-from ..bench.trials import agent_dir
+from ..core.records import check_trial, read_json
+from ..core.trials import agent_dir
 from .measure import agent_entry, reference_entries
 from .schema import CASES, EFFORT_CASES, EFFORT_KEYS, check_level, empty_level, read_level
 
@@ -98,7 +98,7 @@ def collect_references(
     """The ``references`` part of a level's file: every reference and mark of ``env_id``
     (``policies``: name -> policy instead, e.g. a subset) and the bound, with
     provenance (``command``: how it was asked for)."""
-    from acld_gym.benchmark import evaluation_set
+    from acld_gym.test_sets import evaluation_set
     from baselines.analysis.references import make_env
     from baselines.marks import level_references, mark_labels
 

@@ -4,7 +4,7 @@ case and its effort after settling, each by the package's own evaluators.
 * references (:func:`reference_entries`): the policies of
   :func:`baselines.marks.level_references` scored together on the level's test set
   (:func:`baselines.analysis.score.score_policies`, its cached anchors), their mean ISE per
-  case by :func:`train.bench.evaluate.rollout_ise` and the clairvoyant bound's by
+  case by :func:`train.core.evaluate.rollout_ise` and the clairvoyant bound's by
   :func:`baselines.rollout.bound_episode` on the same episodes;
 * a trained agent (:func:`agent_entry`): :func:`train.scoring.score`, the function that
   scores any policy;
@@ -17,7 +17,7 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 
-from acld_gym.benchmark import HELDOUT_SEEDS
+from acld_gym.test_sets import HELDOUT_SEEDS
 
 from .schema import CASES, EFFORT_CASES
 
@@ -35,7 +35,7 @@ def case_episodes(episodes: int | None) -> dict:
     """``{case: seeds}`` of the ISE / thesis LQR columns: seed 0 of thesis cases 1, 2, 3
     and the held-out random loads (all 20; with a reduced run of ``episodes`` test
     episodes, at most that many, as :func:`train.scoring.score` takes them)."""
-    from ..bench.evaluate import eval_episodes
+    from ..core.evaluate import eval_episodes
 
     n = len(HELDOUT_SEEDS) if episodes is None else min(len(HELDOUT_SEEDS), episodes)
     return eval_episodes(n)
@@ -110,7 +110,7 @@ def reference_entries(
     (None: all: the published score)."""
     from baselines.analysis.score import score_policies
 
-    from ..bench.evaluate import rollout_ise
+    from ..core.evaluate import rollout_ise
 
     if "lqr" not in policies:
         raise ValueError("policies must hold the thesis LQR ('lqr'): the ISE columns' yardstick")

@@ -11,8 +11,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from acld_gym.benchmark import TEST_SETS
 from acld_gym.envs.presets import PRESETS
+from acld_gym.test_sets import TEST_SETS
 from acld_gym.util.validate import file_error
 
 from .render import COMMAND, marks

@@ -41,7 +41,7 @@ from pathlib import Path
 from acld_gym.envs.presets import check_env_id
 from acld_gym.util.validate import DataFileError, file_error, json_depth
 
-from ..bench.records import _Reader, read_json
+from ..core.records import _Reader, read_json
 
 __all__ = [
     "FORMAT",

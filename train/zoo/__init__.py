@@ -17,7 +17,7 @@ from __future__ import annotations
 from stable_baselines3.common.callbacks import BaseCallback
 
 from acld_gym.util.validate import check_real
-from train.bench.sb3_train import LinearSchedule
+from train.core.sb3_train import LinearSchedule
 
 __all__ = ["LinearLearningRate"]
 

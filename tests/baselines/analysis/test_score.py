@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import baselines.analysis.references as references_module
-from acld_gym.benchmark import TEST_SETS, evaluation_set
+from acld_gym.test_sets import TEST_SETS, evaluation_set
 from baselines.analysis.references import FORMAT, cache_path, references
 from baselines.analysis.score import (
     SCORE_VERSION,

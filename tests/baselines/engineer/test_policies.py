@@ -4,7 +4,7 @@ episode, the SB3 protocol, and a stable small-signal loop."""
 import numpy as np
 import pytest
 
-from acld_gym.benchmark import TEST_SETS
+from acld_gym.test_sets import TEST_SETS
 from baselines.engineer import engineer_policies, env_plant, spectral_radius
 
 from .conftest import LEVELS

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from acld_gym.benchmark import RESERVED_SEEDS, TEST_SETS
+from acld_gym.test_sets import RESERVED_SEEDS, TEST_SETS
 from baselines.engineer import DESIGNS, design_kwargs
 from baselines.engineer.tuning import RADIUS_MARGIN, TRAINING_SEEDS, grid, search
 

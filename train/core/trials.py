@@ -28,7 +28,7 @@ __all__ = [
     "ray_available",
 ]
 
-#: The benchmark's algorithms (``train/benchmark/<name>.yaml``).
+#: The benchmark's algorithms (``train/recipes/<name>.yaml``).
 DEFAULT_ALGOS = ("vrs", "ars", "ppo", "sac", "tqc")
 REFERENCES = ("lqr", "smc", "mpc", "bound")
 
@@ -49,13 +49,13 @@ def run_trial(
     with restarts, the returned run's, ``train_algo``;
     the final ISE per case, single-env rollouts; the training wall time, evaluations
     excluded; the final policy's ``validation_cost``, the env's own objective on the
-    first :data:`train.bench.evaluate.OBJECTIVE_LOADS` validation loads; the command) and
+    first :data:`train.core.evaluate.OBJECTIVE_LOADS` validation loads; the command) and
     the final policy. With ``out``, the policy is saved as an
     agent in :func:`agent_dir`. ``workers``: how many of the trial's runs (``restarts``)
-    train at once (:func:`train.bench.algos.train_algo`: the same result, in less time).
+    train at once (:func:`train.core.algos.train_algo`: the same result, in less time).
 
     On the console, lines labelled ``<name> s<seed>``
-    (:class:`train.bench.progress.Progress`): one per evaluation with the current
+    (:class:`train.core.progress.Progress`): one per evaluation with the current
     validation score (none with ``quiet``), the retry threshold and every retry with its
     reason, which the record keeps too (``retries``, ``[]`` when the first run sufficed or
     there is one)."""

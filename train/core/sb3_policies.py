@@ -1,5 +1,5 @@
 """Policy pieces for the SB3 algorithms: a critic on its own (e.g. quadratic) features
-(:class:`train.bench.sb3_policies.SplitCriticPolicy`), and a trained model as a
+(:class:`train.core.sb3_policies.SplitCriticPolicy`), and a trained model as a
 ``predict`` policy in volts (:class:`SB3Policy`)."""
 
 from __future__ import annotations
@@ -135,7 +135,7 @@ class NegativeSquareForm(nn.Module):
         return -square_norm(z, self.m)
 
 
-#: ``critic_features`` of :class:`train.bench.sb3_policies.SplitCriticPolicy` and their extractor
+#: ``critic_features`` of :class:`train.core.sb3_policies.SplitCriticPolicy` and their extractor
 #: classes.
 CRITIC_FEATURES = {
     "quadratic": QuadraticFeatures,
@@ -458,7 +458,7 @@ class AsymmetricSACPolicy(SACPolicy):
     """SAC's policy on the observation ``[u, log c]``: the (squashed Gaussian) actor reads u
     only (:class:`DropLast`; ``net_arch: {pi: []}`` a linear law, deployable on the plain
     env), the twin critic is :class:`ScaledQuadraticCritic` of the applied action, for the
-    ``action_headroom`` of the env's action map (:func:`train.bench.sb3_train.make_model`
+    ``action_headroom`` of the env's action map (:func:`train.core.sb3_train.make_model`
     passes the config's), with its ``offset_scale``, never positive with ``negative_critic``
     (:class:`NegativeSquareForm`).
 
@@ -472,7 +472,7 @@ class AsymmetricSACPolicy(SACPolicy):
     actor's gain drifted up until the policy degraded."""
 
     #: The policy takes the env's ``action_headroom`` as a keyword (its critic reads the
-    #: applied action): :func:`train.bench.sb3_train.make_model` passes the config's.
+    #: applied action): :func:`train.core.sb3_train.make_model` passes the config's.
     takes_action_headroom = True
 
     def __init__(

@@ -102,7 +102,7 @@ def summarize(records: list[dict], refs: dict) -> dict:
             "restart_above": runs[0]["config"].get("restart_above"),
             "seeds": [r["seed"] for r in runs],
             "ise_rel_lqr": stats,
-            # the env's own objective (train.bench.evaluate.OBJECTIVE_LOADS validation
+            # the env's own objective (train.core.evaluate.OBJECTIVE_LOADS validation
             # loads); None for trials recorded before it was (acld-gym < 0.19)
             "validation_cost": (
                 None if None in costs else iqm_with_ci(np.array(costs, dtype=float))
@@ -161,7 +161,7 @@ def markdown(summary: dict) -> str:
         f"*Validation cost*: the env's own objective, which the agents are trained on and "
         f"which charges for the voltage: the step cost on each of {OBJECTIVE_LOADS} "
         "validation loads divided by the passive beam's, averaged (passive 1, lower is "
-        "better; `train.bench.evaluate.validation_cost`).",
+        "better; `train.core.evaluate.validation_cost`).",
         "",
         "| algorithm | budget [env steps] | seeds | case 1 | case 2 | case 3 | random "
         "| validation cost | train wall / CPU time per seed [s] (IQM; max) |",
@@ -443,7 +443,7 @@ def curves_figure(summary: dict):
 BLOCKS = {"tables": markdown, "headline": headline}
 
 #: The markers around a generated block (``kind`` one of :data:`BLOCKS`).
-MARK_BEGIN = "<!-- benchmark-{kind}:begin (python -m train.bench.report {src} --write {dst}) -->"
+MARK_BEGIN = "<!-- benchmark-{kind}:begin (python -m train.core.report {src} --write {dst}) -->"
 MARK_END = "<!-- benchmark-{kind}:end -->"
 
 
@@ -476,7 +476,7 @@ def write_blocks(text: str, blocks: dict[str, str], src: str, dst: str) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """``python -m train.bench.report RESULTS.json [--write PAGE.md ...] [--plot FIG.png]``:
+    """``python -m train.core.report RESULTS.json [--write PAGE.md ...] [--plot FIG.png]``:
     the benchmark's tables (:func:`markdown`) from a committed results file, printed, or
     written into the generated blocks of each page (:func:`write_blocks`: the tables, the
     headline; atomically, every page checked before any is written); ``--plot`` also draws
@@ -484,7 +484,7 @@ def main(argv: list[str] | None = None) -> int:
     import argparse
 
     p = argparse.ArgumentParser(
-        prog=prog("python -m train.bench.report"),
+        prog=prog("python -m train.core.report"),
         description=plain(main.__doc__),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

@@ -28,12 +28,12 @@ import gymnasium as gym
 import numpy as np
 
 import acld_gym  # registers the env ids
-from acld_gym.benchmark import (  # noqa: F401 (the seed blocks' home; re-exported)
+from acld_gym.physics.loads import LOAD_CASES
+from acld_gym.test_sets import (  # noqa: F401 (the seed blocks' home; re-exported)
     HELDOUT_SEEDS,
     VALIDATION_SEED0,
     validation_seeds,
 )
-from acld_gym.physics.loads import LOAD_CASES
 from acld_gym.util.atomic import write_text
 from acld_gym.util.validate import DataFileError
 
@@ -62,7 +62,7 @@ __all__ = [
 
 DEFAULT_ENV_ID = acld_gym.ENV_ID
 #: Learning-curve callback of a training run: ``callback(env_steps, policy)`` returns the
-#: curve's point there (a mapping, or None): :func:`train.bench.algos.train_algo`.
+#: curve's point there (a mapping, or None): :func:`train.core.algos.train_algo`.
 CurveCallback = Callable[[int, Any], Mapping | None]
 #: Evaluation cases, in table order (every named load case).
 CASES: tuple = LOAD_CASES
@@ -145,7 +145,7 @@ def _side_by_side(policy, venvs: list, obs: list, value) -> tuple[list, list]:
 
 #: Validation loads of the benchmark's per-seed objective figure (``validation_cost`` in a
 #: trial's record and the report): the 256 the recipes select their runs on
-#: (``select: {episodes: 256}`` in ``train/benchmark/ppo.yaml`` and ``sac.yaml``).
+#: (``select: {episodes: 256}`` in ``train/recipes/ppo.yaml`` and ``sac.yaml``).
 OBJECTIVE_LOADS = 256
 
 
@@ -209,7 +209,7 @@ def lqr_ise(env_id: str = DEFAULT_ENV_ID, episodes: dict | None = None) -> dict:
 
 
 def _cached_references(cache, bound: bool) -> dict | None:
-    """The references cache file ``cache`` if it is whole (:func:`train.bench.records.
+    """The references cache file ``cache`` if it is whole (:func:`train.core.records.
     check_references`); None when there is none, and when it is damaged (said in one line:
     it is computed again)."""
     if cache is None or not Path(cache).is_file():

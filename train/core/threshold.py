@@ -2,7 +2,7 @@
 followed by the next only while its selected check's validation cost is above it.
 
 A threshold is relative to a reference controller's cost on the *same* validation loads by
-the *same* evaluator (:func:`train.bench.evaluate.validation_cost`), computed on the level
+the *same* evaluator (:func:`train.core.evaluate.validation_cost`), computed on the level
 the run trains on, so one recipe carries over to every registered id:
 ``restart_above: 1.0299 * lqg`` retries a run whose cost is more than 2.99 % above the
 level's engineer's LQG (:class:`baselines.engineer.DelayLQGPolicy`, the level's design).
@@ -110,7 +110,7 @@ class RestartRule:
 
 @functools.lru_cache(maxsize=16)
 def reference_cost(reference: str, env_id: str, seeds: tuple) -> float:
-    """:func:`train.bench.evaluate.validation_cost` of ``reference`` (:data:`REFERENCES`)
+    """:func:`train.core.evaluate.validation_cost` of ``reference`` (:data:`REFERENCES`)
     designed on ``env_id`` (its nominal model and the level's design), on ``seeds`` (a
     tuple); computed once per process for the same arguments (a benchmark resolves the same
     rule for every seed it runs)."""

@@ -185,7 +185,7 @@ def make_model(cfg: TrainConfig, venv, seed: int, **kwargs):
 def _flat_n_step_buffer(cls, venv, model_kwargs: dict) -> dict:
     """``model_kwargs`` of an off-policy algorithm with n-step returns (``n_steps > 1``, no
     buffer class of its own, a Box observation) with SB3's n-step buffer replaced by
-    :class:`train.bench.buffers.FlatNStepReplayBuffer`, which returns the same samples,
+    :class:`train.core.buffers.FlatNStepReplayBuffer`, which returns the same samples,
     faster: ``n_steps`` and ``gamma`` move to ``replay_buffer_kwargs``, as SB3 passes
     them to its own. Other kwargs are returned as they are."""
     from gymnasium import spaces
@@ -215,11 +215,11 @@ def _flat_n_step_buffer(cls, venv, model_kwargs: dict) -> dict:
 class Selection:
     """Checkpoint selection of :class:`train.config.SelectConfig` (``cfg.select``; inert if
     None): :meth:`check` scores the policy made by ``snapshot()`` on the validation loads
-    (:func:`train.bench.evaluate.validation_rollout`) and keeps a copy of the SB3 policy's
+    (:func:`train.core.evaluate.validation_rollout`) and keeps a copy of the SB3 policy's
     parameters when it is the best so far; :meth:`finish` checks the final policy too,
     loads the best parameters back into the model and returns the record (the step and
     cost of each check, the step chosen, the env steps of all validation episodes).
-    ``progress`` (a :class:`train.bench.progress.Progress`) says each check."""
+    ``progress`` (a :class:`train.core.progress.Progress`) says each check."""
 
     def __init__(self, cfg: TrainConfig, env_id: str, progress=None):
         from .evaluate import validation_seeds
@@ -283,7 +283,7 @@ def train_sb3(
     unless a probe wraps its own (it must return the same layers, ``VecNormalize`` over
     :class:`train.vec.VecWhiten` where ``cfg.whiten_steps`` is set); the evaluation and the
     validation checks run on the plain env whatever it is. ``progress`` (a
-    :class:`train.bench.progress.Progress`) says each validation check."""
+    :class:`train.core.progress.Progress`) says each validation check."""
     from stable_baselines3.common.callbacks import BaseCallback
 
     torch.set_num_threads(1)

@@ -182,7 +182,7 @@ def train_algo(
     lowest validation cost (with ``cfg.restart_above``, the runs stop at the first whose
     cost is at most that, which is then the lowest: the threshold is resolved on
     ``env_id`` and the selection's own validation loads before the first run,
-    :meth:`train.bench.threshold.RestartRule.resolve`), with ``record["steps"]`` all
+    :meth:`train.core.threshold.RestartRule.resolve`), with ``record["steps"]`` all
     runs' steps, ``record["curve"]`` the returned run's curve (its steps count from the
     start of that run: the curve is the training of the policy returned; the budget spent
     is ``record["steps"]``) and ``record["restarts"]``: each run's seed, chosen step, cost,
@@ -191,7 +191,7 @@ def train_algo(
 
     A retry is never silent: the threshold and each run's outcome (retried, returned, or
     the lowest returned when none met it) are said on the console through ``progress``
-    (:meth:`train.bench.progress.Progress.say`, whatever its ``quiet``; a plain one when
+    (:meth:`train.core.progress.Progress.say`, whatever its ``quiet``; a plain one when
     None), which also gives a line per evaluation unless quiet.
 
     ``workers`` > 1 trains up to that many of the runs at once, in worker processes

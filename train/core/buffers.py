@@ -24,7 +24,7 @@ class FlatNStepReplayBuffer(NStepReplayBuffer):
 
     A drop-in for SB3's buffer: ``replay_buffer_class=FlatNStepReplayBuffer,
     replay_buffer_kwargs={"n_steps": n, "gamma": gamma}``
-    (:func:`train.bench.sb3_train.make_model` passes it for a config with ``n_steps > 1``).
+    (:func:`train.core.sb3_train.make_model` passes it for a config with ``n_steps > 1``).
     """
 
     def _get_samples(self, batch_inds: np.ndarray, env=None) -> ReplayBufferSamples:

@@ -9,7 +9,7 @@ import time
 __all__ = ["PROGRESS_LOADS", "Progress"]
 
 #: Validation loads of a progress line's score at a learning-curve point (the first of the
-#: validation seeds, :func:`train.bench.evaluate.validation_seeds`): ~0.1-0.3 s a line,
+#: validation seeds, :func:`train.core.evaluate.validation_seeds`): ~0.1-0.3 s a line,
 #: off the training time, as the curve's own evaluations are.
 PROGRESS_LOADS = 32
 

@@ -1,5 +1,5 @@
 """The benchmark's files read back as data: a results table (``results.json``, read by
-``python -m train.bench.report``), a trial record (``trials/<name>-s<seed>.json``) and a
+``python -m train.core.report``), a trial record (``trials/<name>-s<seed>.json``) and a
 references cache (``references-<env id>.json``), both read by ``python -m train.benchmark
 --resume``.
 
@@ -31,7 +31,7 @@ __all__ = [
     "check_references",
 ]
 
-#: The statistics of an interquartile mean (:func:`train.bench.stats.iqm_with_ci`).
+#: The statistics of an interquartile mean (:func:`train.core.stats.iqm_with_ci`).
 STAT_KEYS = ("iqm", "ci_low", "ci_high")
 #: The largest file :func:`read_json` reads (a results table of 25 seeds is ~30 kB).
 MAX_BYTES = 64 * 2**20
@@ -139,7 +139,7 @@ class _Reader:
         return None if value is None else self.stat(value, field)
 
     def cases(self, value, field: str, check) -> dict:
-        """A mapping with every case of :data:`train.bench.evaluate.CASES` (as strings)."""
+        """A mapping with every case of :data:`train.core.evaluate.CASES` (as strings)."""
         value = self.mapping(value, field)
         for c in CASES:
             self.key(value, str(c), field, check)
@@ -154,7 +154,7 @@ class _Reader:
 
 
 def _check_algorithm(r: _Reader, a, field: str, goals: list | None) -> dict:
-    """One algorithm's entry of a results table (:func:`train.bench.report.summarize`)."""
+    """One algorithm's entry of a results table (:func:`train.core.report.summarize`)."""
     a = r.mapping(a, field)
     r.key(a, "algo", field, r.text)
     r.key(a, "budget", field, lambda v, f: r.integer(v, f, 1))
@@ -192,8 +192,8 @@ def _check_algorithm(r: _Reader, a, field: str, goals: list | None) -> dict:
 
 def check_results(summary, path: str | Path = "results.json") -> dict:
     """``summary`` (a parsed ``results.json`` of ``python -m train.benchmark``) if it holds
-    every field :func:`train.bench.report.markdown`, :func:`~train.bench.report.headline`
-    and :func:`~train.bench.report.curves_figure` read, of the type they need; else
+    every field :func:`train.core.report.markdown`, :func:`~train.core.report.headline`
+    and :func:`~train.core.report.curves_figure` read, of the type they need; else
     :class:`DataFileError` naming ``path`` and the field."""
     r = _Reader(path)
     s = r.mapping(summary, "")
@@ -227,7 +227,7 @@ def read_results(path: str | Path) -> dict:
 
 
 def check_trial(rec, path: str | Path) -> dict:
-    """``rec`` (a parsed trial record, :func:`train.bench.trials.run_trial`) if it holds
+    """``rec`` (a parsed trial record, :func:`train.core.trials.run_trial`) if it holds
     every field the benchmark's summary and a resumed run read; else
     :class:`DataFileError` naming ``path`` and the field."""
     r = _Reader(path)
@@ -257,7 +257,7 @@ def check_trial(rec, path: str | Path) -> dict:
 
 
 def check_references(data, path: str | Path, bound: bool = True) -> dict:
-    """``data`` (a parsed references cache, :func:`train.bench.evaluate.references`) if it
+    """``data`` (a parsed references cache, :func:`train.core.evaluate.references`) if it
     holds every reference's ISE per case (LQR's positive: the tables divide by it), the
     bound's with ``bound``, and the validation costs; else :class:`DataFileError` naming
     ``path`` and the field."""

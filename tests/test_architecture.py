@@ -59,9 +59,6 @@ LAYERS: tuple[tuple[str, ...], ...] = (
 #: restructured by its owner; acld_gym/ and baselines/ have none.
 KNOWN_CYCLES: dict[frozenset[str], str] = {
     frozenset({"train.agent", "train.sb3_export"}): "sb3_export imports agent in functions",
-    frozenset(
-        {"train.core.sb3_train", "train.core.search", "train.config", "train.config_checks"}
-    ): "config <-> config_checks, which imports bench.sb3_train and bench.search",
     frozenset({"train.compare", "train.figures"}): "compare <-> figures, both in functions",
 }
 #: The train/ cycles among :data:`KNOWN_CYCLES` (the brief's KNOWN_TRAIN_CYCLES).
@@ -82,7 +79,6 @@ KNOWN_OVER_400: frozenset[str] = frozenset(
         "train/core/report.py",
         "train/core/sb3_policies.py",
         "train/compare.py",
-        "train/config.py",
     }
 )
 

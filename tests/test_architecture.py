@@ -58,7 +58,6 @@ LAYERS: tuple[tuple[str, ...], ...] = (
 #: strongly connected component of the import graph), with what closes it. train/ is being
 #: restructured by its owner; acld_gym/ and baselines/ have none.
 KNOWN_CYCLES: dict[frozenset[str], str] = {
-    frozenset({"train.agent", "train.sb3_export"}): "sb3_export imports agent in functions",
     frozenset({"train.compare", "train.figures"}): "compare <-> figures, both in functions",
 }
 #: The train/ cycles among :data:`KNOWN_CYCLES` (the brief's KNOWN_TRAIN_CYCLES).
@@ -75,7 +74,6 @@ KNOWN_UPWARD: dict[tuple[str, str], str] = {
 #: Modules of train/ over MAX_LINES lines (being split by their owner).
 KNOWN_OVER_400: frozenset[str] = frozenset(
     {
-        "train/agent.py",
         "train/core/report.py",
         "train/core/sb3_policies.py",
         "train/compare.py",

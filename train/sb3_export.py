@@ -1,17 +1,16 @@
 """An SB3 model's deterministic actor as an :class:`train.agent.ActorProgram` (numpy arrays
 and a JSON list of operations), so that a trained policy is saved as data
 (:func:`export_sb3`), and the walk over its layers that export and whitening share
-(:func:`actor_parts`). Needs torch and stable-baselines3; re-exported by
+(:func:`actor_parts`). Needs torch and stable-baselines3 (imported when called); re-exported by
 :mod:`train.agent`."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
-if TYPE_CHECKING:
-    from .agent import ActorProgram
+from .agent_program import ActorProgram
 
 __all__ = ["actor_extractor", "actor_parts", "export_sb3"]
 
@@ -33,7 +32,7 @@ def actor_parts(model) -> tuple[Any, list, bool]:
     squash)``: ``squash`` is True where SB3 applies a tanh after the last layer. One walk
     for :func:`export_sb3` and for folding a whitening into the first linear layer
     (:func:`train.core.sb3_train.fold_whitening`)."""
-    import torch.nn as nn
+    import torch.nn as nn  # torch is slow to import: only an SB3 model's export needs it
 
     pol = model.policy
     extractor = actor_extractor(model)
@@ -56,10 +55,10 @@ def export_sb3(model, obs_norm=None) -> ActorProgram:
     :class:`train.agent.ActorProgram` (equal to SB3's ``predict`` to float32 round-off;
     tests/train/test_distill.py and, for CrossQ's batch renormalisation,
     tests/train/test_benchmark.py)."""
+    # torch and stable-baselines3 (train.features too) are slow to import: only an export
     import torch.nn as nn
     from stable_baselines3.common.torch_layers import FlattenExtractor
 
-    from .agent import ActorProgram  # noqa: F811 (at run time, after train.agent is loaded)
     from .features import DirectionFeatures, DropLast
 
     ops: list[dict] = []
@@ -108,7 +107,7 @@ def export_sb3(model, obs_norm=None) -> ActorProgram:
 
 def _is_batch_renorm(m) -> bool:
     """Whether ``m`` is sb3-contrib's ``BatchRenorm`` (CrossQ's layers)."""
-    try:
+    try:  # sb3-contrib is optional (and imports torch)
         from sb3_contrib.common.torch_layers import BatchRenorm
     except ImportError:  # sb3-contrib not installed: no BatchRenorm to meet
         return False

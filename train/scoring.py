@@ -3,13 +3,13 @@ r"""Score any policy in one call: :func:`score`.
 A policy trained with any library on a level of this benchmark is scored the way the
 package scores its own agents and references:
 
-* its **score** (score v2, :mod:`baselines.analysis.score`): the interquartile mean over
-  the level's published test set (:data:`acld_gym.test_sets.TEST_SETS`) of
+* its **score** (score v2, :mod:`baselines.evaluation.score`): the interquartile mean over
+  the level's published test set (:data:`baselines.evaluation.seeds.TEST_SETS`) of
   :math:`(ISE_{passive} - ISE) / (ISE_{passive} - ISE_{bound})` per episode, with its 95 %
   bootstrap interval (passive 0, the clairvoyant bound 1);
 * its **ISE relative to the thesis LQR** (the thesis-facing view of ``python -m
-  train.compare``, :func:`train.core.evaluate.ise_rel_lqr`): the thesis cases 1, 2, 3
-  (seed 0) and the held-out random loads (:data:`acld_gym.test_sets.HELDOUT_SEEDS`), the
+  train.compare``, :mod:`baselines.evaluation.ise`): the thesis cases 1, 2, 3
+  (seed 0) and the held-out random loads (:data:`baselines.evaluation.seeds.HELDOUT_SEEDS`), the
   mean ISE per case divided by the LQR's designed on the same level.
 
 The policy may be a stable-baselines3 model (with its ``VecNormalize`` statistics: the
@@ -38,13 +38,13 @@ import numpy as np
 
 import acld_gym
 from acld_gym.envs.presets import check_env_id
-from acld_gym.test_sets import HELDOUT_SEEDS, evaluation_set
 from acld_gym.util.validate import check_int, shown
-from baselines.analysis.references import make_env, references
-from baselines.analysis.score import SCORE_VERSION, Score, score_of
-from baselines.rollout import check_compatible, metrics_row, rollout
+from baselines.evaluation.ise import eval_episodes, lqr_ise
+from baselines.evaluation.references import make_env, references
+from baselines.evaluation.rollout import check_compatible, metrics_row, rollout
+from baselines.evaluation.score import SCORE_VERSION, Score, score_of
+from baselines.evaluation.seeds import HELDOUT_SEEDS, evaluation_set
 
-from .core.evaluate import eval_episodes, lqr_ise
 from .scoring_inputs import as_policy, check_fits, wrap
 
 __all__ = ["PolicyScore", "score", "policy_ise"]
@@ -56,7 +56,7 @@ class PolicyScore:
     thesis LQR per case."""
 
     score: Score
-    """The score (:class:`baselines.analysis.score.Score`: IQM, interval, per-episode
+    """The score (:class:`baselines.evaluation.score.Score`: IQM, interval, per-episode
     scores and ISE)."""
     ise: dict
     """Mean ISE [m^2 s] per case (1, 2, 3, ``"random"``) of the policy."""
@@ -87,7 +87,7 @@ class PolicyScore:
 
     @property
     def version(self) -> int:
-        """The score's version (:data:`baselines.analysis.score.SCORE_VERSION`)."""
+        """The score's version (:data:`baselines.evaluation.score.SCORE_VERSION`)."""
         return SCORE_VERSION
 
     @property
@@ -117,7 +117,7 @@ class PolicyScore:
 
 def policy_ise(policy, make: Callable[[], gym.Env], seeds: Sequence[int]) -> np.ndarray:
     """ISE [m^2 s] of ``policy`` (SB3 ``predict``) on one episode per seed of the env
-    ``make()`` gives (:func:`baselines.rollout.rollout`, deterministic)."""
+    ``make()`` gives (:func:`baselines.evaluation.rollout.rollout`, deterministic)."""
     env = make()
     try:
         episodes = [rollout(policy, env, seed=s) for s in seeds]

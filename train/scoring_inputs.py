@@ -17,11 +17,11 @@ __all__ = ["ScoredPolicy", "as_policy", "wrap", "check_fits", "load_vec_normaliz
 
 
 class ScoredPolicy:
-    """A policy as :func:`baselines.rollout.rollout` runs it: SB3's ``predict`` on the wrapped
-    env's observation, after the ``VecNormalize`` observation statistics ``obs_norm`` (if
-    any); a plain callable gets the observation and returns the action (no state; a scalar
-    or any shape of one entry per action is taken flat). The
-    recurrent protocol's ``state`` and ``episode_start`` pass through unchanged."""
+    """A policy as :func:`baselines.evaluation.rollout.rollout` runs it: SB3's ``predict`` on
+    the wrapped env's observation, after the ``VecNormalize`` observation statistics
+    ``obs_norm`` (if any); a plain callable gets the observation and returns the action (no
+    state; a scalar or any shape of one entry per action is taken flat). The recurrent
+    protocol's ``state`` and ``episode_start`` pass through unchanged."""
 
     def __init__(self, policy, obs_norm=None):
         self.policy = policy

@@ -1,24 +1,25 @@
-"""Evaluation for the teacher-free benchmark (``python -m train.benchmark``).
+"""The training loop's evaluation: learning curves, validation during training, and the
+benchmark's references table.
 
-The agents are scored by ISE / ISE_LQR through the env (+/-120 V, 1 ms, default Kalman
-observer, deterministic policy): thesis cases 1, 2, 3 with seed 0 and the held-out
-random set (:data:`HELDOUT_SEEDS`; ``ISE / LQR`` there is the mean ISE
-over the set divided by LQR's mean, as in ``python -m train.compare``). LQR, SMC,
-MPC and the clairvoyant bound are computed here ONLY to normalise and report the
-final numbers; no training loop ever sees them.
+The protocol itself -- rollout, seed blocks, the references and their one cache, the score
+and the ISE-relative-to-LQR view -- is :mod:`baselines.evaluation`; this module keeps what
+the training loop needs on top of it and re-exports the view's functions under their old
+names (:func:`eval_episodes`, :func:`rollout_ise`, :func:`lqr_ise`, :func:`relative_ise`,
+:func:`ise_rel_lqr`, :data:`HELDOUT_SEEDS`, :func:`validation_seeds`, ...):
 
-Two evaluators:
-
-* :func:`rollout_ise`: one single-env episode per (case, seed) with
-  :func:`baselines.evaluate.rollout` (the final numbers and the references);
 * :func:`batched_ise`: every episode of a case in one native vector env, the policy
-  called once per step on the batch (the learning curves; equal to the former up
-  to floating-point rounding).
+  called once per step on the batch (the learning curves; equal to
+  :func:`baselines.evaluation.ise.rollout_ise` up to floating-point rounding);
+* :func:`validation_cost`: a run's cost on the validation loads by the env's own reward
+  (checkpoint and run selection);
+* :func:`references`: every reference's ISE per case (LQR, SMC, MPC and the clairvoyant
+  bound, ONLY to normalise and report the final numbers; no training loop ever sees them)
+  and their validation costs, cached with :mod:`baselines.evaluation.cache`;
+* :class:`eval_schedule`: when the learning curve is evaluated.
 """
 
 from __future__ import annotations
 
-import json
 import sys
 from collections.abc import Callable, Mapping
 from pathlib import Path
@@ -27,15 +28,26 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-import acld_gym  # registers the env ids
-from acld_gym.physics.loads import LOAD_CASES
-from acld_gym.test_sets import (  # noqa: F401 (the seed blocks' home; re-exported)
+from acld_gym.util.validate import DataFileError
+from baselines.evaluation.cache import cached, env_inputs, record_key
+from baselines.evaluation.ise import (  # re-exported: the view's home is baselines.evaluation.ise
+    CASES,
+    DEFAULT_ENV_ID,
+    case_references,
+    eval_episodes,
+    ise_rel_lqr,
+    lqr_ise,
+    relative_ise,
+    rollout_ise,
+)
+from baselines.evaluation.ise import case_env as _make_env
+from baselines.evaluation.seeds import (  # re-exported: the seed blocks' home
     HELDOUT_SEEDS,
+    OBJECTIVE_LOADS,
     VALIDATION_SEED0,
     validation_seeds,
 )
-from acld_gym.util.atomic import write_text
-from acld_gym.util.validate import DataFileError
+from baselines.policies import LQRPolicy, policies_for
 
 from .records import check_references, read_json
 
@@ -56,43 +68,16 @@ __all__ = [
     "ise_rel_lqr",
     "lqr_ise",
     "references",
+    "REFERENCES_KIND",
     "CurveCallback",
     "eval_schedule",
 ]
 
-DEFAULT_ENV_ID = acld_gym.ENV_ID
 #: Learning-curve callback of a training run: ``callback(env_steps, policy)`` returns the
 #: curve's point there (a mapping, or None): :func:`train.core.algos.train_algo`.
 CurveCallback = Callable[[int, Any], Mapping | None]
-#: Evaluation cases, in table order (every named load case).
-CASES: tuple = LOAD_CASES
-
-
-def eval_episodes(random_episodes: int | None = None) -> dict:
-    """``{case: seeds}``: seed 0 for the thesis cases, the held-out seeds (all 20, or the
-    first ``random_episodes``) for ``"random"``."""
-    n = len(HELDOUT_SEEDS) if random_episodes is None else int(random_episodes)
-    return {1: (0,), 2: (0,), 3: (0,), "random": tuple(HELDOUT_SEEDS[:n])}
-
-
-def _make_env(env_id: str, case):
-    """The env of ``env_id`` without wrappers (it truncates by itself)."""
-    return gym.make(env_id, load_case=case).unwrapped
-
-
-def rollout_ise(policy, env_id: str = DEFAULT_ENV_ID, episodes: dict | None = None) -> dict:
-    """Mean ISE [m^2 s] per case of ``policy`` (SB3 ``predict`` in volts), one single-env
-    episode per seed (:func:`baselines.evaluate.rollout`)."""
-    from baselines.evaluate import metrics_row, rollout
-
-    episodes = eval_episodes() if episodes is None else episodes
-    out = {}
-    for case, seeds in episodes.items():
-        env = _make_env(env_id, case)
-        out[case] = float(
-            np.mean([metrics_row(case, "agent", rollout(policy, env, seed=s)).ise for s in seeds])
-        )
-    return out
+#: The cache's kind of :func:`references` (:mod:`baselines.evaluation.cache`).
+REFERENCES_KIND = "case references"
 
 
 def batched_ise(policy, env_id: str = DEFAULT_ENV_ID, episodes: dict | None = None) -> dict:
@@ -143,12 +128,6 @@ def _side_by_side(policy, venvs: list, obs: list, value) -> tuple[list, list]:
     return np.split(total, sizes), np.split(steps, sizes)
 
 
-#: Validation loads of the benchmark's per-seed objective figure (``validation_cost`` in a
-#: trial's record and the report): the 256 the recipes select their runs on
-#: (``select: {episodes: 256}`` in ``train/recipes/ppo.yaml`` and ``sac.yaml``).
-OBJECTIVE_LOADS = 256
-
-
 def validation_cost(policy, env_id: str = DEFAULT_ENV_ID, seeds=None) -> float:
     r"""The deterministic ``policy``'s cost on the random loads of ``seeds``, by the env's own
     reward per load (``reward_scale="passive"``, :mod:`acld_gym.envs.scale`):
@@ -167,8 +146,6 @@ def lqr_validation_cost(env_id: str = DEFAULT_ENV_ID, seeds=None) -> float:
     """:func:`validation_cost` of the LQR designed on ``env_id``
     (:meth:`baselines.policies.LQRPolicy.for_env`) on the loads of ``seeds``: the level a
     trained policy has to beat there."""
-    from baselines.policies import LQRPolicy
-
     return validation_cost(LQRPolicy.for_env(_make_env(env_id, 1)), env_id, seeds)
 
 
@@ -181,31 +158,6 @@ def validation_rollout(policy, env_id: str = DEFAULT_ENV_ID, seeds=None) -> tupl
     obs, _ = venv.reset(seed=seeds)
     (ret,), (steps,) = _side_by_side(policy, [venv], [obs], lambda r, info: r)
     return float(np.mean(-ret / steps)), int(steps.sum())
-
-
-def relative_ise(ise: dict, refs: dict, to: str = "lqr") -> dict:
-    """``{case: ise[case] / refs[to][case]}`` (keys of ``refs`` may be strings, as in JSON)."""
-    ref = refs[to]
-    return {c: ise[c] / ref[str(c)] if str(c) in ref else ise[c] / ref[c] for c in ise}
-
-
-def ise_rel_lqr(policy, env_id: str = DEFAULT_ENV_ID, episodes: dict | None = None) -> dict:
-    """``{case: ISE / ISE_LQR}`` of ``policy`` on ``episodes`` (default
-    :func:`eval_episodes`), both by :func:`rollout_ise`, LQR designed on ``env_id``: the
-    figure of a policy trained outside the benchmark (``benchmarks/zoo_eval.py``,
-    ``benchmarks/single_file_ppo.py``)."""
-    episodes = eval_episodes() if episodes is None else episodes
-    ise = rollout_ise(policy, env_id, episodes)
-    return relative_ise(ise, {"lqr": lqr_ise(env_id, episodes)})
-
-
-def lqr_ise(env_id: str = DEFAULT_ENV_ID, episodes: dict | None = None) -> dict:
-    """Mean ISE [m^2 s] per case of the LQR designed on ``env_id`` (:func:`rollout_ise`),
-    the yardstick of ISE / LQR, without designing the other references."""
-    from baselines.policies import LQRPolicy
-
-    lqr = LQRPolicy.for_env(_make_env(env_id, 1))
-    return rollout_ise(lqr, env_id, eval_episodes() if episodes is None else episodes)
 
 
 def _cached_references(cache, bound: bool) -> dict | None:
@@ -227,51 +179,50 @@ def references(
     random_episodes: int | None = None,
     bound: bool = True,
 ) -> dict[str, Any]:
-    """Mean ISE per case of passive, LQR, SMC, MPC and the clairvoyant bound,
-    ``{"env_id": ..., "episodes": ..., "passive": {case: ise}, ...}`` (cases as strings),
-    and the :func:`validation_cost` of passive, LQR and SMC on the first
-    :data:`OBJECTIVE_LOADS` validation loads, ``"validation_cost": {name: cost}`` (the
-    MPC's, a QP per load and step, and the bound's are left out: not needed to read the
-    agents' figure, and slow).
+    """Mean ISE per case of passive, LQR, SMC, MPC and the clairvoyant bound
+    (:func:`baselines.evaluation.ise.case_references`), ``{"env_id": ..., "episodes": ...,
+    "passive": {case: ise}, ...}`` (cases as strings), and the :func:`validation_cost` of
+    passive, LQR and SMC on the first :data:`OBJECTIVE_LOADS` validation loads,
+    ``"validation_cost": {name: cost}`` (the MPC's, a QP per load and step, and the
+    bound's are left out: not needed to read the agents' figure, and slow), with the
+    header of :mod:`baselines.evaluation.cache` (``format``, ``kind``, ``key``).
 
-    Read from ``cache`` (JSON) when it holds the same env id and episodes, else computed
-    (the bound takes about 30 s) and written there atomically.
+    Read from ``cache`` (JSON) when it is a record of the same env (id, configuration,
+    observation), episodes and package version that passes
+    :func:`train.core.records.check_references`, else computed (the bound takes about
+    30 s) and written there atomically (a file of an older format: one line on stderr,
+    then computed again). ``cache`` None: computed, not written.
     """
-    from baselines.evaluate import bound_episode, metrics_row, policies_for
-
     episodes = eval_episodes(random_episodes)
-    key = {str(c): list(s) for c, s in episodes.items()}
-    data = _cached_references(cache, bound)
-    if data is not None:
-        if (
-            data.get("env_id") == env_id
-            and data.get("episodes") == key
-            and (not bound or "bound" in data)
-            and "validation_cost" in data
-        ):
-            return data
-    # passive, LQR, SMC and MPC designed on env_id's own nominal model and observation
-    # (to report the evaluation only, never in training)
-    pols = policies_for(_make_env(env_id, 1))
-    data: dict[str, Any] = {"env_id": env_id, "episodes": key}
-    for name, pol in pols.items():
-        data[name] = {str(c): v for c, v in rollout_ise(pol, env_id, episodes).items()}
-    loads = validation_seeds(OBJECTIVE_LOADS)
-    data["validation_cost"] = {
-        name: validation_cost(pols[name], env_id, loads) for name in ("passive", "lqr", "smc")
+    env = _make_env(env_id, 1)
+    inputs = {
+        "kind": REFERENCES_KIND,
+        "env_id": env_id,
+        "episodes": {str(c): list(s) for c, s in episodes.items()},
+        "objective_loads": OBJECTIVE_LOADS,
     }
-    if bound:
-        data["bound"] = {}
-        for case, seeds in episodes.items():
-            env = _make_env(env_id, case)
-            vals = []
-            for s in seeds:
-                env.reset(seed=s)
-                vals.append(metrics_row(case, "bound", bound_episode(env)).ise)
-            data["bound"][str(case)] = float(np.mean(vals))
-    if cache is not None:
-        write_text(cache, json.dumps(data, indent=2) + "\n")
-    return data
+
+    def compute() -> dict:
+        # passive, LQR, SMC and MPC designed on env_id's own nominal model and observation
+        # (to report the evaluation only, never in training)
+        pols = policies_for(env)
+        data = case_references(env_id, episodes, bound, pols)
+        loads = validation_seeds(OBJECTIVE_LOADS)
+        data["validation_cost"] = {
+            name: validation_cost(pols[name], env_id, loads) for name in ("passive", "lqr", "smc")
+        }
+        return data
+
+    def check(rec: dict) -> str | None:
+        try:
+            check_references(rec, cache, bound)
+        except DataFileError as exc:
+            return str(exc)
+        return None
+
+    key = record_key(inputs | env_inputs(env))
+    what = f"the references of {env_id}"
+    return cached(cache, REFERENCES_KIND, key, compute, check, what, required=True)
 
 
 class eval_schedule:  # noqa: N801  (used like a function)

@@ -29,6 +29,9 @@ from acld_gym.envs.presets import check_env_id
 from acld_gym.util.atomic import strict_json, write_json
 from acld_gym.util.stats import iqm_with_ci
 from acld_gym.util.validate import DataFileError, file_error
+from baselines.evaluation.references import make_env
+from baselines.evaluation.seeds import evaluation_set
+from baselines.marks import level_references, mark_labels
 
 from ..core.records import check_trial, read_json
 from ..core.trials import agent_dir
@@ -98,10 +101,6 @@ def collect_references(
     """The ``references`` part of a level's file: every reference and mark of ``env_id``
     (``policies``: name -> policy instead, e.g. a subset) and the bound, with
     provenance (``command``: how it was asked for)."""
-    from acld_gym.test_sets import evaluation_set
-    from baselines.analysis.references import make_env
-    from baselines.marks import level_references, mark_labels
-
     env_id = check_env_id(env_id, "--env-id")
     if policies is None:
         probe = make_env(evaluation_set(env_id)).unwrapped

@@ -3,9 +3,9 @@ case and its effort after settling, each by the package's own evaluators.
 
 * references (:func:`reference_entries`): the policies of
   :func:`baselines.marks.level_references` scored together on the level's test set
-  (:func:`baselines.analysis.score.score_policies`, its cached anchors), their mean ISE per
-  case by :func:`train.core.evaluate.rollout_ise` and the clairvoyant bound's by
-  :func:`baselines.rollout.bound_episode` on the same episodes;
+  (:func:`baselines.evaluation.score.score_policies`, its cached anchors), their mean ISE per
+  case by :func:`baselines.evaluation.ise.rollout_ise` and the clairvoyant bound's by
+  :func:`baselines.evaluation.ise.bound_ise` on the same episodes;
 * a trained agent (:func:`agent_entry`): :func:`train.scoring.score`, the function that
   scores any policy;
 * the effort of either (:func:`settled_effort`): one episode of thesis cases 1 and 2 (seed
@@ -14,17 +14,20 @@ case and its effort after settling, each by the package's own evaluators.
 
 from __future__ import annotations
 
-import gymnasium as gym
-import numpy as np
+from baselines.analysis.effort import effort, settled_from
+from baselines.evaluation.ise import bound_ise, case_env, eval_episodes, rollout_ise
+from baselines.evaluation.rollout import bound_episode, rollout
+from baselines.evaluation.score import score_policies
+from baselines.evaluation.seeds import HELDOUT_SEEDS
 
-from acld_gym.test_sets import HELDOUT_SEEDS
-
+from ..scoring import score
 from .schema import CASES, EFFORT_CASES
 
 __all__ = [
     "case_episodes",
     "settled_effort",
     "bound_effort",
+    "bound_ise",
     "reference_entries",
     "agent_entry",
     "score_fields",
@@ -35,15 +38,11 @@ def case_episodes(episodes: int | None) -> dict:
     """``{case: seeds}`` of the ISE / thesis LQR columns: seed 0 of thesis cases 1, 2, 3
     and the held-out random loads (all 20; with a reduced run of ``episodes`` test
     episodes, at most that many, as :func:`train.scoring.score` takes them)."""
-    from ..core.evaluate import eval_episodes
-
     n = len(HELDOUT_SEEDS) if episodes is None else min(len(HELDOUT_SEEDS), episodes)
     return eval_episodes(n)
 
 
 def _effort(ep, case: str) -> dict:
-    from baselines.analysis.effort import effort, settled_from
-
     dt = float(ep.t[1] - ep.t[0])
     e = effort(ep.voltage, ep.y, dt, settled_from(int(case)))
     return {
@@ -52,22 +51,15 @@ def _effort(ep, case: str) -> dict:
     }
 
 
-def _case_env(env_id: str, case: str):
-    return gym.make(env_id, load_case=int(case)).unwrapped
-
-
 def settled_effort(policy, env_id: str) -> dict:
     """``{case: {"settled_rms_voltage_V", "settled_limit_fraction"}}`` of ``policy`` (SB3
-    ``predict`` in volts) on thesis cases 1 and 2, seed 0 (:func:`baselines.rollout.rollout`)."""
-    from baselines.rollout import rollout
-
-    return {c: _effort(rollout(policy, _case_env(env_id, c), seed=0), c) for c in EFFORT_CASES}
+    ``predict`` in volts) on thesis cases 1 and 2, seed 0
+    (:func:`baselines.evaluation.rollout.rollout`)."""
+    return {c: _effort(rollout(policy, case_env(env_id, int(c)), seed=0), c) for c in EFFORT_CASES}
 
 
 def _bound_episode(env_id: str, case, seed: int):
-    from baselines.rollout import bound_episode
-
-    env = gym.make(env_id, load_case=case).unwrapped
+    env = case_env(env_id, case)
     env.reset(seed=seed)
     return bound_episode(env)
 
@@ -77,21 +69,9 @@ def bound_effort(env_id: str) -> dict:
     return {c: _effort(_bound_episode(env_id, int(c), 0), c) for c in EFFORT_CASES}
 
 
-def bound_ise(env_id: str, cases: dict) -> dict:
-    """The bound's mean ISE [m^2 s] per case of ``cases`` (``{case: seeds}``)."""
-    from baselines.rollout import metrics_row
-
-    return {
-        c: float(
-            np.mean([metrics_row(c, "bound", _bound_episode(env_id, c, s)).ise for s in seeds])
-        )
-        for c, seeds in cases.items()
-    }
-
-
 def score_fields(score) -> dict:
     """The ``SCORE`` fields (:mod:`train.leaderboard.schema`) of a
-    :class:`baselines.analysis.score.Score`."""
+    :class:`baselines.evaluation.score.Score`."""
     d = score.as_dict()
     return {k: d[k] for k in ("version", "iqm", "ci_low", "ci_high", "n_episodes", "test_set")}
 
@@ -108,10 +88,6 @@ def reference_entries(
     LQR, the yardstick of the ISE columns) and of the clairvoyant bound; ``kinds``: what each is
     (:func:`baselines.marks.mark_labels`); ``episodes``: the first that many test episodes
     (None: all: the published score)."""
-    from baselines.analysis.score import score_policies
-
-    from ..core.evaluate import rollout_ise
-
     if "lqr" not in policies:
         raise ValueError("policies must hold the thesis LQR ('lqr'): the ISE columns' yardstick")
     scores = score_policies(policies, env_id, episodes, quiet=quiet)
@@ -135,8 +111,6 @@ def agent_entry(agent, env_id: str, episodes: int | None = None) -> dict:
     """The measured part of a ``SEED`` (:mod:`train.leaderboard.schema`) of a trained agent
     (:class:`train.agent.TrainedAgent`): :func:`train.scoring.score` and
     :func:`settled_effort`."""
-    from ..scoring import score
-
     s = score(agent, env_id, episodes=episodes)
     rel = {str(c): float(v) for c, v in s.ise_rel_lqr.items()}
     if sorted(rel) != sorted(CASES):

@@ -1,8 +1,4 @@
-"""Score v2, between the passive beam (0) and the clairvoyant bound (1), and its cached
-references."""
-
-import json
-from types import SimpleNamespace
+"""Score v2, between the passive beam (0) and the clairvoyant bound (1)."""
 
 import gymnasium as gym
 import numpy as np
@@ -10,10 +6,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import baselines.analysis.references as references_module
-from acld_gym.test_sets import TEST_SETS, evaluation_set
-from baselines.analysis.references import FORMAT, cache_path, references
-from baselines.analysis.score import (
+from baselines.evaluation.references import references
+from baselines.evaluation.rollout import bound_episode, metrics_row, rollout
+from baselines.evaluation.score import (
     SCORE_VERSION,
     ScoreUndefined,
     episode_scores,
@@ -22,9 +17,9 @@ from baselines.analysis.score import (
     score_policies,
     score_policy,
 )
+from baselines.evaluation.seeds import TEST_SETS, evaluation_set
 from baselines.oracle import ClairvoyantReplay
 from baselines.policies import LQRPolicy, PassivePolicy, SMCPolicy
-from baselines.rollout import bound_episode, metrics_row, rollout
 
 TEST = evaluation_set("ACLDBeam-v1")
 
@@ -131,127 +126,3 @@ def test_episode_scores_are_the_affine_map_with_the_two_anchors(passive, frac, i
     assert s0 == 0.0 and s1 == pytest.approx(1.0, rel=1e-12)
     assert s == pytest.approx((1.0 - ise_factor) / (1.0 - frac), rel=1e-9, abs=1e-9)
     assert (s > 1.0) == (ise < bound) and (s < 0.0) == (ise > passive)
-
-
-# --- the cache ----------------------------------------------------------------------------
-@pytest.fixture
-def counted(monkeypatch, tmp_path):
-    """A fresh cache directory, and a count of the episodes the references run."""
-    monkeypatch.setenv("ACLD_GYM_CACHE_DIR", str(tmp_path))
-    calls = []
-    real = references_module.reference_episode
-
-    def counting(env, seed):
-        calls.append(seed)
-        return real(env, seed)
-
-    monkeypatch.setattr(references_module, "reference_episode", counting)
-    return calls
-
-
-def _file(tmp_path):
-    (path,) = tmp_path.glob("references-*.json")
-    return path
-
-
-def test_a_cached_file_is_reused_after_one_spot_check(counted, tmp_path):
-    test = TEST.first(3)
-    first = references(test)
-    assert len(counted) == 3
-    again = references(test)
-    assert counted[3:] == [test.seeds[0]]  # only the spot check ran
-    np.testing.assert_array_equal(again.bound_ise, first.bound_ise)
-    assert _file(tmp_path) == cache_path(test, _file(tmp_path).stem.rsplit("-", 1)[1])
-
-
-@pytest.mark.parametrize(
-    "damage",
-    [
-        "not json",
-        "bound above lqr",
-        "stale first episode",
-        "other seeds",
-        "format 1",
-        "nested 50000 deep",  # was a RecursionError
-        "ISE as strings",  # numpy would have parsed them
-    ],
-)
-def test_a_damaged_or_stale_file_is_recomputed(counted, tmp_path, damage, capsys):
-    test = TEST.first(3)
-    good = references(test)
-    path = _file(tmp_path)
-    rec = json.loads(path.read_text())
-    if damage == "not json":
-        path.write_text("{")
-    elif damage == "nested 50000 deep":
-        path.write_text("[" * 50000 + "]" * 50000)
-    else:
-        if damage == "bound above lqr":
-            rec["bound_ise"][1] = 2 * rec["lqr_ise"][1]
-        elif damage == "stale first episode":
-            rec["lqr_ise"][0] *= 1.001
-        elif damage == "ISE as strings":
-            rec["lqr_ise"] = [str(v) for v in rec["lqr_ise"]]
-        elif damage == "format 1":  # score v1's cache: no passive ISE
-            del rec["passive_ise"]
-            rec["format"] = 1
-        else:
-            rec["seeds"][2] += 1
-        path.write_text(json.dumps(rec))
-    counted.clear()
-    again = references(test)
-    assert len(counted) >= 3  # recomputed
-    err = capsys.readouterr().err
-    assert "recomputing the references" in err and len(err.strip().splitlines()) == 1
-    if damage == "format 1":
-        assert f"need format {FORMAT}" in err
-    np.testing.assert_array_equal(again.lqr_ise, good.lqr_ise)
-    assert json.loads(path.read_text())["lqr_ise"] == good.lqr_ise.tolist()  # rewritten
-    assert json.loads(path.read_text())["passive_ise"] == good.passive_ise.tolist()
-
-
-def test_other_env_arguments_have_their_own_file(counted, tmp_path):
-    test = TEST.first(2)
-    references(test)
-    references(test, {"param_noise": 0.05})
-    assert len(list(tmp_path.glob("references-*.json"))) == 2
-
-
-_RECORD = {"format": FORMAT, "key": "k", "seeds": [5, 6], "passive_ise": [3.0, 4.0]} | {
-    "lqr_ise": [2.0, 3.0],
-    "bound_ise": [1.0, 1.5],
-}
-_JSON = st.recursive(
-    st.none() | st.booleans() | st.integers() | st.floats() | st.text(max_size=5),
-    lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=8), inner),
-    max_leaves=8,
-)
-
-
-@settings(max_examples=150, deadline=None)
-@given(
-    drop=st.sampled_from([None, *_RECORD]),
-    field=st.sampled_from(list(_RECORD)),
-    value=_JSON,
-    cut=st.integers(0, 400),
-)
-def test_the_cache_check_is_total_on_mutated_records(tmp_path_factory, drop, field, value, cut):
-    # deletion, type change and truncation of a record: the check says why or returns the
-    # three arrays of the checked form, never another exception
-    from baselines.analysis.references import _damage
-
-    test = SimpleNamespace(seeds=(5, 6))
-    rec = dict(_RECORD)
-    if drop is not None:
-        rec.pop(drop)
-    rec[field] = value
-    text = json.dumps(rec)
-    if cut % 4 == 0:
-        text = text[: cut % (len(text) + 1)]
-    path = tmp_path_factory.mktemp("refs") / "r.json"
-    path.write_text(text)
-    got = _damage(path, test, "k")
-    if isinstance(got, str):
-        return
-    assert len(got) == 3 and all(a.shape == (2,) and np.all(a > 0) for a in got)
-    assert all(np.all(np.isfinite(a)) for a in got)

@@ -58,7 +58,6 @@ LAYERS: tuple[tuple[str, ...], ...] = (
 #: strongly connected component of the import graph), with what closes it. train/ is being
 #: restructured by its owner; acld_gym/ and baselines/ have none.
 KNOWN_CYCLES: dict[frozenset[str], str] = {
-    frozenset({"train.compare", "train.figures"}): "compare <-> figures, both in functions",
 }
 #: The train/ cycles among :data:`KNOWN_CYCLES` (the brief's KNOWN_TRAIN_CYCLES).
 KNOWN_TRAIN_CYCLES = frozenset(c for c in KNOWN_CYCLES if all(m.startswith("train.") for m in c))
@@ -76,7 +75,6 @@ KNOWN_OVER_400: frozenset[str] = frozenset(
     {
         "train/core/report.py",
         "train/core/sb3_policies.py",
-        "train/compare.py",
     }
 )
 

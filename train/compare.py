@@ -22,11 +22,13 @@ import argparse
 import sys
 from pathlib import Path
 
+from acld_gym.envs.beam_env import ACLDBeamEnv
 from acld_gym.physics.truth import MESHES
-from acld_gym.util.atomic import save_figure, write_json, write_text
+from acld_gym.util.atomic import write_json, write_text
 from acld_gym.util.progress import Progress
 from acld_gym.util.text import plain, prog
-from acld_gym.util.validate import arg_type
+from acld_gym.util.validate import arg_type, run_main
+from baselines.analysis.score import SCORE_NAME
 from baselines.arguments import folder_name, input_directory, outputs, param_noise
 from baselines.evaluate import (
     EvalRow,
@@ -39,8 +41,12 @@ from baselines.evaluate import (
     mean_rows,
     plot_episodes,
 )
+from baselines.marks import marks_for
+from baselines.policies import RewardMPCPolicy, mpc_available
 
+from .agent_dirs import AGENTS_DIR, agent_names, load_agents
 from .core.evaluate import HELDOUT_SEEDS  # re-exported (defined with the other eval seeds)
+from .curves_figure import learning_curves_figure, plot_learning_curves
 
 __all__ = [
     "AGENTS_DIR",
@@ -58,50 +64,12 @@ __all__ = [
     "main",
 ]
 
-AGENTS_DIR = Path(__file__).resolve().parent / "agents"
-
-
-def agent_names(directory: str | Path = AGENTS_DIR, mesh: str = "converged") -> list[str]:
-    """The agent directories under ``directory`` trained on ``mesh`` (sorted), and each
-    whose metadata does not read (:func:`train.agent_files.read_metadata`): loading it
-    names the fault, it is never skipped in silence."""
-    from .agent import META_FILE, AgentFileError
-    from .agent_files import read_metadata
-
-    out = []
-    for d in sorted(Path(directory).iterdir()) if Path(directory).is_dir() else []:
-        if (d / META_FILE).exists() or (d / META_FILE).is_symlink():
-            try:
-                env = read_metadata(d)["env"]
-            except (AgentFileError, OSError):
-                out.append(d.name)  # TrainedAgent.load reports it
-                continue
-            default = "thesis" if env["id"] == "ACLDBeam-v0" else "converged"
-            if env.get("kwargs", {}).get("mesh", default) == mesh:
-                out.append(d.name)
-    return out
-
-
-def load_agents(directory: str | Path = AGENTS_DIR, names=None, mesh: str = "converged") -> dict:
-    """The agents ``directory/<name>/`` as policies (default: every agent trained on
-    ``mesh``); ``FileNotFoundError`` / :class:`train.agent.AgentFileError` if one is
-    missing or does not match its env."""
-    from .agent import TrainedAgent
-
-    directory = Path(directory)
-    names = agent_names(directory, mesh) if names is None else names
-    return {name: TrainedAgent.load(directory / name, name) for name in names}
-
 
 def reference_policies(mesh: str = "converged") -> dict:
     """Passive, LQR, SMC, MPC (:func:`baselines.evaluate.default_policies`) and, with osqp,
     the MPC of the env's reward (``"mpc_reward"``, :class:`baselines.policies.
     RewardMPCPolicy`) on the nominal ``mesh`` plant; the engineer's designs and the plant
     oracle (:func:`baselines.marks.marks_for`)."""
-    from acld_gym.envs.beam_env import ACLDBeamEnv
-    from baselines.marks import marks_for
-    from baselines.policies import RewardMPCPolicy, mpc_available
-
     out = default_policies(mesh)
     if mpc_available():
         out[RewardMPCPolicy.name] = RewardMPCPolicy(mesh=mesh)
@@ -208,8 +176,6 @@ def markdown_scores(rows: list[dict]) -> str:
             seen.setdefault(d["policy"], d)
     if not seen:
         return ""
-    from baselines.analysis.score import SCORE_NAME
-
     first = next(iter(seen.values()))["score"]
     out = [
         f"{SCORE_NAME.capitalize()} on `{first['test_set']}` ({first['n_episodes']} random "
@@ -227,74 +193,6 @@ def markdown_scores(rows: list[dict]) -> str:
             f"| [{sc['ci_low']:.3f}, {sc['ci_high']:.3f}] | {rel} |"
         )
     return "\n".join(out)
-
-
-def learning_curves_figure(agents: dict):
-    """ISE / LQR on the three thesis cases against training env steps for each agent (from
-    its ``learning_curve.csv``), both axes logarithmic: the curves span four decades of
-    steps (SAC's 2M to the random search's 100M) and fall from the passive level (~3.7x)
-    to within a few per cent of one another. The untrained point (step 0) has no place on
-    a log axis and is left out. ``None`` if no agent has a curve."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from .agent import AgentFileError
-    from .agent_files import read_curve
-    from .core.evaluate import lqr_ise
-    from .core.report import ratio_log_axis
-    from .figures import sparse_ratio_labels
-
-    curves = {}
-    for name, agent in agents.items():  # read as the agent was: no link, rows checked
-        try:
-            rows = None if agent.directory is None else read_curve(agent.directory)
-        except AgentFileError as exc:  # one line; the comparison stands
-            print(f"{name}: no learning curve ({exc})", file=sys.stderr)
-            rows = None
-        if rows:
-            curves[name] = rows
-    if not curves:
-        return None
-    lqr = lqr_ise(episodes={c: (0,) for c in (1, 2, 3)})
-    fig, axes = plt.subplots(1, 3, figsize=(12, 3.6))
-    for ax, case in zip(axes, (1, 2, 3), strict=True):
-        for name, rows in curves.items():
-            sub = [r for r in rows if r["case"] == str(case) and int(r["timesteps"]) > 0]
-            ax.plot(
-                [int(r["timesteps"]) for r in sub],
-                [float(r["ise"]) / lqr[case] for r in sub],
-                marker=".",
-                lw=1,
-                label=name,
-            )
-        ax.axhline(1.0, color="k", ls="--", lw=1, label="LQR")
-        ax.set_xscale("log")
-        ratio_log_axis(ax)
-        sparse_ratio_labels(ax)  # 0.9 beside 1 overlapped
-        ax.set_title(f"load case {case}")
-        ax.set_xlabel("training env steps")
-        ax.grid(alpha=0.3, which="both")
-    axes[0].set_ylabel("ISE / LQR")
-    axes[0].legend(fontsize=8)
-    fig.tight_layout()
-    return fig
-
-
-def plot_learning_curves(agents: dict, directory: Path) -> Path | None:
-    """Write :func:`learning_curves_figure` to ``directory/learning_curves.png``; ``None``
-    (and no file) if no agent has a curve."""
-    import matplotlib.pyplot as plt
-
-    fig = learning_curves_figure(agents)
-    if fig is None:
-        return None
-    directory.mkdir(parents=True, exist_ok=True)
-    out = directory / "learning_curves.png"
-    save_figure(fig, out, dpi=110)
-    plt.close(fig)
-    return out
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -405,6 +303,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    from acld_gym.util.validate import run_main
-
     sys.exit(run_main(main))

@@ -22,11 +22,22 @@ import io
 import sys
 from pathlib import Path
 
+import gymnasium as gym
 import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
 
+from acld_gym.envs.beam_env import ACLDBeamEnv
+from acld_gym.envs.presets import check_env_id
 from acld_gym.util.atomic import check_writable, save_figure, write_atomic
 from acld_gym.util.text import plain, prog
-from acld_gym.util.validate import arg_type
+from acld_gym.util.validate import arg_type, run_main
+from baselines.evaluate import episode_rows
+from baselines.marks import level_references
+from baselines.rollout import check_compatible
+
+from .agent_dirs import AGENTS_DIR, load_agents
+from .core.evaluate import HELDOUT_SEEDS
+from .curves_figure import sparse_ratio_labels
 
 __all__ = [
     "HERO_CASES",
@@ -52,27 +63,10 @@ _STYLE = {
 }
 
 
-def sparse_ratio_labels(ax) -> None:
-    """Label only the minor ticks 2, 3, 5, 8 of each decade of ``ax``'s log y axis (0.8,
-    2, 3, 5, ...): 0.9 and 1 lie 0.05 decade apart and their labels overlap."""
-    from matplotlib.ticker import FuncFormatter
-
-    def label(v: float, _pos) -> str:
-        lead = round(v / 10 ** np.floor(np.log10(v) + 1e-9), 6)
-        return f"{v:g}" if lead in (2, 3, 5, 8) else ""
-
-    ax.yaxis.set_minor_formatter(FuncFormatter(label))
-
-
 def hero_policies(agents_dir: str | Path | None = None) -> dict:
     """Name -> policy: passive, the thesis's LQR and the engineer's design of
     ``ACLDBeam-v1`` (:func:`baselines.marks.level_references`), and the shipped ``ppo``
-    agent (``agents_dir``, default :data:`train.compare.AGENTS_DIR`)."""
-    from acld_gym.envs.beam_env import ACLDBeamEnv
-    from baselines.marks import level_references
-
-    from .compare import AGENTS_DIR, load_agents
-
+    agent (``agents_dir``, default :data:`train.agent_dirs.AGENTS_DIR`)."""
     refs = level_references(ACLDBeamEnv())
     engineer = "mpc_rig" if "mpc_rig" in refs else "lqg"
     out = {name: refs[name] for name in ("passive", "lqr", engineer)}
@@ -83,10 +77,6 @@ def hero_data(policies: dict, random_episodes: int = 20, env_kwargs: dict | None
     """``(case-1 episodes by name, {case: {name: ISE / thesis LQR}})`` for ``policies``
     and the bound: episode seed 0 of each thesis case (as ``train.compare``), the mean ISE
     over the first ``random_episodes`` held-out random loads."""
-    from baselines.evaluate import episode_rows
-
-    from .core.evaluate import HELDOUT_SEEDS
-
     episodes: dict = {}
     ratios = {}
     for case in HERO_CASES:
@@ -101,14 +91,13 @@ def hero_data(policies: dict, random_episodes: int = 20, env_kwargs: dict | None
 
 def _envelope(y: np.ndarray, window: int) -> np.ndarray:
     """The running maximum of ``|y|`` over the last ``window`` samples."""
-    from numpy.lib.stride_tricks import sliding_window_view
-
     a = np.abs(np.concatenate([np.zeros(window - 1), np.asarray(y)]))
     return sliding_window_view(a, window).max(axis=1)
 
 
 def hero_figure(episodes: dict, ratios: dict):
     """The hero figure of :func:`hero_data`'s output (a matplotlib figure)."""
+    # matplotlib is slow to import (and sets its backend): only a figure needs it
     import matplotlib
 
     matplotlib.use("Agg")
@@ -165,11 +154,6 @@ def hero_figure(episodes: dict, ratios: dict):
 def beam_frames(policy, env_id: str = "ACLDBeam-v1", case=1, n_frames: int = 150, stride: int = 4):
     """``n_frames`` ``render()`` frames of one episode of ``policy`` on load ``case``, one
     every ``stride`` steps (episode seed 0)."""
-    import gymnasium as gym
-
-    from acld_gym.envs.presets import check_env_id
-    from baselines.rollout import check_compatible
-
     check_env_id(env_id, "env_id")
     env = gym.make(env_id, load_case=case, render_mode="rgb_array")
     try:
@@ -194,7 +178,7 @@ def beam_frames(policy, env_id: str = "ACLDBeam-v1", case=1, n_frames: int = 150
 def save_animation(frames: list, path: str | Path, fps: float = 10.0, scale: float = 1.0) -> Path:
     """``frames`` (H x W x 3 uint8) as an animated GIF or WebP (by ``path``'s suffix),
     looping, written atomically; ``scale`` resizes each frame."""
-    from PIL import Image
+    from PIL import Image  # pillow (matplotlib's dependency): only an animation needs it
 
     path = Path(path)
     fmt = {".gif": "GIF", ".webp": "WEBP"}.get(path.suffix.lower())
@@ -260,7 +244,7 @@ def main(argv: list[str] | None = None) -> int:
     except ValueError as exc:
         p.error(str(exc))
     if args.what == "hero":
-        import matplotlib.pyplot as plt
+        import matplotlib.pyplot as plt  # slow to import: only the hero needs it
 
         kwargs = {} if args.episode_length == 1.0 else {"episode_length": args.episode_length}
         episodes, ratios = hero_data(
@@ -272,9 +256,6 @@ def main(argv: list[str] | None = None) -> int:
         for case, r in ratios.items():
             print(f"case {case}: " + ", ".join(f"{n} {v:.3f}" for n, v in r.items()))
     else:
-        from acld_gym.envs.beam_env import ACLDBeamEnv
-        from baselines.marks import level_references
-
         policy = level_references(ACLDBeamEnv())[args.policy]
         frames = beam_frames(policy, n_frames=args.frames, stride=args.stride)
         save_animation(frames, args.path, fps=args.fps, scale=args.scale)
@@ -283,6 +264,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    from acld_gym.util.validate import run_main
-
     sys.exit(run_main(main))

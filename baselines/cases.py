@@ -2,7 +2,7 @@
 clairvoyant bound of the same load and plant, as rows of metrics (:func:`evaluate`), and
 their means over episodes (:func:`mean_rows`). The primitives of ``python -m
 baselines.evaluate`` (:mod:`baselines.evaluate`, the CLI and its tables) and of
-``train.compare``; one episode is :func:`baselines.rollout.rollout`."""
+``train.compare``; one episode is :func:`baselines.evaluation.rollout.rollout`."""
 
 from __future__ import annotations
 
@@ -14,8 +14,8 @@ from acld_gym.envs.beam_env import ACLDBeamEnv
 from acld_gym.physics.loads import THESIS_CASES
 from acld_gym.util.progress import Progress
 
+from .evaluation.rollout import EvalRow, bound_episode, metrics_row, rollout
 from .policies import policies_for
-from .rollout import EvalRow, bound_episode, metrics_row, rollout
 
 __all__ = ["episode_rows", "evaluate", "mean_rows"]
 

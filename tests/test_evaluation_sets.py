@@ -8,11 +8,13 @@ import pytest
 
 import acld_gym
 from acld_gym.test_sets import RESERVED_SEEDS, TEST_SEEDS, TEST_SETS, EvaluationSet, evaluation_set
+from baselines.evaluation.seeds import (
+    HELDOUT_SEEDS,
+    OBJECTIVE_LOADS,
+    SEARCH_SEEDS,  # the random search's episode seeds (train.core.search)
+    validation_seeds,
+)
 from train.compare import AGENTS_DIR
-from train.core.evaluate import HELDOUT_SEEDS, OBJECTIVE_LOADS, validation_seeds
-
-#: The random search draws its episode seeds from [1_000_000, 2**31) (train.core.search).
-SEARCH_SEEDS = range(1_000_000, 2**31)
 
 
 @pytest.mark.parametrize("env_id", sorted(TEST_SETS))

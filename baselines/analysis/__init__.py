@@ -15,8 +15,9 @@ runs them all):
   response, margins at the actuator;
 * :mod:`~baselines.analysis.effort`: RMS voltage, reactive power, chattering, time at the
   limit;
-* :mod:`~baselines.analysis.references` and :mod:`~baselines.analysis.score`: score v2,
-  between the passive beam (0) and the clairvoyant bound (1) on a published test set;
+* the score (score v2, between the passive beam (0) and the clairvoyant bound (1) on a
+  published test set) is :mod:`baselines.evaluation`'s (``references`` and ``score`` here
+  re-export it under their old paths);
 * :mod:`~baselines.analysis.control` and :mod:`~baselines.analysis.report`: all of it for
   one policy, as JSON, text and a Bode figure.
 """

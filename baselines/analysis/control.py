@@ -11,7 +11,7 @@ For any object with SB3's ``predict`` (volts), through the env ``env_id``:
   gain), a check of the identified ones, and the **gain and phase margins** of the loop
   broken at the actuator (:mod:`~baselines.analysis.linear`);
 * **effort** on the thesis cases 1-3 (:mod:`~baselines.analysis.effort`);
-* the **score** on the env's test set (:mod:`~baselines.analysis.score`).
+* the **score** on the env's test set (:mod:`baselines.evaluation.score`).
 
 :meth:`Analysis.as_dict` is the JSON of ``python -m baselines.analyze``.
 """
@@ -26,10 +26,12 @@ import numpy as np
 import acld_gym
 from acld_gym.envs.presets import preset
 from acld_gym.physics.actuator import patch_capacitance
-from acld_gym.test_sets import evaluation_set
 from acld_gym.util.blas import one_blas_thread
 from acld_gym.util.progress import Progress
-from baselines.rollout import metrics_row, rollout
+from baselines.evaluation.references import References, references
+from baselines.evaluation.rollout import metrics_row, rollout
+from baselines.evaluation.score import Score, policy_ises, score_of
+from baselines.evaluation.seeds import BASIS_SEEDS, evaluation_set
 
 from .compliance import ComplianceTest, compliance_test
 from .effort import Effort, effort, settled_from
@@ -38,16 +40,11 @@ from .frequency import RESOLUTION, multisine
 from .linear import LinearLaw, ObserverLoop, margins, small_signal_law
 from .modal import RECORD_STEPS, ModalTest, modal_test, passive_modes
 from .modes import Mode
-from .references import References, references
-from .score import Score, policy_ises, score_of
 
 __all__ = ["Analysis", "analyze", "CASES", "BASIS_SEEDS"]
 
 #: The thesis cases of the effort measures.
 CASES = (1, 2, 3)
-#: Passive episodes averaged into the excitation's unit-pulse response
-#: (:class:`~baselines.analysis.excitation.PulseSuperposition`).
-BASIS_SEEDS = 64
 
 
 @dataclass(frozen=True)
@@ -195,7 +192,7 @@ def analyze(
         )
 
         progress.stage("small-signal law")
-        if hasattr(policy, "start_episode"):  # an oracle (baselines.rollout): no static law
+        if hasattr(policy, "start_episode"):  # an oracle (evaluation.rollout): no static law
             law, why = None, "an oracle: it reads the episode's plant at reset, a dynamic law"
         else:
             law, why = small_signal_law(policy, obs_size, v_max)

@@ -55,7 +55,7 @@ from scipy.signal import fftconvolve
 import acld_gym  # noqa: F401  (registers the env ids)
 from acld_gym.physics.loads import thesis_load
 from acld_gym.util.validate import check_int, check_seed
-from baselines.rollout import check_compatible
+from baselines.evaluation.rollout import check_compatible
 
 __all__ = ["Response", "PulseSuperposition", "causal_convolution"]
 
@@ -199,7 +199,7 @@ class PulseSuperposition:
     def run(self, policy, load) -> Response:
         """``policy`` (SB3 ``predict``, deterministic; a policy with a state, such as
         :class:`baselines.policies.MeasurementFeedback`, gets it back each step as from
-        :func:`baselines.rollout.rollout`) in the loop under ``load`` (as many periods as
+        :func:`baselines.evaluation.rollout.rollout`) in the loop under ``load`` (as many periods as
         it has values, at most ``n_steps``)."""
         f = self._check_load(load)
         check_compatible(policy, self.env)
@@ -208,7 +208,7 @@ class PulseSuperposition:
         n = f.size
         y, v, req = np.zeros(n + 1), np.empty(n), np.empty(n)
         obs, _ = self.env.reset(seed=self.seed)
-        if hasattr(policy, "start_episode"):  # an oracle (baselines.rollout.rollout)
+        if hasattr(policy, "start_episode"):  # an oracle (evaluation.rollout.rollout)
             policy.start_episode(self.env)
         dtype = obs.dtype
         state, start = None, np.ones(1, dtype=bool)  # SB3's recurrent-policy protocol

@@ -9,9 +9,9 @@ from pathlib import Path
 import numpy as np
 
 from acld_gym.util.atomic import save_figure
+from baselines.evaluation.score import SCORE_NAME
 
 from .control import Analysis
-from .score import SCORE_NAME
 
 __all__ = ["format_analysis", "plot_compliance", "markdown_summary"]
 

@@ -11,6 +11,8 @@ never scored on an episode it was trained or selected on:
   :data:`HELDOUT_SEEDS` of the ISE-relative-to-LQR view (:mod:`baselines.evaluation.ise`),
   and the validation loads from :data:`VALIDATION_SEED0` (:func:`validation_seeds`; the
   recipes select their runs on the first :data:`OBJECTIVE_LOADS`);
+* **analysis**: the passive episodes of seeds ``0 .. BASIS_SEEDS - 1`` averaged into the
+  excitation's unit-pulse response (:mod:`baselines.analysis.control`; noise, not loads);
 * **test**: the published test sets :data:`TEST_SETS` in :data:`RESERVED_SEEDS`, the
   episodes of the score (:mod:`baselines.evaluation.score`).
 
@@ -44,6 +46,7 @@ __all__ = [
     "TEST_SETS",
     "TEST_SEEDS",
     "evaluation_set",
+    "BASIS_SEEDS",
 ]
 
 #: The block the random search (``train.core.search``) draws its training episodes' seeds
@@ -54,3 +57,7 @@ SEARCH_SEEDS = range(1_000_000, 2**31)
 #: the report): the 256 the recipes select their runs on (``select: {episodes: 256}`` in
 #: ``train/recipes/ppo.yaml`` and ``sac.yaml``).
 OBJECTIVE_LOADS = 256
+
+#: Passive episodes (seeds 0 .. 63) averaged into the excitation's unit-pulse response
+#: (:class:`baselines.analysis.excitation.PulseSuperposition`, :mod:`baselines.analysis.control`).
+BASIS_SEEDS = 64

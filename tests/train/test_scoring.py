@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 import torch
 
-import acld_gym.test_sets as bench
+import baselines.evaluation.seeds as bench
 from acld_gym.wrappers import ObserveModes, UnitAction
-from baselines.analysis.score import score_policy
+from baselines.evaluation.score import score_policy
 from baselines.policies import LQRPolicy
 from train.agent import TrainedAgent, export_sb3
 from train.scoring import score
@@ -245,7 +245,7 @@ def test_seeds_in_one_public_place():
 
 def test_engineer_lqg_keeps_its_filter_state():
     """The engineer's LQG (its Kalman filter and commands in flight are SB3's ``state``)
-    scores exactly as baselines.analysis.score scores it; without its state it is another
+    scores exactly as baselines.evaluation.score scores it; without its state it is another
     policy."""
     from baselines.engineer import DelayLQGPolicy
 

@@ -260,7 +260,8 @@ def check_references(data, path: str | Path, bound: bool = True) -> dict:
     """``data`` (a parsed references cache, :func:`train.core.evaluate.references`) if it
     holds every reference's ISE per case (LQR's positive: the tables divide by it), the
     bound's with ``bound``, and the validation costs; else :class:`DataFileError` naming
-    ``path`` and the field."""
+    ``path`` and the field. The payload only: the record's header (format, kind, key) is
+    the cache's to check (:mod:`baselines.evaluation.cache`)."""
     r = _Reader(path)
     data = r.mapping(data, "")
     r.key(data, "env_id", "", r.text)

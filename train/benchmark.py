@@ -5,7 +5,7 @@ and a fixed env-step budget, the same for every seed) with every seed, from rand
 initialisation, on the env's observation and reward only. Then evaluates each final
 policy deterministically through the env (+/-120 V, 1 ms, default Kalman observer):
 ISE / ISE_LQR on thesis cases 1, 2, 3 (seed 0) and on the held-out random set
-(``train.core.evaluate.HELDOUT_SEEDS``). LQR, SMC, MPC and the clairvoyant bound are used
+(``acld_gym.test_sets.HELDOUT_SEEDS``). LQR, SMC, MPC and the clairvoyant bound are used
 only to normalise and report these numbers.
 
 Writes to ``--out`` (default ``runs/<env id>/benchmark``: runs on different levels never

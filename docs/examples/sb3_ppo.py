@@ -1,0 +1,39 @@
+"""SB3 PPO with MlpPolicy on any ACLDBeam level, scored: python sb3_ppo.py [ENV_ID]."""
+
+import argparse
+from functools import partial
+
+import gymnasium as gym
+import torch
+from stable_baselines3 import PPO
+from stable_baselines3.common.vec_env import VecNormalize
+
+from acld_gym.envs import SB3VecEnv
+from acld_gym.envs.presets import PRESETS, preset
+from acld_gym.wrappers import ObserveModes, UnitAction, vector
+from train.scoring import score
+
+p = argparse.ArgumentParser()
+p.add_argument("env_id", nargs="?", default="ACLDBeam-v1", choices=list(PRESETS))
+p.add_argument("--timesteps", type=int, default=2_000_000)
+p.add_argument("--seed", type=int, default=0)
+p.add_argument("--episodes", type=int, help="score on the first N test loads (default: all)")
+args = p.parse_args()
+torch.set_num_threads(1)  # torch's default threads make SB3 15-25x slower on 2 cores
+
+modes = preset(args.env_id).obs_mode == "estimate"  # mode 1 and the tip, where observed
+venv = VecNormalize(
+    SB3VecEnv(
+        venv=gym.make_vec(args.env_id, 256, load_case="random", reward_scale="passive"),
+        wrappers=[vector.UnitAction] + [partial(vector.ObserveModes, modes=1)] * modes,
+    ),
+    gamma=0.999,
+)
+model = PPO(
+    "MlpPolicy", venv, n_steps=64, batch_size=512, n_epochs=5, gamma=0.999, gae_lambda=0.98,
+    learning_rate=lambda progress: 3e-3 * progress, ent_coef=0.05, use_sde=True,
+    policy_kwargs=dict(net_arch=dict(pi=[], vf=[64, 64]), log_std_init=-1.0), seed=args.seed,
+)  # fmt: skip
+model.learn(args.timesteps)
+wrappers = [UnitAction] + [partial(ObserveModes, modes=1)] * modes  # the same, one env
+print(score(model, args.env_id, wrappers=wrappers, episodes=args.episodes))

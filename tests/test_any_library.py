@@ -1,0 +1,313 @@
+"""The guide page "Train on any level with any library" (docs/any-library.md): its scripts
+(docs/examples/) run end to end on a tiny budget on ACLDBeam-v1 and on another level and
+print a finite score, CleanRL's additions run as the diff gives them, the rl-zoo3 files
+hold the scripts' hyperparameters on every registered id, and the page includes every
+example verbatim (pymdownx.snippets)."""
+
+from __future__ import annotations
+
+import ast
+import contextlib
+import io
+import math
+import os
+import re
+import subprocess
+import sys
+import types
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+import pytest
+import torch
+import yaml
+
+from acld_gym.envs.presets import PRESETS, preset
+
+ROOT = Path(__file__).resolve().parent.parent
+EXAMPLES = ROOT / "docs" / "examples"
+PAGE = ROOT / "docs" / "any-library.md"
+#: What train.scoring.PolicyScore prints: the score, its interval, ISE / LQR per case.
+SCORE_LINE = re.compile(
+    r"score v2 on (?P<id>\S+)/test-v\d+ \(first (?P<n>\d+) of \d+\): (?P<iqm>\S+) "
+    r"\[(?P<lo>\S+), (?P<hi>\S+)\]; ISE / thesis LQR 1: (?P<c1>\S+), 2: (?P<c2>\S+), "
+    r"3: (?P<c3>\S+), random: (?P<cr>\S+)$"
+)
+OTHER = "ACLDBeamHard-v1"  # observes the sensor: the scripts leave ObserveModes out
+
+
+def _run(args: list[str], cwd: Path, timeout: int = 600) -> str:
+    env = dict(os.environ, PYTHONPATH=str(ROOT), OMP_NUM_THREADS="1")
+    done = subprocess.run(
+        [sys.executable, *args], cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout
+    )
+    assert done.returncode == 0, done.stderr[-3000:]
+    return done.stdout
+
+
+def _check_score(stdout: str, env_id: str, episodes: int) -> None:
+    """The last line is a score of ``env_id`` on ``episodes`` test loads, every number
+    finite, the ratios positive."""
+    m = SCORE_LINE.match(stdout.strip().splitlines()[-1])
+    assert m, stdout[-2000:]
+    assert m["id"] == env_id and int(m["n"]) == episodes
+    values = [float(m[k]) for k in ("iqm", "lo", "hi", "c1", "c2", "c3", "cr")]
+    assert all(math.isfinite(v) for v in values)
+    assert float(m["lo"]) <= float(m["iqm"]) <= float(m["hi"])
+    assert all(v > 0 for v in values[3:])
+
+
+# one level each (the other script's level): the suite's time, both kinds of observation
+@pytest.mark.parametrize(
+    "script, steps, env_id", [("sb3_ppo.py", 16_384, "ACLDBeam-v1"), ("sb3_sac.py", 12_000, OTHER)]
+)
+def test_sb3_script_runs_on_a_tiny_budget(script, steps, env_id, tmp_path):
+    out = _run(
+        [str(EXAMPLES / script), env_id, "--timesteps", str(steps), "--episodes", "2"], tmp_path
+    )
+    _check_score(out, env_id, 2)
+
+
+def test_scripts_refuse_an_unknown_level_in_one_line(tmp_path):
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    done = subprocess.run(
+        [sys.executable, str(EXAMPLES / "sb3_ppo.py"), "ACLDBeam-v9"],
+        cwd=tmp_path,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+    assert "invalid choice: 'ACLDBeam-v9'" in done.stderr.splitlines()[-1]
+
+
+@pytest.mark.parametrize("algo, env_id", [("ppo", "ACLDBeam-v1"), ("sac", OTHER)])
+def test_rl_zoo3_trains_from_the_mlp_file_and_zoo_score_scores_it(algo, env_id, tmp_path):
+    """rl-zoo3 trains from ``train/zoo/<algo>_mlp.yml`` (a few thousand steps, 8 sub-envs)
+    and ``docs/examples/zoo_score.py`` scores the run with the wrappers and the
+    ``VecNormalize`` it saved."""
+    train = ["-m", "rl_zoo3.train", "--algo", algo, "--env", env_id, "--gym-packages"]
+    train += ["acld_gym", "--conf-file", str(ROOT / f"train/zoo/{algo}_mlp.yml"), "-f", "logs"]
+    train += ["--seed", "0", "--eval-freq", "-1", "-n", "4096", "--hyperparams", "n_envs:8"]
+    if algo == "sac":
+        train.append("learning_starts:1000")
+    _run(train, tmp_path)
+    run = tmp_path / "logs" / algo / f"{env_id}_1"
+    score = [str(EXAMPLES / "zoo_score.py"), algo, str(run), env_id, "--episodes", "2"]
+    out = _run(score, tmp_path)
+    _check_score(out, env_id, 2)
+
+
+# -- CleanRL: the diff's additions, run as they stand in the patched file --------------------
+
+
+def _new_side(diff: str) -> list[list[str]]:
+    """Each hunk of a unified diff as the lines of the patched file (context and ``+``)."""
+    hunks: list[list[str]] = []
+    for line in diff.splitlines():
+        if line.startswith("@@"):
+            hunks.append([])
+        elif hunks and not line.startswith(("-", "---", "+++")):
+            hunks[-1].append(line[1:])
+    return hunks
+
+
+def _added(diff: str) -> list[list[str]]:
+    """Each hunk's added lines (without the ``+``)."""
+    hunks: list[list[str]] = []
+    for line in diff.splitlines():
+        if line.startswith("@@"):
+            hunks.append([])
+        elif hunks and line.startswith("+") and not line.startswith("+++"):
+            hunks[-1].append(line[1:])
+    return hunks
+
+
+def test_cleanrl_diff_is_the_documented_additions():
+    """The diff changes CleanRL's file at the pinned commit by the documented additions
+    only: ``make_env`` wraps the level with UnitAction, the reward per load and (where the
+    level observes the estimate) ObserveModes; torch on one thread; the score at the end."""
+    diff = (EXAMPLES / "cleanrl_ppo.diff").read_text()
+    assert diff.startswith("--- a/cleanrl/ppo_continuous_action.py\n")
+    removed = [line[1:] for line in diff.splitlines() if line[:1] == "-" and line[:3] != "---"]
+    assert removed == [
+        '    env_id: str = "HalfCheetah-v4"',
+        "            env = gym.make(env_id)",
+        "        env = gym.wrappers.TransformObservation(env, lambda obs: np.clip(obs, -10, 10))",
+    ]
+    added = "\n".join(sum(_added(diff), []))
+    for needed in ("torch.set_num_threads(1)", 'reward_scale="passive"', "score(policy"):
+        assert needed in added
+    # each hunk's header counts its lines (so `patch` and `git apply` take it)
+    for m in re.finditer(r"^@@ -\d+,(\d+) \+\d+,(\d+) @@\n(.*?)(?=^@@|\Z)", diff, re.M | re.S):
+        lines = m[3].splitlines()
+        assert sum(not line.startswith("+") for line in lines) == int(m[1])
+        assert sum(not line.startswith("-") for line in lines) == int(m[2])
+
+
+@pytest.mark.parametrize("env_id", ["ACLDBeam-v1", OTHER])
+def test_cleanrl_additions_train_env_and_score_run(env_id):
+    """The patched ``make_env`` (whole, from the diff's hunk) builds CleanRL's vector env on
+    the level, and the added scoring block scores an actor on it (a finite score)."""
+    diff = (EXAMPLES / "cleanrl_ppo.diff").read_text()
+    new = _new_side(diff)
+    imports = "\n".join(_added(diff)[0])
+    (make_env,) = ["\n".join(h) for h in new if any(x.startswith("def make_env") for x in h)]
+    make_env = make_env[make_env.index("def make_env") :]
+    make_env = make_env[: make_env.index("    return thunk") + len("    return thunk")]
+    namespace = {"gym": gym, "np": np, "torch": torch}
+    exec(imports + "\n" + make_env, namespace)
+    make = namespace["make_env"]
+    envs = gym.vector.SyncVectorEnv([make(env_id, i, False, "t", 0.99) for i in range(2)])
+    obs, _ = envs.reset(seed=0)
+    for _ in range(50):  # the running statistics move
+        obs, *_ = envs.step(envs.action_space.sample())
+    estimate = preset(env_id).obs_mode == "estimate"
+    assert envs.single_observation_space.shape == ((3,) if estimate else (9,))
+    actor = torch.nn.Linear(envs.single_observation_space.shape[0], 1)
+    scoring = "\n".join(line[4:] for line in _added(diff)[-1])
+    namespace |= {
+        "envs": envs,
+        "agent": types.SimpleNamespace(actor_mean=actor),
+        "args": types.SimpleNamespace(env_id=env_id, score_episodes=1),
+    }
+    printed = io.StringIO()
+    with contextlib.redirect_stdout(printed), torch.no_grad():
+        exec(scoring, namespace)
+    _check_score(printed.getvalue(), env_id, 1)
+    envs.close()
+
+
+# -- the rl-zoo3 files hold the scripts' hyperparameters, on every registered id ---------------
+
+
+def _model_kwargs(script: str, algo: str) -> dict:
+    """The keyword arguments of the script's ``PPO(...)`` / ``SAC(...)`` call (literals;
+    ``learning_rate`` and ``seed`` as source text) and its sub-env count."""
+    tree = ast.parse((EXAMPLES / script).read_text())
+    calls = [n for n in ast.walk(tree) if isinstance(n, ast.Call)]
+    (model,) = [c for c in calls if isinstance(c.func, ast.Name) and c.func.id == algo.upper()]
+    out = {"policy": ast.literal_eval(model.args[0])}
+    for kw in model.keywords:
+        if kw.arg == "policy_kwargs":
+            out[kw.arg] = eval(ast.unparse(kw.value))
+        else:
+            try:
+                out[kw.arg] = ast.literal_eval(kw.value)
+            except ValueError:
+                out[kw.arg] = ast.unparse(kw.value)
+    (make_vec,) = [c for c in calls if ast.unparse(c.func) == "gym.make_vec"]
+    out["n_envs"] = ast.literal_eval(make_vec.args[1])
+    return out
+
+
+@pytest.mark.parametrize("algo", ["ppo", "sac"])
+def test_zoo_mlp_file_holds_the_scripts_settings_on_every_id(algo):
+    zoo = yaml.safe_load((ROOT / f"train/zoo/{algo}_mlp.yml").read_text())
+    assert sorted(zoo) == sorted(PRESETS)
+    script = _model_kwargs(f"sb3_{algo}.py", algo)
+    assert script.pop("seed") == "args.seed"
+    lr = script.pop("learning_rate")
+    headroom = 3.0 if algo == "sac" else None
+    for env_id, hp in zoo.items():
+        hp = dict(hp)
+        wrappers = hp.pop("env_wrapper")
+        unit = (
+            {"acld_gym.wrappers.UnitAction": {"headroom": headroom}}
+            if headroom
+            else "acld_gym.wrappers.UnitAction"
+        )
+        modes = [{"acld_gym.wrappers.ObserveModes": {"modes": 1}}]
+        assert wrappers == [unit] + modes * (preset(env_id).obs_mode == "estimate"), env_id
+        assert hp.pop("env_kwargs") == {"load_case": "random", "reward_scale": "passive"}
+        assert hp.pop("n_timesteps") == (2e6 if algo == "ppo" else 3e5)
+        normalize = hp.pop("normalize")
+        zoo_lr = hp.pop("learning_rate")
+        if isinstance(zoo_lr, str):  # rl-zoo3's lin_<start>: start * progress
+            assert lr == f"lambda progress: {float(zoo_lr[4:])} * progress"
+        else:
+            assert zoo_lr == lr
+        hp["policy_kwargs"] = eval(hp["policy_kwargs"])
+        assert hp == script, env_id
+        assert normalize in (True, "dict(norm_reward=False)")
+
+
+def test_scripts_set_one_torch_thread_and_take_a_budget_and_a_seed():
+    for script in ("sb3_ppo.py", "sb3_sac.py", "zoo_score.py"):
+        text = (EXAMPLES / script).read_text()
+        assert "torch.set_num_threads(1)  # " in text, script
+        assert len(text.splitlines()) <= 45, script
+    for script in ("sb3_ppo.py", "sb3_sac.py"):
+        text = (EXAMPLES / script).read_text()
+        assert '"--timesteps"' in text and '"--seed"' in text and "score(model" in text
+
+
+# -- the page ---------------------------------------------------------------------------
+
+
+def test_page_includes_every_example_verbatim_and_is_in_the_nav():
+    """Every file of docs/examples/ is included in a fenced block by a snippet line (the
+    built page shows the file as it is), and no ```python block holds one (the docs test
+    runs those)."""
+    text = PAGE.read_text()
+    fences = re.findall(r"^```(\w+)[^\n]*\n(.*?)^```", text, flags=re.S | re.M)
+    included = {}
+    for lang, body in fences:
+        for path in re.findall(r'^--8<-- "([^"]+)"$', body, flags=re.M):
+            assert body.strip() == f'--8<-- "{path}"', "a snippet is alone in its block"
+            assert lang != "python"
+            included[path] = lang
+    files = {str(p.relative_to(ROOT)) for p in EXAMPLES.iterdir() if p.is_file()}
+    zoo = {"train/zoo/ppo_mlp.yml", "train/zoo/sac_mlp.yml"}
+    assert set(included) == files | zoo
+    assert {included[f] for f in files if f.endswith(".py")} == {"py"}
+    assert included["docs/examples/cleanrl_ppo.diff"] == "diff"
+    nav = yaml.safe_load((ROOT / "mkdocs.yml").read_text().replace("!!python/name:", ""))["nav"]
+    guide = next(item["Guide"] for item in nav if isinstance(item, dict) and "Guide" in item)
+    assert {"Train on any level with any library": "any-library.md"} in guide
+
+
+def test_page_states_each_measured_figure_with_its_command():
+    """Each measured row names its command and machine; every other level says "not
+    measured yet"."""
+    text = PAGE.read_text()
+    for script in ("sb3_ppo.py", "sb3_sac.py"):
+        assert re.search(rf"python docs/examples/{script} ACLDBeam-v1 --seed \d+", text), script
+    assert "2-core container, shared" in text
+    for env_id in PRESETS:
+        if env_id != "ACLDBeam-v1":
+            assert env_id in text
+    assert "not measured yet" in text.lower()
+
+
+def _measured_rows() -> list[tuple[str, list[float]]]:
+    """The page's measured rows run by a guide script: (command, [score, case 1, case 2,
+    case 3, random])."""
+    rows = []
+    for line in PAGE.read_text().splitlines():
+        cells = [c.strip() for c in line.strip("|").split("|")]
+        if len(cells) == 10 and cells[2].startswith("`python docs/examples/"):
+            numbers = [float(cells[4].split()[0])] + [float(c) for c in cells[5:9]]
+            rows.append((cells[2].strip("`"), numbers))
+    return rows
+
+
+def test_measured_rows_are_found():
+    commands = [c for c, _ in _measured_rows()]
+    assert any("sb3_ppo.py" in c for c in commands), commands
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("command, figures", _measured_rows(), ids=lambda x: str(x)[:40])
+def test_a_measured_row_is_what_its_command_prints(command, figures, tmp_path):
+    """The page's command, run again at its stated budget, prints its figures: the score and
+    ISE / LQR to 0.03 (another CPU's kernels move a training run by round-off)."""
+    args = command.split()[1:]
+    assert args[0].startswith("docs/examples/")
+    out = _run([str(ROOT / args[0]), *args[1:]], tmp_path, timeout=3600)
+    m = SCORE_LINE.match(out.strip().splitlines()[-1])
+    assert m, out[-2000:]
+    got = [float(m[k]) for k in ("iqm", "c1", "c2", "c3", "cr")]
+    assert np.allclose(got, figures, atol=0.03, rtol=0), (got, figures)

@@ -74,7 +74,6 @@ KNOWN_UPWARD: dict[tuple[str, str], str] = {
 KNOWN_OVER_400: frozenset[str] = frozenset(
     {
         "train/core/report.py",
-        "train/core/sb3_policies.py",
     }
 )
 

@@ -73,7 +73,6 @@ KNOWN_UPWARD: dict[tuple[str, str], str] = {
 #: Modules of train/ over MAX_LINES lines (being split by their owner).
 KNOWN_OVER_400: frozenset[str] = frozenset(
     {
-        "train/core/report.py",
     }
 )
 

@@ -16,7 +16,7 @@ from acld_gym.util.atomic import save_figure
 from .agent import AgentFileError
 from .agent_files import read_curve
 from .core.evaluate import lqr_ise
-from .core.report import ratio_log_axis
+from .core.report_plots import ratio_log_axis
 
 __all__ = ["learning_curves_figure", "plot_learning_curves", "sparse_ratio_labels"]
 

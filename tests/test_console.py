@@ -213,3 +213,22 @@ def test_invoked_as_is_scoped():
     with invoked_as("acld-gym a"):
         assert prog("python -m a") == "acld-gym a"
     assert prog("python -m a") == "python -m a"
+
+
+@pytest.mark.parametrize("name", list(COMMANDS))
+def test_every_python_m_form_has_the_same_plain_help(name, capsys):
+    """The module a subcommand runs, called as its ``python -m`` form: its usage names that
+    form (not ``acld-gym``), and its help has no reStructuredText either."""
+    command = COMMANDS[name]
+    try:
+        code = importlib.import_module(command.module).main([*command.lead, "--help"])
+    except SystemExit as exc:
+        code = exc.code
+    out = capsys.readouterr().out
+    assert code == 0
+    # the thesis's commands were acld-gym's own before the others joined: no python -m form
+    form = (
+        f"acld-gym {name} " if command.lead else f"python -m {command.module.removesuffix('.cli')}"
+    )
+    assert out.startswith(f"usage: {form}"), out[:80]
+    assert not MARKUP.search(out), MARKUP.search(out)

@@ -180,3 +180,15 @@ def test_the_home_page_says_whom_it_is_for_before_the_figure():
     guide = home[home.index("**Guide**") :]
     for page in ("getting-started.md", "any-library.md", "training.md", "leaderboard.md"):
         assert f"]({page})" in guide, page
+
+
+@pytest.mark.parametrize("page", [*PAGES, ROOT / "README.md"], ids=lambda p: p.name)
+def test_every_sb3_model_a_page_builds_is_on_one_torch_thread(page):
+    """A plain SB3 script on torch's default threads ran 15-25x slower on 2 cores: every
+    page's code that builds an SB3 model sets one thread before it."""
+    code = ""
+    for block in re.findall(r"^```python\n(.*?)^```", page.read_text(), flags=re.S | re.M):
+        code += block
+        for model in re.finditer(r"\b(?:PPO|SAC|TD3|A2C|DDPG|TQC|CrossQ)\(", block):
+            before = code[: len(code) - len(block) + model.start()]
+            assert "torch.set_num_threads(1)" in before, (page.name, block[:80])

@@ -26,6 +26,7 @@ PAGES = sorted(p for p in DOCS.glob("*.md") if p.name not in ("changelog.md", "s
 #: The pages whose prose timings are checked: the guide's, but for the two whose authors
 #: measure them elsewhere (any-library.md states its machine above its table).
 TIMED_PAGES = [p for p in PAGES if p.name not in ("any-library.md", "internals.md")]
+TIMED_PAGES.append(ROOT / "README.md")
 FENCE = re.compile(r"^```[^\n]*\n.*?^```", re.S | re.M)
 #: A time: a number and a unit of time (not a unit's power such as m^2 s, not a rate).
 TIME = r"(?<![\w.^/-])~?\s?\d[\d.,]*\s?(?:s|sec|seconds?|min|minutes?|h|hours?)\b(?!\s*/)"
@@ -77,7 +78,7 @@ def test_getting_started_opens_with_the_install_then_make_reset_step():
     assert first.index("gym.make(") < first.index(".reset(") < first.index(".step(")
 
 
-@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)
+@pytest.mark.parametrize("page", [*PAGES, ROOT / "README.md"], ids=lambda p: p.name)
 def test_no_bare_time_in_a_commands_comment(page):
     """A time after a command ('# ~1 min') cannot say on what machine it was measured: it
     goes in the prose or a table, with the machine and the command, or not at all."""
@@ -146,7 +147,7 @@ def test_the_settings_for_any_library_are_stated_once_and_agreed_on():
 
 
 def test_shipped_agents_go_where_the_user_works():
-    for page in PAGES:
+    for page in [*PAGES, ROOT / "README.md"]:
         for line in page.read_text().splitlines():
             if "train.ship" in line and "->" in line:
                 assert "train/agents" not in line.split("->", 1)[1], (page.name, line)

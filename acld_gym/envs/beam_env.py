@@ -61,7 +61,8 @@ class ACLDBeamEnv(BatchView, ConfigAttributes, FigureOwner, gym.Env):
     ``Box(-120, 120, (1,), float32)``: the commanded piezo voltage [V], held for one period.
     Out-of-range actions are clipped to +/-120 V and reported in
     ``info["clipped"]``; NaN or inf raise ``ValueError`` and leave the state
-    untouched. (Train with ``gymnasium.wrappers.RescaleAction`` for [-1, 1].) By default
+    untouched. (Train in [-1, 1] with :class:`acld_gym.wrappers.UnitAction`; what any RL
+    library should add: the training guide, ``docs/training.md``.) By default
     the command is the patch voltage; with the actuator options it reaches the patch
     ``actuator_delay`` periods later, through an amplifier that moves at most
     ``slew_rate`` and lags with ``amplifier_bandwidth`` (``info["voltage"]`` is the patch

@@ -3,16 +3,16 @@
 (a) no import cycle between the modules of ``acld_gym/``, ``baselines/`` and ``train/``;
 (b) no import upward across the layers of :data:`LAYERS` (physics -> design -> envs ->
     baselines -> train, lowest first);
-(c) no module over :data:`MAX_LINES` lines in ``acld_gym/`` and ``baselines/``.
+(c) no module over :data:`MAX_LINES` lines in ``acld_gym/``, ``baselines/`` and ``train/``.
 
 An import inside a function is an edge like one at the top of a module: it runs later, but
 the modules still depend on each other. An edge goes to the module imported:
 ``from a.b import c`` to ``a.b.c`` where that is a module, else to ``a.b``; the packages
 a name passes through (``a`` and ``a.b`` for ``import a.b.c``) are not counted.
 
-The allowlists (:data:`KNOWN_CYCLES`, :data:`KNOWN_UPWARD`, :data:`KNOWN_OVER_400`) are
-exact both ways: a new cycle, upward import or long module fails, and so does a listed one
-that is gone or has changed, until the list is updated.
+There are no exceptions to (a) and (c). The one allowlist, :data:`KNOWN_UPWARD`, is exact
+both ways: a new upward import fails, and so does a listed one that is gone, until the list
+is updated.
 """
 
 from __future__ import annotations
@@ -54,14 +54,6 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("train",),
 )
 
-#: Import cycles present today, each as the set of modules that import each other (a
-#: strongly connected component of the import graph), with what closes it. train/ is being
-#: restructured by its owner; acld_gym/ and baselines/ have none.
-KNOWN_CYCLES: dict[frozenset[str], str] = {
-}
-#: The train/ cycles among :data:`KNOWN_CYCLES` (the brief's KNOWN_TRAIN_CYCLES).
-KNOWN_TRAIN_CYCLES = frozenset(c for c in KNOWN_CYCLES if all(m.startswith("train.") for m in c))
-
 #: Upward imports allowed, with the reason.
 KNOWN_UPWARD: dict[tuple[str, str], str] = {
     ("baselines.analyze", "train.agent"): (
@@ -69,12 +61,6 @@ KNOWN_UPWARD: dict[tuple[str, str], str] = {
         "the agent folder's format is train's; a caller on train's side passes its own"
     ),
 }
-
-#: Modules of train/ over MAX_LINES lines (being split by their owner).
-KNOWN_OVER_400: frozenset[str] = frozenset(
-    {
-    }
-)
 
 
 @dataclass(frozen=True)
@@ -276,22 +262,16 @@ def test_every_module_has_a_layer():
 
 
 # --- (a) no cycles ---------------------------------------------------------------------------
-def test_no_import_cycles_beyond_the_known_ones():
+def test_no_import_cycles():
+    """None in any of the three packages: a module that two others share goes below both
+    (e.g. :mod:`train.agent_program` under ``train.agent`` and ``train.sb3_export``)."""
     es = edges()
     found = cycles(graph(es))
-    new = [c for c in found if c not in KNOWN_CYCLES]
     shown = "\n".join(
         "cycle among " + ", ".join(sorted(c)) + ":\n  " + "\n  ".join(map(str, one_cycle(c, es)))
-        for c in new
+        for c in found
     )
-    assert not new, f"import cycles:\n{shown}"
-    gone = [sorted(c) for c in KNOWN_CYCLES if c not in found]
-    assert not gone, f"KNOWN_CYCLES lists cycles that are gone or changed: {gone}"
-
-
-def test_the_known_train_cycles_are_the_only_ones_in_train():
-    found = {c for c in cycles(graph(edges())) if any(m.startswith("train.") for m in c)}
-    assert found == KNOWN_TRAIN_CYCLES
+    assert not found, f"import cycles:\n{shown}"
 
 
 # --- (b) no upward imports -------------------------------------------------------------------
@@ -316,7 +296,7 @@ def _lines(path: Path) -> int:
     return len(path.read_text(encoding="utf-8").splitlines())
 
 
-@pytest.mark.parametrize("package", ["acld_gym", "baselines"])
+@pytest.mark.parametrize("package", PACKAGES)
 def test_no_module_over_400_lines(package):
     long = {
         str(p.relative_to(ROOT)): _lines(p)
@@ -324,15 +304,3 @@ def test_no_module_over_400_lines(package):
         if _lines(p) > MAX_LINES
     }
     assert not long, f"modules over {MAX_LINES} lines (split them by job): {long}"
-
-
-def test_the_long_train_modules_are_the_known_ones():
-    long = {
-        str(p.relative_to(ROOT))
-        for p in sorted((ROOT / "train").rglob("*.py"))
-        if _lines(p) > MAX_LINES
-    }
-    assert long == KNOWN_OVER_400, (
-        f"train modules over {MAX_LINES} lines: new {sorted(long - KNOWN_OVER_400)}, "
-        f"no longer {sorted(KNOWN_OVER_400 - long)} (update KNOWN_OVER_400)"
-    )

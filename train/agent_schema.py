@@ -12,13 +12,17 @@ else is an :class:`AgentFileError` naming the file and the field.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import numbers
 
 import numpy as np
 
+from acld_gym.envs.config import EnvConfig
+from acld_gym.envs.presets import check_env_id
 from acld_gym.util.validate import json_depth, shown
+from acld_gym.wrappers import MAX_HEADROOM, check_headroom
 
 __all__ = [
     "AgentFileError",
@@ -140,8 +144,6 @@ def check_metadata(meta, where: str = "metadata.json") -> dict:
     if meta.get("residual") not in (None, "lqr"):
         raise _fail(where, "residual", f"expected null or 'lqr', got {shown(meta['residual'])}")
     if "action_headroom" in meta:
-        from acld_gym.wrappers import MAX_HEADROOM, check_headroom
-
         headroom = meta["action_headroom"]
         try:  # is_real first: check_headroom cannot take an integer beyond the float range
             check_headroom(headroom if is_real(headroom) else None, "action_headroom")
@@ -157,8 +159,6 @@ def check_metadata(meta, where: str = "metadata.json") -> dict:
 def _check_env(env, where: str) -> None:
     """``env``: ``{"id": <a registered id of this package>, "kwargs": {<EnvConfig field>:
     <a JSON value>}}``."""
-    from acld_gym.envs.presets import check_env_id
-
     if not isinstance(env, dict):
         raise _fail(where, "env", f"expected an object with 'id' and 'kwargs', got {shown(env)}")
     if "id" not in env:
@@ -175,10 +175,6 @@ def _check_env(env, where: str) -> None:
     kwargs = env.get("kwargs", {})
     if not isinstance(kwargs, dict):
         raise _fail(where, "env.kwargs", f"expected an object, got {shown(kwargs)}")
-    import dataclasses
-
-    from acld_gym.envs.config import EnvConfig
-
     fields = [f.name for f in dataclasses.fields(EnvConfig)]
     bad = sorted(k for k in kwargs if k not in fields)
     if bad:

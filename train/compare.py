@@ -28,7 +28,6 @@ from acld_gym.util.atomic import write_json, write_text
 from acld_gym.util.progress import Progress
 from acld_gym.util.text import plain, prog
 from acld_gym.util.validate import arg_type, run_main
-from baselines.analysis.score import SCORE_NAME
 from baselines.arguments import folder_name, input_directory, outputs, param_noise
 from baselines.evaluate import (
     EvalRow,
@@ -41,6 +40,7 @@ from baselines.evaluate import (
     mean_rows,
     plot_episodes,
 )
+from baselines.evaluation.score import SCORE_NAME
 from baselines.marks import marks_for
 from baselines.policies import RewardMPCPolicy, mpc_available
 

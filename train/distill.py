@@ -29,6 +29,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from acld_gym.physics.actuator import V_LIMIT
+from baselines.evaluate import default_policies
 
 __all__ = ["DistillConfig", "actor_mean", "distill", "fit_sign", "TEACHERS"]
 
@@ -94,7 +95,7 @@ def actor_mean(model):
     """``(f, params, squash)``: the actor's mean (before PPO's clipping or SAC's tanh)
     as a torch function of the (normalized) observation, its parameters, and
     whether the action is ``tanh`` of it (SAC) rather than the mean clipped (PPO)."""
-    from stable_baselines3 import SAC
+    from stable_baselines3 import SAC  # slow to import (torch): the config imports this module
 
     pol = model.policy
     if isinstance(model, SAC):
@@ -117,7 +118,7 @@ def actor_mean(model):
 def fit_sign(f, params, x, s, max_iter: int = 300) -> float:
     """Logistic regression of ``f(x)`` on the signs ``s`` (full-batch L-BFGS, in
     place); returns the final mean loss."""
-    import torch
+    import torch  # slow to import: the config imports this module (DistillConfig)
 
     opt = torch.optim.LBFGS(
         params,
@@ -152,6 +153,7 @@ def distill(model, venv, cfg: DistillConfig, seed: int = 0, log=None) -> list[di
     iteration: ``beta``, ``labels`` (so far), ``loss`` and ``agreement`` (fraction of this
     iteration's states where the refitted actor's voltage has the teacher's sign).
     """
+    # torch and train.vec (SB3) are slow to import: the config imports this module
     import torch
 
     from .vec import VecAgentEnv, find_wrapper
@@ -167,8 +169,6 @@ def distill(model, venv, cfg: DistillConfig, seed: int = 0, log=None) -> list[di
             "distill needs the plain voltage map (residual: null), got "
             f"residual {agent_env.residual!r}"
         )
-    from baselines.evaluate import default_policies
-
     teacher = default_policies()[cfg.teacher]
     f, params, squash = actor_mean(model)
     rng = np.random.default_rng(seed)

@@ -32,8 +32,8 @@ from acld_gym.util.atomic import check_writable, save_figure, write_atomic
 from acld_gym.util.text import plain, prog
 from acld_gym.util.validate import arg_type, run_main
 from baselines.evaluate import episode_rows
+from baselines.evaluation.rollout import check_compatible
 from baselines.marks import level_references
-from baselines.rollout import check_compatible
 
 from .agent_dirs import AGENTS_DIR, load_agents
 from .core.evaluate import HELDOUT_SEEDS

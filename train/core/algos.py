@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import gc
+import multiprocessing
 import time
 from typing import Any
 
@@ -84,7 +85,7 @@ def _run(
 
 def _children_cpu_seconds() -> float | None:
     """CPU time of this process's ended child processes (None where unknown)."""
-    try:
+    try:  # Unix only
         import resource
     except ImportError:  # pragma: no cover - not on Unix
         return None
@@ -130,8 +131,6 @@ class _Runs:
         self._outcomes.close()
 
     def _at_once(self, cfg: TrainConfig, seeds: list[int], env_id: str, callback, workers: int):
-        import multiprocessing
-
         before = _children_cpu_seconds()
         pool = multiprocessing.get_context("spawn").Pool(workers)
         reported, pending, p = 0.0, [], None

@@ -7,12 +7,16 @@ from __future__ import annotations
 
 import copy
 import inspect
+import time
 from collections.abc import Callable
 
 import numpy as np
 import torch
 import torch.nn as nn
+from gymnasium import spaces
+from stable_baselines3.common.callbacks import BaseCallback
 from stable_baselines3.common.logger import Logger
+from stable_baselines3.common.off_policy_algorithm import OffPolicyAlgorithm
 from stable_baselines3.common.vec_env import VecNormalize
 
 import acld_gym  # noqa: F401  (registers the env ids)
@@ -20,15 +24,15 @@ from acld_gym.wrappers import whitening
 
 from ..agent import actor_parts
 from ..config import TrainConfig, algo_class
+from ..distill import distill
 from ..vec import VecWhiten, make_vec_env
 from ..voltage import VoltageMap
-from .evaluate import CurveCallback, eval_schedule
-from .sb3_policies import (
-    AsymmetricCriticPolicy,
-    AsymmetricSACPolicy,
-    SB3Policy,
-    SplitCriticPolicy,
-)
+from . import evaluate
+from .buffers import FlatNStepReplayBuffer
+from .evaluate import CurveCallback, eval_schedule, validation_seeds
+from .ppo_policies import AsymmetricCriticPolicy, SplitCriticPolicy
+from .sac_policies import AsymmetricSACPolicy
+from .sb3_inference import SB3Policy
 
 __all__ = [
     "LinearSchedule",
@@ -188,9 +192,6 @@ def _flat_n_step_buffer(cls, venv, model_kwargs: dict) -> dict:
     :class:`train.core.buffers.FlatNStepReplayBuffer`, which returns the same samples,
     faster: ``n_steps`` and ``gamma`` move to ``replay_buffer_kwargs``, as SB3 passes
     them to its own. Other kwargs are returned as they are."""
-    from gymnasium import spaces
-    from stable_baselines3.common.off_policy_algorithm import OffPolicyAlgorithm
-
     n = model_kwargs.get("n_steps", 1)
     if (
         not issubclass(cls, OffPolicyAlgorithm)
@@ -199,8 +200,6 @@ def _flat_n_step_buffer(cls, venv, model_kwargs: dict) -> dict:
         or not isinstance(venv.observation_space, spaces.Box)
     ):
         return model_kwargs
-    from .buffers import FlatNStepReplayBuffer
-
     gamma = model_kwargs.get("gamma", inspect.signature(cls.__init__).parameters["gamma"].default)
     out = {k: v for k, v in model_kwargs.items() if k != "n_steps"}
     out["replay_buffer_class"] = FlatNStepReplayBuffer
@@ -222,8 +221,6 @@ class Selection:
     ``progress`` (a :class:`train.core.progress.Progress`) says each check."""
 
     def __init__(self, cfg: TrainConfig, env_id: str, progress=None):
-        from .evaluate import validation_seeds
-
         self.config = cfg.select_config
         self.env_id = env_id
         self.progress = progress
@@ -237,8 +234,6 @@ class Selection:
         return self.next is not None and steps >= self.next
 
     def check(self, steps: int, model, snapshot) -> None:
-        from . import evaluate
-
         cost, env_steps = evaluate.validation_rollout(snapshot(), self.env_id, self.seeds)
         self.env_steps += env_steps
         self.history.append({"steps": int(steps), "cost": cost})
@@ -284,8 +279,6 @@ def train_sb3(
     :class:`train.vec.VecWhiten` where ``cfg.whiten_steps`` is set); the evaluation and the
     validation checks run on the plain env whatever it is. ``progress`` (a
     :class:`train.core.progress.Progress`) says each validation check."""
-    from stable_baselines3.common.callbacks import BaseCallback
-
     torch.set_num_threads(1)
     venv = make_env(cfg, seed, env_id)
     if not isinstance(venv, VecNormalize):
@@ -299,10 +292,6 @@ def train_sb3(
     vmap = VoltageMap(cfg.residual, cfg.mesh, cfg.action_headroom)
     distilled = None
     if cfg.distill is not None:
-        import time
-
-        from ..distill import distill
-
         t0 = time.perf_counter()
         distilled = {
             "history": distill(model, venv, cfg.distill_config, seed=seed),

@@ -8,12 +8,24 @@ import json
 import time
 from pathlib import Path
 
+import gymnasium as gym
 import numpy as np
 
+from acld_gym.envs.fingerprint import observation_fingerprint
 from acld_gym.util.atomic import write_text
 
+from ..agent import CURVE_FILE, ActorProgram, TrainedAgent, export_sb3, linear_program, versions
 from ..config import CONFIG_DIR, TrainConfig
-from .evaluate import DEFAULT_ENV_ID
+from .evaluate import (
+    DEFAULT_ENV_ID,
+    OBJECTIVE_LOADS,
+    batched_ise,
+    eval_episodes,
+    rollout_ise,
+    validation_cost,
+    validation_seeds,
+)
+from .progress import Progress
 
 __all__ = [
     "CONFIG_DIR",
@@ -59,17 +71,10 @@ def run_trial(
     validation score (none with ``quiet``), the retry threshold and every retry with its
     reason, which the record keeps too (``retries``, ``[]`` when the first run sufficed or
     there is one)."""
+    # torch and the training algorithms (SB3) are slow to import: only a run needs them
     import torch
 
     from .algos import train_algo
-    from .evaluate import (
-        OBJECTIVE_LOADS,
-        eval_episodes,
-        rollout_ise,
-        validation_cost,
-        validation_seeds,
-    )
-    from .progress import Progress
 
     torch.set_num_threads(1)
     cfg = TrainConfig.from_dict(config)
@@ -120,8 +125,6 @@ class CaseISE:
         self.episodes = episodes
 
     def __call__(self, steps: int, policy) -> dict:
-        from .evaluate import batched_ise
-
         ise = batched_ise(policy, self.env_id, self.episodes)
         return {"ise": {str(c): v for c, v in ise.items()}}
 
@@ -149,8 +152,8 @@ def agent_dir(out: Path, name: str, seed: int) -> Path:
 def policy_program(policy):
     """A trained benchmark policy as a :class:`train.agent.ActorProgram` (numpy arrays and
     a JSON list of operations: loading it never runs code)."""
-    from ..agent import ActorProgram, export_sb3, linear_program
-    from .sb3_policies import SB3Policy
+    # the trained policies' classes import torch (slow): only an export needs them
+    from .sb3_inference import SB3Policy
     from .search import LinearDirectionActor
 
     if isinstance(policy, LinearDirectionActor):
@@ -171,12 +174,6 @@ def save_agent(
     a teacher or controller knowledge --, the command, config, budget, times and the
     observation fingerprint of the env it was trained on, ``learning_curve.csv`` and the
     text ``files``), the folder written whole (:meth:`train.agent.TrainedAgent.save`)."""
-    import gymnasium as gym
-
-    from acld_gym.envs.fingerprint import observation_fingerprint
-
-    from ..agent import CURVE_FILE, TrainedAgent, versions
-
     cfg = TrainConfig.from_dict(rec["config"])
     probe = gym.make(rec["env_id"])
     meta = {
@@ -209,7 +206,7 @@ def save_agent(
 
 
 def _tune_trainable(config: dict) -> None:  # pragma: no cover - runs inside Ray workers
-    from ray import tune
+    from ray import tune  # Ray is optional (the extra "ray")
 
     kwargs = json.loads(config["trial"])
     out = Path(kwargs["out"])
@@ -222,7 +219,7 @@ def _tune_trainable(config: dict) -> None:  # pragma: no cover - runs inside Ray
 
 def _trial_cpus(config: dict):  # pragma: no cover - called by Ray Tune
     """A Ray trial's resources: one CPU per run it trains at once (``workers``)."""
-    from ray.tune import PlacementGroupFactory
+    from ray.tune import PlacementGroupFactory  # Ray is optional (the extra "ray")
 
     return PlacementGroupFactory([{"CPU": json.loads(config["trial"])["workers"]}])
 
@@ -230,7 +227,7 @@ def _trial_cpus(config: dict):  # pragma: no cover - called by Ray Tune
 def init_ray(address: str | None, num_cpus: int) -> None:
     """Connect to the Ray cluster at ``address``, or start a local one with ``num_cpus``;
     a session already running in this process (an earlier benchmark or sweep) is reused."""
-    import ray
+    import ray  # optional (the extra "ray")
 
     if not ray.is_initialized():
         ray.init(address=address) if address else ray.init(num_cpus=num_cpus)
@@ -261,7 +258,7 @@ def run_trials(
             print(f"  {rec['name']} seed {rec['seed']}: {trained_line(rec)}", flush=True)
             records.append(rec)
         return records
-    from ray import tune
+    from ray import tune  # optional (the extra "ray")
 
     init_ray(address, num_cpus)
     # one grid point per run: run_trial's arguments as JSON text (Tune's loggers sort config

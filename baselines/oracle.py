@@ -32,7 +32,7 @@ measured, not a bound.
 
 :class:`ClairvoyantReplay` (``"bound_replay"``) replays the clairvoyant bound's commands
 (:func:`baselines.rollout.bound_solution`) open loop: the bound's own episode through the
-path that scores a policy (tests/baselines/analysis/test_score.py).
+path that scores a policy (tests/baselines/evaluation/test_score.py).
 """
 
 from __future__ import annotations

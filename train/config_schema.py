@@ -22,7 +22,7 @@ class TrainConfig:
     Attributes
     ----------
     algo : str
-        One of :data:`ALGOS`.
+        One of :data:`train.config_algos.ALGOS`.
     timesteps : int
         Env-step budget of a run, all sub-envs together (the same for every seed).
     n_envs : int

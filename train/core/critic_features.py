@@ -113,8 +113,8 @@ def square_norm(z: torch.Tensor, m: torch.Tensor) -> torch.Tensor:
 class NegativeSquareForm(nn.Module):
     r"""A critic head :math:`Q = -\|M z\|^2 \le 0` on features z (:func:`square_norm`,
     M from :func:`square_form_matrix`): SAC's never-positive twin of
-    :class:`NegativeScaledQuadraticFeature` (:class:`ScaledQuadraticCritic` with
-    ``negative=True``)."""
+    :class:`NegativeScaledQuadraticFeature`
+    (:class:`train.core.sac_policies.ScaledQuadraticCritic` with ``negative=True``)."""
 
     def __init__(self, n: int, init: float = 0.1):
         super().__init__()

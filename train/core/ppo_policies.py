@@ -51,10 +51,13 @@ def antithetic_pairs(draws: torch.Tensor) -> torch.Tensor:
 class SplitCriticPolicy(ActorCriticPolicy):
     """PPO's ``ActorCriticPolicy`` whose critic has features of its own,
     ``critic_features`` (a ``policy_kwargs`` key): ``"quadratic"``
-    (:class:`QuadraticFeatures`; with ``net_arch: {vf: []}`` the value is a quadratic
-    form of the observation, suited to a linear-quadratic problem),
-    ``"scaled_quadratic"`` (:class:`ScaledQuadraticFeatures`), ``"negative_scaled_quadratic"``
-    (:class:`NegativeScaledQuadraticFeature`: the value itself, never positive; its output
+    (:class:`train.core.critic_features.QuadraticFeatures`; with ``net_arch: {vf: []}``
+    the value is a quadratic form of the observation, suited to a linear-quadratic
+    problem), ``"scaled_quadratic"``
+    (:class:`train.core.critic_features.ScaledQuadraticFeatures`),
+    ``"negative_scaled_quadratic"``
+    (:class:`train.core.critic_features.NegativeScaledQuadraticFeature`: the value
+    itself, never positive; its output
     layer fixed, with ``net_arch: {vf: []}`` only), ``"direction"``
     (:class:`train.features.DirectionFeatures`) or ``"flatten"``. The actor sees the
     (flattened) observation, e.g. linear with ``net_arch: {pi: []}``.
@@ -136,7 +139,7 @@ class AsymmetricCriticPolicy(SplitCriticPolicy):
     ``reward_scale: passive`` and ``observe_reward_scale: true``: the actor reads u only
     (:class:`DropLast`; with ``net_arch: {pi: []}`` a linear law, deployable on the plain
     env), the critic the quadratic features of :math:`u/\sqrt{c}`
-    (:class:`ScaledQuadraticFeatures`)."""
+    (:class:`train.core.critic_features.ScaledQuadraticFeatures`)."""
 
     def __init__(self, *args, critic_features: str = "scaled_quadratic", **kwargs):
         kwargs.setdefault("features_extractor_class", DropLast)

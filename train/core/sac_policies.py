@@ -33,7 +33,8 @@ class ScaledQuadraticCritic(ContinuousCritic):
     ``reward_scale: passive`` and ``observe_reward_scale: true``. With ``net_arch: {qf: []}``
     each critic is a quadratic form of w: the shape of the state-action value of a linear
     policy on a linear plant with a quadratic reward, divided by the episode's passive cost
-    c (:class:`ScaledQuadraticFeatures` for the state value). With hidden layers
+    c (:class:`train.core.critic_features.ScaledQuadraticFeatures` for the state value).
+    With hidden layers
     (``qf: [64, 64]``) an MLP on those features, which can also represent what the
     saturation at +/-120 V does to the value.
 
@@ -56,7 +57,8 @@ class ScaledQuadraticCritic(ContinuousCritic):
     ``negative``: each critic is :math:`Q = -\|M [w; s]\|^2` instead
     (:class:`NegativeSquareForm`; s the ``offset_scale``, or 1), a quadratic form, a linear
     term and a constant that sum to at most 0, as every value of the env's costs is: the
-    PPO recipe's never-positive critic (:class:`NegativeScaledQuadraticFeature`) for SAC.
+    PPO recipe's never-positive critic
+    (:class:`train.core.critic_features.NegativeScaledQuadraticFeature`) for SAC.
     It takes ``net_arch: []`` only."""
 
     def __init__(

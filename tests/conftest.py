@@ -12,6 +12,8 @@ import shutil
 import tempfile
 from multiprocessing import util as _mp_util
 
+import pytest
+
 _SESSION_TMP = tempfile.mkdtemp(prefix="acld-gym-tests-")
 os.environ["TMPDIR"] = _SESSION_TMP  # subprocesses
 tempfile.tempdir = _SESSION_TMP  # this process: tempfile.gettempdir(), pytest's tmp_path
@@ -19,3 +21,20 @@ os.environ.setdefault("ACLD_GYM_CACHE_DIR", os.path.join(_SESSION_TMP, "plant-ca
 _mp_util.Finalize(
     None, shutil.rmtree, args=(_SESSION_TMP,), kwargs={"ignore_errors": True}, exitpriority=-1000
 )
+
+
+@pytest.fixture(scope="session")
+def v1_references(tmp_path_factory):
+    """The references of ``python -m train.benchmark --no-bound --random-episodes 1`` on
+    ACLDBeam-v1 (:func:`train.core.evaluate.references`: passive, LQR, SMC and MPC on the
+    thesis cases and one held-out load, and the validation cost on 256 loads), computed
+    once per session (per xdist worker) and written by the command's own cache writer.
+    The tiny benchmarks of ``tests/train`` copy the file into their ``--out`` folder as
+    ``references-ACLDBeam-v1.json``; the command checks its key and reads it back instead
+    of computing it again (its MPC episodes and validation loads were most of each test's
+    time)."""
+    from train.core.evaluate import references
+
+    path = tmp_path_factory.mktemp("references") / "references-ACLDBeam-v1.json"
+    references("ACLDBeam-v1", path, 1, bound=False)
+    return path

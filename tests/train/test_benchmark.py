@@ -1,8 +1,9 @@
 """train.benchmark: IQM and stratified bootstrap against hand-computed values, the
-command end to end on a tiny budget (local backend), and (slow) one seed of the
-teacher-free recipe beating LQR on thesis case 1."""
+command end to end on a tiny budget (local backend) with its agents shippable, and (slow)
+one seed of the teacher-free recipe beating LQR on thesis case 1."""
 
 import json
+import shutil
 
 import gymnasium as gym
 import numpy as np
@@ -52,7 +53,11 @@ def _tiny_configs(tmp_path):
     vrs.update(timesteps=8000, loads={1: 1, "random": 1}, eval_points=2)
     vrs["model"] = {**vrs["model"], "n_directions": 2, "top_directions": 1}
     ppo = yaml.safe_load(open("train/recipes/ppo.yaml"))
-    ppo.update(timesteps=2048, n_envs=4, eval_points=2, whiten_steps=256)
+    # one run per seed, its end checked on 4 validation loads (the recipe: up to 3 runs,
+    # 256 loads each): the runs one after another or at once, and the retry threshold,
+    # are tests/train/test_stack.py::test_train_cli_is_a_benchmark_trial's
+    ppo.update(timesteps=2048, n_envs=4, eval_points=2, whiten_steps=256, restarts=1)
+    ppo.update(restart_above=None, select={"episodes": 4, "every": 2048, "start": 2048})
     ppo["model"] = {**ppo["model"], "n_steps": 256, "batch_size": 256, "n_epochs": 1}
     paths = []
     for name, data in (("tiny_vrs", vrs), ("tiny_ppo", ppo)):
@@ -62,10 +67,46 @@ def _tiny_configs(tmp_path):
     return paths
 
 
-def test_benchmark_runs_end_to_end(tmp_path, capsys):
+def _check_shippable(out, name, seed, ship_to):
+    """The benchmark's agent of ``name`` seed ``seed`` in ``out`` as a safe agent
+    directory: it loads (fingerprint checked against ACLDBeam-v1 today), says "from
+    scratch" with no teacher and its command, holds no pickle, and reproduces the trial's
+    own final evaluation (case 1, seed 0); ``train.ship`` copies it into ``ship_to`` and
+    ``train.compare`` finds it there."""
+    from acld_gym.envs.beam_env import ACLDBeamEnv
+    from baselines.evaluate import metrics_row, rollout
+    from train.agent import TrainedAgent
+    from train.benchmark import agent_dir
+    from train.compare import agent_names
+    from train.ship import ship
+
+    rec = json.loads((out / "trials" / f"{name}-s{seed}.json").read_text())
+    d = agent_dir(out, name, seed)
+    agent = TrainedAgent.load(d)
+    assert agent.training == "from scratch" and agent.metadata["teacher"] is None
+    assert agent.metadata["command"].startswith(f"python -m train.benchmark --config {name}")
+    assert not list(d.glob("*.pkl")) and not list(d.glob("*.zip"))
+    ise = metrics_row(1, name, rollout(agent, ACLDBeamEnv(load_case=1), seed=0)).ise
+    assert ise == pytest.approx(rec["final_ise"]["1"], rel=1e-5)
+    shipped = ship(d, f"{name}_shipped", ship_to)
+    assert (shipped / "learning_curve.csv").is_file()
+    assert f"{name}_shipped" in agent_names(ship_to)
+    return shipped
+
+
+def test_benchmark_runs_end_to_end(tmp_path, capsys, monkeypatch, v1_references):
+    """The command on two tiny configs (random search and PPO) and two seeds: its files,
+    tables and statistics, its agents shippable (the exported actor acts as the trained
+    policy did), a resume that trains nothing, and damaged files computed again. The
+    references come from the session's file (``v1_references``: the same command's
+    cache, computed once), which the command checks and reads."""
+    import train.core.evaluate as evaluate
     from train.benchmark import main
+    from train.compare import agent_names
 
     out = tmp_path / "bench"
+    out.mkdir()
+    shutil.copyfile(v1_references, out / "references-ACLDBeam-v1.json")
     argv = [
         "--config",
         *_tiny_configs(tmp_path),
@@ -75,7 +116,7 @@ def test_benchmark_runs_end_to_end(tmp_path, capsys):
         "--backend",
         "local",
         "--random-episodes",
-        "2",
+        "1",
         "--no-bound",
         "--out",
         str(out),
@@ -109,12 +150,26 @@ def test_benchmark_runs_end_to_end(tmp_path, capsys):
     md = (out / "results.md").read_text()
     assert "| tiny_vrs (vrs) | 8,000 | 2 |" in md and "mpc (reference)" in md
     assert f"| lqr (reference) | - | - | 1.000 | 1.000 | 1.000 | 1.000 | {refs['lqr']:.4f} |" in md
+    # the agents: random search's linear program and PPO's actor with the recipe's
+    # whitening folded in (was tests/train/test_benchmark_agents.py, on its own benchmark)
+    _check_shippable(out, "tiny_vrs", 0, tmp_path / "agents")
+    _check_shippable(out, "tiny_ppo", 1, tmp_path / "agents")
+    assert agent_names(tmp_path / "agents") == ["tiny_ppo_shipped", "tiny_vrs_shipped"]
     # a repeat with --resume trains nothing
     assert main([*argv, "--resume"]) == 0
     assert "0 runs to train (4 reused)" in capsys.readouterr().out
     # damaged files (issue 65): a truncated record and references file, an agent that no
-    # longer loads: each said in one line and computed again, the others reused
+    # longer loads: each said in one line and computed again, the others reused (the
+    # references by the command's call of train.core.evaluate.references, here handed the
+    # session's: their computation is the fixture's, with this command's cache)
     record, refs_file = out / "trials/tiny_vrs-s0.json", out / "references-ACLDBeam-v1.json"
+    calls = []
+
+    def references(*args, **kwargs):
+        calls.append((args, kwargs))
+        return json.loads(v1_references.read_text())
+
+    monkeypatch.setattr(evaluate, "references", references)
     for f in (record, refs_file):
         f.write_text(f.read_text()[:200])
     meta = out / "agents/tiny_ppo-s1/metadata.json"
@@ -124,6 +179,7 @@ def test_benchmark_runs_end_to_end(tmp_path, capsys):
     assert f"{record}: not valid JSON" in said and "training tiny_vrs seed 0 again" in said
     assert "tiny_ppo-s1: the agent does not load" in said and "tiny_ppo seed 1 again" in said
     assert f"{refs_file}: not valid JSON" in said and "computing the references again" in said
+    assert calls == [(("ACLDBeam-v1", None, 1), {"bound": False})]
     assert "2 runs to train (2 reused)" in said
     assert json.loads(refs_file.read_text())["env_id"] == "ACLDBeam-v1"
     assert json.loads(record.read_text())["seed"] == 0
@@ -137,7 +193,18 @@ def test_benchmark_runs_end_to_end(tmp_path, capsys):
             {"timesteps": 2000, "n_envs": 1, "loads": {1: 1}},
             {"n_delta": 1, "n_top": 1, "n_eval_episodes": 1},
         ),
-        ("sac", {"timesteps": 300, "n_envs": 2}, {"learning_starts": 100, "buffer_size": 1000}),
+        (  # one run, its end checked on 4 validation loads (the recipe: up to 4 runs and a
+            # retry threshold, 64 loads each: tests/train/test_stack.py's sac trial has 2)
+            "sac",
+            {
+                "timesteps": 300,
+                "n_envs": 2,
+                "restarts": 1,
+                "restart_above": None,
+                "select": {"episodes": 4, "every": 300, "start": 300},
+            },
+            {"learning_starts": 100, "buffer_size": 1000},
+        ),
         ("tqc", {"timesteps": 300, "n_envs": 2}, {"learning_starts": 100, "buffer_size": 1000}),
     ],
 )

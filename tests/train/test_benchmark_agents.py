@@ -1,13 +1,12 @@
 """The benchmark's trained policies as safe agent directories: the exported actor program
-acts exactly like the trained policy, the metadata says "from scratch" with no teacher,
-and ``train.ship`` / ``train.compare`` pick the agent up."""
-
-import json
+acts exactly like the trained policy. (That the benchmark's agent folders load, say "from
+scratch" with no teacher, reproduce their trial's evaluation and are picked up by
+``train.ship`` / ``train.compare`` is checked on the end-to-end run of
+``tests/train/test_benchmark.py::test_benchmark_runs_end_to_end``.)"""
 
 import gymnasium as gym
 import numpy as np
 import pytest
-import yaml
 
 import acld_gym  # noqa: F401  (registers the env ids)
 from acld_gym.wrappers import whitening
@@ -44,60 +43,3 @@ def test_linear_program_acts_like_the_random_search_actor(features, whiten):
 def test_linear_program_rejects_unknown_features():
     with pytest.raises(ValueError, match="features"):
         linear_program(np.zeros(3), None, "quadratic")
-
-
-def test_benchmark_saves_shippable_agents(tmp_path, capsys):
-    from train.benchmark import agent_dir, main
-    from train.compare import agent_names
-    from train.ship import ship
-
-    vrs = yaml.safe_load(open("train/recipes/vrs.yaml"))
-    vrs.update(timesteps=8000, loads={"random": 1}, eval_points=1)
-    vrs["model"] = {**vrs["model"], "n_directions": 2, "top_directions": 1}
-    ppo = yaml.safe_load(open("train/recipes/ppo.yaml"))
-    ppo.update(timesteps=1024, n_envs=2, eval_points=1, whiten_steps=256)  # the recipe's
-    # whitening, folded into the exported actor
-    ppo["model"] = {**ppo["model"], "n_steps": 256, "batch_size": 256, "n_epochs": 1}
-    configs = []
-    for name, data in (("tiny_vrs", vrs), ("tiny_ppo", ppo)):
-        (tmp_path / f"{name}.yaml").write_text(yaml.safe_dump(data))
-        configs.append(str(tmp_path / f"{name}.yaml"))
-    out = tmp_path / "bench"
-    assert (
-        main(
-            [
-                "--config",
-                *configs,
-                "--seeds",
-                "0",
-                "--backend",
-                "local",
-                "--random-episodes",
-                "1",
-                "--no-bound",
-                "--out",
-                str(out),
-            ]
-        )
-        == 0
-    )
-    capsys.readouterr()
-    trials = {
-        n: json.loads((out / "trials" / f"{n}-s0.json").read_text())
-        for n in ("tiny_vrs", "tiny_ppo")
-    }
-    for name, rec in trials.items():
-        d = agent_dir(out, name, 0)
-        agent = TrainedAgent.load(d)  # fingerprint checked against ACLDBeam-v1 today
-        assert agent.training == "from scratch" and agent.metadata["teacher"] is None
-        assert agent.metadata["command"].startswith(f"python -m train.benchmark --config {name}")
-        assert not list(d.glob("*.pkl")) and not list(d.glob("*.zip"))
-        # the saved agent reproduces the trial's own final evaluation (case 1, seed 0)
-        from acld_gym.envs.beam_env import ACLDBeamEnv
-        from baselines.evaluate import metrics_row, rollout
-
-        ise = metrics_row(1, name, rollout(agent, ACLDBeamEnv(load_case=1), seed=0)).ise
-        assert ise == pytest.approx(rec["final_ise"]["1"], rel=1e-5)
-    shipped = ship(agent_dir(out, "tiny_vrs", 0), "vrs_tiny", tmp_path / "agents")
-    assert (shipped / "learning_curve.csv").is_file()
-    assert agent_names(tmp_path / "agents") == ["vrs_tiny"]

@@ -3,6 +3,7 @@
 budget, and its agent loads and acts in volts."""
 
 import json
+import shutil
 
 import numpy as np
 import pytest
@@ -27,6 +28,12 @@ def _tiny(tmp_path, algo):
             "buffer_size": 2000,
             "batch_size": 64,
         }
+    # two runs per seed (the recipe: up to 3 or 4), each ending in a check on 4 validation
+    # loads (the recipe: 256 or 64), which also set the retry threshold's level: a tiny run
+    # is above it, so both runs are trained, one after another or at once
+    data.update(
+        restarts=2, select={"episodes": 4, "every": data["timesteps"], "start": data["timesteps"]}
+    )
     path = tmp_path / f"tiny_{algo}.yaml"
     path.write_text(yaml.safe_dump(data))
     return path
@@ -59,7 +66,7 @@ def test_overrides_of_the_command_line():
 
 
 @pytest.mark.parametrize("algo", ["ppo", "sac"])
-def test_train_cli_is_a_benchmark_trial(algo, tmp_path, capsys):
+def test_train_cli_is_a_benchmark_trial(algo, tmp_path, capsys, v1_references):
     """``python -m train ALGO --seed N`` and ``python -m train.benchmark --seeds N`` give the
     same agent, bit for bit, the one training its runs one after another, the other two at
     once in worker processes (``--cpus-per-trial 2``); it loads (validated) and acts in
@@ -77,6 +84,8 @@ def test_train_cli_is_a_benchmark_trial(algo, tmp_path, capsys):
     )
     out = capsys.readouterr().out
     assert "ISE / LQR" in out and "case random" in out
+    (tmp_path / "bench").mkdir()  # the session's references (tests/conftest.py), read back
+    shutil.copyfile(v1_references, tmp_path / "bench" / "references-ACLDBeam-v1.json")
     recipe = yaml.safe_load(cfg.read_text())  # a run is retried only while it fails:
     runs, timesteps = recipe["restarts"], recipe["timesteps"]  # the budget is the most
     assert recipe["restart_above"] is not None and runs > 1

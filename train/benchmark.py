@@ -13,7 +13,7 @@ share a folder), atomically:
 
 * ``results.md`` / ``results.json``: per algorithm the interquartile mean (IQM) over
   seeds with 95 % stratified-bootstrap intervals, the training wall time, the
-  issue's goals, and every seed's numbers;
+  checks, and every seed's numbers;
 * ``learning_curves.png``: IQM ISE / LQR vs env steps with 95 % bands, and the LQR,
   SMC, MPC and bound levels;
 * ``trials/<name>-s<seed>.json`` (one per run) and ``references-<env id>.json``.
@@ -191,7 +191,7 @@ def trial_workers(cpus_per_trial: int | None, num_cpus: int, address: str | None
 
     Until acld-gym 0.14.0 the CPUs were shared among the command's trials: ``--algos ppo
     sac --seeds N`` gave each trial one, and a SAC seed that needs all four runs took about
-    20 min, over the 15-min goal of a seed (issue 20)."""
+    20 min, over 15 min a seed."""
     if cpus_per_trial is not None:
         return cpus_per_trial
     return 1 if address else num_cpus

@@ -1,6 +1,6 @@
-"""The benchmark's tables in the docs and the README's headline are generated from the
-committed per-seed results (``python -m train.core.report studies/results-v1.json
---write docs/training.md README.md``)."""
+"""The benchmark's tables on the training page are generated from the committed per-seed
+results (``python -m train.core.report studies/results-v1.json --write docs/training.md``);
+the README shows the leaderboard instead."""
 
 from __future__ import annotations
 
@@ -20,11 +20,9 @@ from train.core.report import (
     headline,
     main,
     markdown,
-    render_blocks,
     replace_block,
     seeds_beating_references,
     stretch_lines,
-    write_blocks,
 )
 from train.core.threshold import RestartRule
 
@@ -39,11 +37,12 @@ def test_docs_tables_are_the_committed_results():
     assert replace_block(text, markdown(summary), str(RESULTS), str(PAGE)) == text
 
 
-def test_readme_headline_is_the_committed_results():
-    summary = json.loads(RESULTS.read_text())
+def test_readme_shows_the_leaderboard_not_the_research_record():
+    """The README's results are the leaderboard's block (train.leaderboard); the v1 run
+    of acld-gym 0.19 (studies/results-v1.json) is the training page's, not the README's."""
     text = README.read_text()
-    assert write_blocks(text, render_blocks(summary), str(RESULTS), str(README)) == text
-    assert headline(summary) in text and "benchmark-tables" not in text
+    assert "<!-- leaderboard:start -->" in text
+    assert "benchmark-headline" not in text and "benchmark-tables" not in text
 
 
 def test_the_headline_counts_the_seeds_better_than_lqr_and_smc():
@@ -97,7 +96,8 @@ def test_committed_results_hold_every_seed_and_the_goals():
     for name, expected in seeds.items():
         a = summary["algorithms"][name]
         assert a["seeds"] == expected, name
-        assert set(a["goals"]) == set(GOALS)
+        # the research record keeps the checks of its version (goals of acld-gym 0.19)
+        assert set(GOALS) <= set(a["goals"])
         for s in a["per_seed"]:
             assert all(0 < s[c] < 10 for c in ("1", "2", "3", "random"))
 

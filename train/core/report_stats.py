@@ -1,6 +1,6 @@
 """The benchmark's statistics: per algorithm and case, the IQM of ISE / LQR over the seeds
-with 95 % stratified-bootstrap intervals, the learning curves' bands and the goals
-(:func:`summarize`, :data:`GOALS`)."""
+with 95 % stratified-bootstrap intervals, the learning curves' bands and the checks
+(:func:`summarize`, :data:`CHECKS`)."""
 
 from __future__ import annotations
 
@@ -10,24 +10,22 @@ from .evaluate import CASES
 from .stats import iqm, iqm_with_ci
 from .trials import REFERENCES
 
-__all__ = ["GOALS", "goals_of", "summarize", "seeds_beating_references"]
+__all__ = ["GOALS", "CHECKS", "goals_of", "summarize", "seeds_beating_references"]
 
 
-#: The goals (issue 20), each a function of every seed's ISE / LQR ``rel`` (seeds x
-#: :data:`CASES`), their IQM ``stats``, the references (ISE / LQR) and the runs.
+#: The checks a benchmark's table prints, each a function of every seed's ISE / LQR ``rel``
+#: (seeds x :data:`CASES`), their IQM ``stats``, the references (ISE / LQR) and the runs.
+#: Each holds on any level (relative to the level's own thesis LQR and SMC), none is
+#: calibrated on one level; the level's marks (the engineer, the oracle, the bound) are the
+#: leaderboard's (:mod:`train.leaderboard`). The records' field keeps its name, ``goals``.
 GOALS = {
     "every_seed_beats_lqr_and_smc": lambda rel, stats, refs, runs: bool(
         seeds_beating_references(rel, refs).all()
     ),
     "every_seed_case3_within_2pct": lambda rel, stats, refs, runs: bool((rel[:, 2] <= 1.02).all()),
-    "iqm_cases_1_2_at_most_0.90": lambda rel, stats, refs, runs: all(
-        stats[c]["iqm"] <= 0.90 for c in ("1", "2")
-    ),
-    "iqm_random_at_most_0.97": lambda rel, stats, refs, runs: stats["random"]["iqm"] <= 0.97,
-    "train_wall_within_15_min": lambda rel, stats, refs, runs: (
-        max(r["train_seconds"] for r in runs) <= 900.0
-    ),
 }
+#: The same checks under the name the tables print.
+CHECKS = GOALS
 
 
 def seeds_beating_references(rel: np.ndarray, refs: dict) -> np.ndarray:
@@ -42,13 +40,13 @@ def seeds_beating_references(rel: np.ndarray, refs: dict) -> np.ndarray:
 
 
 def goals_of(rel: np.ndarray, stats: dict, refs: dict, runs: list[dict]) -> dict:
-    """Which of :data:`GOALS` a config meets."""
+    """Which of :data:`CHECKS` a config meets."""
     return {name: bool(goal(rel, stats, refs, runs)) for name, goal in GOALS.items()}
 
 
 def summarize(records: list[dict], refs: dict) -> dict:
     """Per config: IQM and 95 % stratified-bootstrap CI of ISE / LQR per case over the
-    seeds, the per-seed values, wall time, and the goals (:data:`GOALS`)."""
+    seeds, the per-seed values, wall time, and the checks (:data:`CHECKS`)."""
     lqr = refs["lqr"]
     out: dict = {
         "env_id": refs["env_id"],

@@ -5,7 +5,7 @@
 from __future__ import annotations
 
 from .evaluate import CASES, OBJECTIVE_LOADS
-from .report_stats import seeds_beating_references
+from .report_stats import GOALS, seeds_beating_references
 
 __all__ = ["budget", "markdown", "headline", "stretch_lines", "LABELS", "KINDS", "STRETCH_BASE"]
 
@@ -59,16 +59,18 @@ def markdown(summary: dict) -> str:
             + " | ".join(f"{vals[str(c)]:.3f}" for c in CASES)
             + f" | {cost(ref_costs.get(ref))} | - |"
         )
+    # the checks of this version that the record holds (an older record's other goals: not shown)
+    checks = [k for k in next(iter(summary["algorithms"].values()))["goals"] if k in GOALS]
     lines += [
         "",
-        "Goals (issue 20; every seed, or the IQM over seeds, as named):",
+        "Checks (on every seed, relative to the level's thesis LQR and SMC):",
         "",
-        "| algorithm | " + " | ".join(next(iter(summary["algorithms"].values()))["goals"]) + " |",
-        "|---" * (1 + len(next(iter(summary["algorithms"].values()))["goals"])) + "|",
+        "| algorithm | " + " | ".join(checks) + " |",
+        "|---" * (1 + len(checks)) + "|",
     ]
     for name, a in summary["algorithms"].items():
         lines.append(
-            f"| {name} | " + " | ".join("yes" if v else "no" for v in a["goals"].values()) + " |"
+            f"| {name} | " + " | ".join("yes" if a["goals"][k] else "no" for k in checks) + " |"
         )
     lines += stretch_lines(summary)
     lines += [
@@ -146,12 +148,12 @@ def headline(summary: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-#: The algorithm issue 20's stretch goal measures the deep-RL agents against.
+#: The algorithm the deep-RL agents are compared with, case by case.
 STRETCH_BASE = "vrs"
 
 
 def stretch_lines(summary: dict) -> list[str]:
-    """Issue 20's stretch goal, read off the summary: for each algorithm but
+    """The comparison with the random search, read off the summary: for each algorithm but
     :data:`STRETCH_BASE`, the cases whose IQM of ISE / LQR is below the random search's
     (five decimals: the two can be that close) and, where both have it, the IQM of the
     validation cost against the search's. No lines without the search."""
@@ -161,7 +163,7 @@ def stretch_lines(summary: dict) -> list[str]:
         return []
     out = [
         "",
-        f"Stretch (issue 20): the IQM below {STRETCH_BASE}'s on every case "
+        f"Against {STRETCH_BASE}: is the IQM below {STRETCH_BASE}'s on every case "
         "(ISE / LQR, and the validation cost, lower is better):",
         "",
     ]

@@ -1,4 +1,4 @@
-"""Deprecated: the test sets are :mod:`acld_gym.test_sets` (renamed in acld-gym 0.20.0).
+"""Deprecated: the test sets are :mod:`acld_gym.test_sets` (renamed in acld-gym 0.21.0).
 
 Every name of ``acld_gym.benchmark`` is the same object in :mod:`acld_gym.test_sets`, for
 one more version; importing this module warns once (a ``DeprecationWarning`` naming the new

@@ -1,5 +1,5 @@
 """The import path of :mod:`baselines.evaluation.rollout` before it moved
-(acld-gym 0.20.0): its public names, re-exported (the same objects). New code imports
+(acld-gym 0.21.0): its public names, re-exported (the same objects). New code imports
 :mod:`baselines.evaluation.rollout`."""
 
 from baselines.evaluation.rollout import (  # noqa: F401 (re-exported)

@@ -14,7 +14,7 @@ inputs, the env's whole configuration and observation fingerprint, :data:`FORMAT
 package version). :func:`cached` reads a file back only if it is UTF-8 JSON of at most
 :data:`MAX_BYTES`, of this format, kind and key, and passes the kind's own check; else it
 says why in one line on stderr, computes the record again and replaces the file (an
-unwritable file only costs the time). A file of an older format (before acld-gym 0.20.0:
+unwritable file only costs the time). A file of an older format (before acld-gym 0.21.0:
 without ``"format"``/``"kind"``, or format 2) is one such line, then recomputed.
 """
 

@@ -1,4 +1,4 @@
-"""The old import paths of the renamed modules (acld-gym 0.20.0) keep working for one more
+"""The old import paths of the renamed modules (acld-gym 0.21.0) keep working for one more
 version: each warns once with a ``DeprecationWarning`` naming its new path, and gives the
 very objects of the new one. ``train.bench`` -> :mod:`train.core`, ``acld_gym.benchmark`` ->
 :mod:`acld_gym.test_sets`; the recipes are ``train/recipes/``."""

@@ -1,4 +1,4 @@
-"""Deprecated: the training core is :mod:`train.core` (renamed in acld-gym 0.20.0).
+"""Deprecated: the training core is :mod:`train.core` (renamed in acld-gym 0.21.0).
 
 ``train.bench`` and its submodules (``train.bench.evaluate``, ``train.bench.trials``, ...)
 are the modules of :mod:`train.core` under their old names, for one more version: importing

@@ -38,7 +38,7 @@ run: $(STAMP)
 studies: $(STAMP)
 	$(BIN)/acld-gym mesh --json results/mesh.json
 	$(BIN)/python -m baselines.robustness
-	$(BIN)/python -m baselines.analyze passive lqr smc mpc $(dir $(wildcard train/agents/*/metadata.json)) --json results/analysis.json --markdown results/analysis.md --plots results/figures
+	$(BIN)/python -m train.analyze passive lqr smc mpc $(dir $(wildcard train/agents/*/metadata.json)) --json results/analysis.json --markdown results/analysis.md --plots results/figures
 
 ## Retrain the shipped agents, from scratch (no teacher): the benchmark's runs of vrs, ppo and
 ## sac (5 seeds each, resumable), then ship vrs seed 0 and the ppo and sac seeds that are best

@@ -8,8 +8,8 @@ POLICY is a reference of the level (:mod:`baselines.marks`: ``passive``; the the
 delay-free ``lqr`` and ``smc`` and the nominal ``mpc``; the engineer's designs for the
 level's actuator, ``lqg`` and ``mpc_rig`` (:mod:`baselines.engineer`); the plant oracle
 ``mpc_oracle`` (:mod:`baselines.oracle`)), ``references`` for all of them, or an agent
-directory (read by :func:`load_trained_agent`, or by the ``load_agent`` a caller passes to
-:func:`main`). Through the env it
+directory, read by the ``load_agent`` a caller passes to :func:`main` (``python -m
+train.analyze``, the same command with train's agent loader). Through the env it
 measures the closed-loop modes 1-3 (frequency, damping ratio) from a small tip pulse, the
 drop of each mode's load-to-tip compliance peak against the passive beam (multisine),
 for a policy linear about rest the exact closed-loop modes of the sampled loop and the
@@ -71,16 +71,14 @@ AgentLoader = Callable[[Path], object]
 
 
 def load_trained_agent(path: Path):
-    """The agent in the directory ``path``, named after it
-    (``train.agent.TrainedAgent.load``): the ``load_agent`` of :func:`main` and
-    :func:`resolve_policies` when the caller passes none."""
-    # Imported here, not at the top: train sits above baselines (physics -> design -> envs
-    # -> baselines -> train) and owns the agent folder's format, but `python -m
-    # baselines.analyze DIR` must read one. Only this default loader reaches up, and only
-    # when a POLICY is a directory; a caller on train's side passes its own `load_agent`.
-    from train.agent import TrainedAgent
-
-    return TrainedAgent.load(path, path.name)
+    """The default ``load_agent`` of :func:`main` and :func:`resolve_policies`: it refuses an
+    agent directory in one line. The agent folder's format is train's, the layer above, so
+    this command reads an agent through ``python -m train.analyze`` (``acld-gym analyze``),
+    which passes train's loader; baselines imports nothing from train."""
+    raise ValueError(
+        f"POLICY: {path.name!r} is an agent directory: analyze it with "
+        f"`python -m train.analyze {path}` (acld-gym analyze), which reads the agent format"
+    )
 
 
 def resolve_policies(
@@ -90,8 +88,8 @@ def resolve_policies(
     load_agent: AgentLoader | None = None,
 ) -> list:
     """``[(policy, name), ...]`` for a reference's name, :data:`ALL` or an agent
-    directory (read by ``load_agent``, default :func:`load_trained_agent`); ``ValueError``
-    naming ``POLICY`` otherwise."""
+    directory (read by ``load_agent``; without one it is refused:
+    :func:`load_trained_agent`); ``ValueError`` naming ``POLICY`` otherwise."""
     if spec in BASELINES or spec == ALL:
         refs = level_references(gym.make(env_id, **(env_kwargs or {})))
         if spec == ALL:
@@ -147,7 +145,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None, load_agent: AgentLoader | None = None) -> int:
     """The command: ``argv`` as on the command line; an agent directory among the POLICY
-    arguments is read by ``load_agent`` (default :func:`load_trained_agent`)."""
+    arguments is read by ``load_agent`` (without one, refused: :func:`load_trained_agent`;
+    ``python -m train.analyze`` passes train's)."""
     parser = build_parser()
     args = parser.parse_args(argv)
     try:  # a bad id, unusable output paths and a bad POLICY fail now, before any computing

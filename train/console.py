@@ -55,7 +55,7 @@ GROUPS: dict[str, dict[str, Command]] = {
             "baselines.evaluate", "run and score every reference controller of a level"
         ),
         "analyze": Command(
-            "baselines.analyze", "a controller or agent in control terms (modes, margins, effort)"
+            "train.analyze", "a controller or agent in control terms (modes, margins, effort)"
         ),
         "robustness": Command(
             "baselines.robustness", "stability of the reference controllers on varied beams"

@@ -66,12 +66,12 @@ def test_a_module_env_id_imports_nothing(tmp_path, monkeypatch):
 @pytest.mark.parametrize(
     "command",
     [
-        ["baselines.analyze", "evil_agent", "--quiet"],
+        ["train.analyze", "evil_agent", "--quiet"],
         ["train.compare", "--agents", ".", "--only", "evil_agent", "--quiet"],
     ],
 )
 def test_the_commands_run_nothing_from_the_agents_parent_folder(tmp_path, command):
-    """The probe's case: ``python -m baselines.analyze evil_agent`` (or ``train.compare``)
+    """The probe's case: ``python -m train.analyze evil_agent`` (or ``train.compare``)
     run from the folder holding it (so that the agent is importable) exits with one line
     and runs nothing."""
     _, marker = _evil(tmp_path)

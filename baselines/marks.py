@@ -1,4 +1,4 @@
-"""Every level's references and what each one is: the three marks of issue 66.
+"""Every level's references and what each one is: the three marks.
 
 On every level (``ACLDBeam-v1``, ``ACLDBeamLab-v1``, ``ACLDBeamHard-v1``, ...) the
 tables of :mod:`baselines.evaluate` and :mod:`baselines.analyze` show

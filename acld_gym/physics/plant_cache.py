@@ -44,7 +44,7 @@ from acld_gym.util.validate import (
 __all__ = ["FORMAT", "key", "cached", "save", "load", "SHIPPED_DIR", "user_cache_dir"]
 
 #: Version of the converged plant's construction; bump it when the construction changes.
-#: 2 (issue 65): modes enumerated on the fine mesh, shifts up to 1.3 x the band, the basis
+#: 2 (acld-gym 0.20.0): modes enumerated on the fine mesh, shifts up to 1.3 x the band, the basis
 #: deflated below 1e-10 (:mod:`acld_gym.physics.krylov`). The default plant has the same
 #: four shifts in both: its shipped file is the format-1 build, renamed (a fresh build
 #: agrees with it to 3e-9).

@@ -16,7 +16,7 @@ knows the whole load in advance. The score is the interquartile mean of the :mat
 with a 95 % percentile bootstrap interval (:mod:`acld_gym.util.stats`; the episodes are one
 stratum, the test set's single task).
 
-Score v1 (before issue 66) anchored 0 on the thesis's LQR, which is a delay-free design:
+Score v1 (before acld-gym 0.20.0) anchored 0 on the thesis's LQR, which is a delay-free design:
 under the lab rig's period of delay it limit-cycles, so v1 scores are not comparable with
 these (:data:`SCORE_VERSION`; every table that prints a score names its version). The
 mean ISE relative to the thesis LQR's stays beside the score as the thesis-facing column.

@@ -1,4 +1,4 @@
-"""The leaderboard of every level, generated from committed data (issue 67).
+"""The leaderboard of every level, generated from committed data.
 
 * :mod:`train.leaderboard.schema`: the data, one JSON file per level
   (``results/<env id>.json``), and its checks;

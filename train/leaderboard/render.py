@@ -27,7 +27,7 @@ __all__ = ["COMMAND", "GOAL_MARGIN", "read_levels", "marks", "goal_lines", "sect
 
 #: The command that regenerates the page and the README block.
 COMMAND = "python -m train.leaderboard render"
-#: The first goal of issue 67: an algorithm's IQM at least the best engineer's score minus this.
+#: The mark an algorithm reaches on a level: its IQM at least the best engineer's score minus this.
 GOAL_MARGIN = 0.02
 ENGINEER = "engineer's design"
 ORACLE = "plant oracle"

@@ -9,15 +9,16 @@ import pytest
 
 from baselines.analyze import BASELINES, analyze, main
 from baselines.policies import LQRPolicy
+from train.analyze import main as train_main  # the command with train's agent loader
 from train.compare import AGENTS_DIR, agent_names
 
 #: Agents with known faults (described in the README of tests/data/agents).
 FIXTURES = Path(__file__).resolve().parents[1] / "data" / "agents"
 
 
-def _run(tmp_path, policy, *extra):
+def _run(tmp_path, policy, *extra, command=main):
     out = tmp_path / "a.json"
-    assert main([policy, "--json", str(out), "--quiet", *extra]) == 0
+    assert command([policy, "--json", str(out), "--quiet", *extra]) == 0
     return json.loads(out.read_text())
 
 
@@ -59,7 +60,7 @@ def test_lqr_in_control_terms(tmp_path):
 
 
 def test_an_agent_at_the_limit_is_reported_not_refused(tmp_path):
-    rec = _run(tmp_path, str(FIXTURES / "ppo_dagger"), "--score-episodes", "0")
+    rec = _run(tmp_path, str(FIXTURES / "ppo_dagger"), "--score-episodes", "0", command=train_main)
     _check_schema(rec)
     assert rec["closed_loop_modes"] == [{"frequency_rad_s": None, "damping_ratio": None}] * 3
     assert rec["peak_reduction_db"] == [None] * 3
@@ -126,7 +127,8 @@ def test_unwritable_json_fails_up_front(tmp_path, capsys):
 @pytest.mark.parametrize("policy", [*BASELINES, *agent_names()])
 def test_the_command_runs_on_every_baseline_and_agent(tmp_path, policy):
     spec = policy if policy in BASELINES else str(AGENTS_DIR / policy)
-    rec = _run(tmp_path, spec, "--score-episodes", "5", "--plots", str(tmp_path))
+    extra = ("--score-episodes", "5", "--plots", str(tmp_path))
+    rec = _run(tmp_path, spec, *extra, command=train_main)
     _check_schema(rec)
     ident = rec["identification"]
     if ident["valid"]:
@@ -142,7 +144,7 @@ def test_the_command_runs_on_every_baseline_and_agent(tmp_path, policy):
 def test_several_policies_give_a_list_and_the_comparison_tables(tmp_path):
     js, md = tmp_path / "all.json", tmp_path / "all.md"
     assert (
-        main(
+        train_main(
             [
                 "passive",
                 str(FIXTURES / "ppo_dagger") + "/",

@@ -1,6 +1,6 @@
 r"""The benchmark's published test sets: the episodes a policy's score is computed on.
 
-A policy's score (:mod:`baselines.analysis.score`, score v2) is the interquartile mean over
+A policy's score (:mod:`baselines.evaluation.score`, score v2) is the interquartile mean over
 these episodes of :math:`(ISE_{passive} - ISE) / (ISE_{passive} - ISE_{bound})`: the passive
 beam 0, the clairvoyant bound 1 on every level. Each env id has its test
 set, versioned with it: the seeds below, reset as ``env.reset(seed=s)`` with

@@ -13,7 +13,7 @@ episode's plant and actuator but not the load (:mod:`baselines.oracle`); and the
 clairvoyant bound, with the env's actuator inside -- all with the +/-120 V limit and 1 ms
 control, in the configuration of ``--env-id`` (default ``ACLDBeam-v1``; ``--mesh``
 replaces its mesh). Then it prints score v2 of each on the env's published test set
-(:mod:`baselines.analysis.score`: passive 0, bound 1; :data:`acld_gym.test_sets.TEST_SETS`;
+(:mod:`baselines.evaluation.score`: passive 0, bound 1; :data:`acld_gym.test_sets.TEST_SETS`;
 ``--score-episodes``) beside the mean ISE relative to the thesis LQR's; on the thesis mesh
 also the saturated LQR/SMC rows against thesis Table 2. The id and the output paths are
 checked before anything is computed. Any object with SB3's ``predict`` can be evaluated

@@ -7,7 +7,7 @@ For each thesis load case (1, 2, 3) and a fixed held-out set of random loads (``
 agent (labelled by how it was trained) and the bound through ``ACLDBeam-v1``; prints peak
 [mm], 5 % settling [s], ISE [m^2 s] (and / LQR, / bound), max |V| [V], return, ms per
 step, the effort after settling (:mod:`baselines.analysis.effort`), and score v2 on the
-test set (:mod:`baselines.analysis.score`: passive 0, bound 1; ``--score-episodes``)
+test set (:mod:`baselines.evaluation.score`: passive 0, bound 1; ``--score-episodes``)
 beside the mean ISE relative to the thesis LQR's.
 
 ``--param-noise X``: per-episode parameter randomization (the same plants for every

@@ -1,5 +1,5 @@
 """Aggregate statistics of the RL benchmark (``train.core``) and of the policy score
-(:mod:`baselines.analysis.score`): the interquartile mean (IQM) and 95 %
+(:mod:`baselines.evaluation.score`): the interquartile mean (IQM) and 95 %
 stratified-bootstrap confidence intervals (Agarwal et al. 2021, as ``rliable`` 1.2.0
 computes them: IQM = 25 %-trimmed mean of all run x task scores; the bootstrap
 resamples the runs with replacement within each task; percentile interval)."""

@@ -16,5 +16,5 @@ The command lines are apart: ``python -m baselines.evaluate`` (the references' t
 ``python -m baselines.analyze`` (one policy in control terms), ``python -m train.compare``.
 ``train`` imports this subpackage; it imports nothing of ``train``. The old import paths
 :mod:`baselines.rollout`, :mod:`baselines.analysis.references` and
-:mod:`baselines.analysis.score` re-export their public names (the same objects).
+``baselines.analysis.score`` re-export their public names (the same objects).
 """

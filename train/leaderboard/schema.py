@@ -16,7 +16,7 @@ A file (:data:`FORMAT` 1) is a mapping::
   ``budget``, ``train_seconds``, ``train_cpu_seconds`` (None: not recorded), ``runs`` and
   ``retries`` (the reasons, from the trial's record);
 * ``SCORE``: score v2 on the level's test set, ``{"version", "iqm", "ci_low", "ci_high",
-  "n_episodes", "test_set"}`` (:meth:`baselines.analysis.score.Score.as_dict`'s fields);
+  "n_episodes", "test_set"}`` (:meth:`baselines.evaluation.score.Score.as_dict`'s fields);
 * ``case``: ``"1"``, ``"2"``, ``"3"`` (thesis cases, seed 0) and ``"random"`` (the held-out
   random loads); ``ise_rel_lqr``: the mean ISE over the case's episodes divided by the
   thesis LQR's;

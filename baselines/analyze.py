@@ -54,7 +54,7 @@ __all__ = [
     "BASELINES",
     "ALL",
     "AgentLoader",
-    "load_trained_agent",
+    "refuse_agent_directory",
     "resolve_policy",
     "resolve_policies",
     "main",
@@ -70,7 +70,7 @@ ALL = "references"
 AgentLoader = Callable[[Path], object]
 
 
-def load_trained_agent(path: Path):
+def refuse_agent_directory(path: Path):
     """The default ``load_agent`` of :func:`main` and :func:`resolve_policies`: it refuses an
     agent directory in one line. The agent folder's format is train's, the layer above, so
     this command reads an agent through ``python -m train.analyze`` (``acld-gym analyze``),
@@ -89,7 +89,7 @@ def resolve_policies(
 ) -> list:
     """``[(policy, name), ...]`` for a reference's name, :data:`ALL` or an agent
     directory (read by ``load_agent``; without one it is refused:
-    :func:`load_trained_agent`); ``ValueError`` naming ``POLICY`` otherwise."""
+    :func:`refuse_agent_directory`); ``ValueError`` naming ``POLICY`` otherwise."""
     if spec in BASELINES or spec == ALL:
         refs = level_references(gym.make(env_id, **(env_kwargs or {})))
         if spec == ALL:
@@ -102,7 +102,7 @@ def resolve_policies(
         raise ValueError(
             f"POLICY: expected one of {[*BASELINES, ALL]} or an agent directory, got {spec!r}"
         )
-    return [((load_agent or load_trained_agent)(path), path.name)]
+    return [((load_agent or refuse_agent_directory)(path), path.name)]
 
 
 def resolve_policy(
@@ -145,7 +145,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None, load_agent: AgentLoader | None = None) -> int:
     """The command: ``argv`` as on the command line; an agent directory among the POLICY
-    arguments is read by ``load_agent`` (without one, refused: :func:`load_trained_agent`;
+    arguments is read by ``load_agent`` (without one, refused: :func:`refuse_agent_directory`;
     ``python -m train.analyze`` passes train's)."""
     parser = build_parser()
     args = parser.parse_args(argv)

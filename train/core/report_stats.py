@@ -1,6 +1,6 @@
 """The benchmark's statistics: per algorithm and case, the IQM of ISE / LQR over the seeds
 with 95 % stratified-bootstrap intervals, the learning curves' bands and the checks
-(:func:`summarize`, :data:`CHECKS`)."""
+(:func:`summarize`, :data:`GOALS`)."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from .evaluate import CASES
 from .stats import iqm, iqm_with_ci
 from .trials import REFERENCES
 
-__all__ = ["GOALS", "CHECKS", "goals_of", "summarize", "seeds_beating_references"]
+__all__ = ["GOALS", "goals_of", "summarize", "seeds_beating_references"]
 
 
 #: The checks a benchmark's table prints, each a function of every seed's ISE / LQR ``rel``
@@ -24,8 +24,6 @@ GOALS = {
     ),
     "every_seed_case3_within_2pct": lambda rel, stats, refs, runs: bool((rel[:, 2] <= 1.02).all()),
 }
-#: The same checks under the name the tables print.
-CHECKS = GOALS
 
 
 def seeds_beating_references(rel: np.ndarray, refs: dict) -> np.ndarray:
@@ -40,13 +38,13 @@ def seeds_beating_references(rel: np.ndarray, refs: dict) -> np.ndarray:
 
 
 def goals_of(rel: np.ndarray, stats: dict, refs: dict, runs: list[dict]) -> dict:
-    """Which of :data:`CHECKS` a config meets."""
+    """Which of :data:`GOALS` a config meets."""
     return {name: bool(goal(rel, stats, refs, runs)) for name, goal in GOALS.items()}
 
 
 def summarize(records: list[dict], refs: dict) -> dict:
     """Per config: IQM and 95 % stratified-bootstrap CI of ISE / LQR per case over the
-    seeds, the per-seed values, wall time, and the checks (:data:`CHECKS`)."""
+    seeds, the per-seed values, wall time, and the checks (:data:`GOALS`)."""
     lqr = refs["lqr"]
     out: dict = {
         "env_id": refs["env_id"],

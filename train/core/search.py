@@ -9,6 +9,7 @@ import numpy as np
 
 import acld_gym  # noqa: F401  (registers the env ids)
 from acld_gym.wrappers import whitening
+from baselines.evaluation.seeds import SEARCH_SEEDS
 
 from ..config import TrainConfig
 from ..features import direction_features
@@ -185,7 +186,8 @@ def train_random_search(
         )
 
     def episode_seed() -> int:
-        return int(rng.integers(1_000_000, 2**31 - 10_000_000))
+        # the first seed of a round's episodes; the 10M left at the top keep seed + k in range
+        return int(rng.integers(SEARCH_SEEDS.start, SEARCH_SEEDS.stop - 10_000_000))
 
     if rs.whiten and steps + envs.steps_per_round <= cfg.timesteps:
         if callback is not None and schedule.due(steps):

@@ -65,12 +65,13 @@ def test_overrides_of_the_command_line():
         configure(odd)
 
 
-@pytest.mark.parametrize("algo", ["ppo", "sac"])
-def test_train_cli_is_a_benchmark_trial(algo, tmp_path, capsys, v1_references):
+@pytest.mark.parametrize("algo, cpus", [("ppo", 1), ("sac", 2)])
+def test_train_cli_is_a_benchmark_trial(algo, cpus, tmp_path, capsys, v1_references):
     """``python -m train ALGO --seed N`` and ``python -m train.benchmark --seeds N`` give the
-    same agent, bit for bit, the one training its runs one after another, the other two at
-    once in worker processes (``--cpus-per-trial 2``); it loads (validated) and acts in
-    volts."""
+    same agent, bit for bit, the one training its runs one after another, the other in this
+    process (``--cpus-per-trial 1``, PPO) or two at once in worker processes
+    (``--cpus-per-trial 2``, SAC; every algorithm's runs at once:
+    tests/train/test_restarts.py); it loads (validated) and acts in volts."""
     from train.benchmark import main as bench_main
     from train.cli import main as train_main
 
@@ -100,7 +101,7 @@ def test_train_cli_is_a_benchmark_trial(algo, tmp_path, capsys, v1_references):
                 "--backend",
                 "local",
                 "--cpus-per-trial",
-                "2",
+                str(cpus),
                 "--random-episodes",
                 "1",
                 "--no-bound",
@@ -130,9 +131,9 @@ def test_train_cli_is_a_benchmark_trial(algo, tmp_path, capsys, v1_references):
 def _documented_commands(module: str) -> list[list[str]]:
     """The arguments of every ``python -m <module> ...`` line of the README and the docs'
     shell blocks (line continuations joined, comments dropped, brace lists expanded to
-    their first item). The research record (docs/studies.md) is left out: its commands ran
-    on the versions it names, and some of its ablations set options since removed
-    (studies/README.md lists them)."""
+    their first item). The research record (``studies/studies.md``) is not among them: its
+    commands ran on the versions it names, and some of its ablations set options since
+    removed (studies/README.md lists them)."""
     import re
     import shlex
     from pathlib import Path
@@ -140,7 +141,7 @@ def _documented_commands(module: str) -> list[list[str]]:
     root = Path(__file__).resolve().parents[2]
     out = []
     pages = [root / "README.md", *sorted((root / "docs").rglob("*.md"))]
-    for page in [p for p in pages if p.name != "studies.md"]:
+    for page in pages:
         for block in re.findall(r"^```bash\n(.*?)^```", page.read_text(), flags=re.S | re.M):
             for line in block.replace("\\\n", " ").splitlines():
                 line = re.sub(r"\{([^,}]+)(,[^}]*)?\}", r"\1", line.split("  #")[0])

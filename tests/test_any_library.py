@@ -85,14 +85,14 @@ def test_scripts_refuse_an_unknown_level_in_one_line(tmp_path):
 
 @pytest.mark.parametrize("algo, env_id", [("ppo", "ACLDBeam-v1"), ("sac", OTHER)])
 def test_rl_zoo3_trains_from_the_mlp_file_and_zoo_score_scores_it(algo, env_id, tmp_path):
-    """rl-zoo3 trains from ``train/zoo/<algo>_mlp.yml`` (a few thousand steps, 8 sub-envs)
+    """rl-zoo3 trains from ``train/zoo/<algo>_mlp.yml`` (2048 steps, 8 sub-envs)
     and ``docs/examples/zoo_score.py`` scores the run with the wrappers and the
     ``VecNormalize`` it saved."""
     train = ["-m", "rl_zoo3.train", "--algo", algo, "--env", env_id, "--gym-packages"]
     train += ["acld_gym", "--conf-file", str(ROOT / f"train/zoo/{algo}_mlp.yml"), "-f", "logs"]
-    train += ["--seed", "0", "--eval-freq", "-1", "-n", "4096", "--hyperparams", "n_envs:8"]
+    train += ["--seed", "0", "--eval-freq", "-1", "-n", "2048", "--hyperparams", "n_envs:8"]
     if algo == "sac":
-        train.append("learning_starts:1000")
+        train.append("learning_starts:1024")
     _run(train, tmp_path)
     run = tmp_path / "logs" / algo / f"{env_id}_1"
     score = [str(EXAMPLES / "zoo_score.py"), algo, str(run), env_id, "--episodes", "2"]

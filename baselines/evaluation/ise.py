@@ -14,6 +14,8 @@ score on the test sets is the other view (:mod:`baselines.evaluation.score`).
 
 from __future__ import annotations
 
+import functools
+
 import gymnasium as gym
 import numpy as np
 
@@ -70,9 +72,18 @@ def rollout_ise(policy, env_id: str = DEFAULT_ENV_ID, episodes: dict | None = No
 
 def lqr_ise(env_id: str = DEFAULT_ENV_ID, episodes: dict | None = None) -> dict:
     """Mean ISE [m^2 s] per case of the LQR designed on ``env_id`` (:func:`rollout_ise`),
-    the yardstick of ISE / LQR, without designing the other references."""
+    the yardstick of ISE / LQR, without designing the other references. Computed once per
+    process for an id and a set of episodes (the design and the episodes are deterministic),
+    a fresh dict each call."""
+    episodes = eval_episodes() if episodes is None else episodes
+    key = tuple((c, tuple(int(s) for s in seeds)) for c, seeds in episodes.items())
+    return dict(_lqr_ise(env_id, key))
+
+
+@functools.lru_cache(maxsize=32)
+def _lqr_ise(env_id: str, episodes: tuple) -> tuple:
     lqr = LQRPolicy.for_env(case_env(env_id, 1))
-    return rollout_ise(lqr, env_id, eval_episodes() if episodes is None else episodes)
+    return tuple(rollout_ise(lqr, env_id, dict(episodes)).items())
 
 
 def relative_ise(ise: dict, refs: dict, to: str = "lqr") -> dict:

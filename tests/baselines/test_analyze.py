@@ -98,7 +98,7 @@ def test_bad_arguments_exit_2_before_computing(argv, word, capsys):
 
 
 def test_the_oracle_is_analyzed_as_a_dynamic_law_and_scored(tmp_path):
-    rec = _run(tmp_path, "mpc_oracle", "--env-id", "ACLDBeamLab-v1", "--score-episodes", "2")
+    rec = _run(tmp_path, "mpc_oracle", "--env-id", "ACLDBeamLab-v1", "--score-episodes", "1")
     _check_schema(rec)
     assert rec["policy"] == "mpc_oracle" and not rec["linear"]
     assert "oracle" in rec["small_signal_law"]

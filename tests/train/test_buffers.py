@@ -98,3 +98,24 @@ def test_sac_trains_bit_for_bit_as_with_sb3s_buffer(monkeypatch):
     for key in a:
         assert torch.equal(a[key], b[key]), key
     assert ours.model.num_timesteps == theirs.model.num_timesteps == 1200 - 128
+
+
+@pytest.mark.parametrize("verbose", [0, 1])
+def test_a_model_leaves_no_sb3_folder_in_the_temp_dir(verbose, tmp_path, monkeypatch):
+    """SB3's default logger makes an empty ``<tmp>/SB3-<date>`` folder per model, quiet or
+    not; the package's models log to the console or nowhere, without one."""
+    import tempfile
+
+    from train.core.sb3_train import make_model
+    from train.vec import make_vec_env
+
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    monkeypatch.delenv("SB3_LOGDIR", raising=False)
+    cfg = tiny_sac_recipe(300)
+    venv = make_vec_env(cfg, 0, "ACLDBeam-v1")
+    model = make_model(cfg, venv, 0, verbose=verbose)
+    model.learn(300)
+    venv.close()
+    assert not list(tmp_path.glob("SB3-*"))
+    kinds = [type(f).__name__ for f in model.logger.output_formats]
+    assert kinds == (["HumanOutputFormat"] if verbose else [])  # the console, when verbose

@@ -1,11 +1,11 @@
 """Files the training core reads: a key given twice in a config is refused (plain YAML keeps
-the last one silently), and a damaged references cache is computed again, said in one line."""
+the last one silently); the recipes load. A damaged references cache is
+tests/baselines/evaluation/test_references.py's."""
 
 import pytest
 
 from acld_gym.util.validate import DataFileError
 from train.config import load_config
-from train.core.evaluate import _cached_references
 
 
 def test_a_key_given_twice_is_refused_naming_file_line_and_key(tmp_path):
@@ -26,15 +26,3 @@ def test_yaml_merge_keys_and_the_recipes_still_load(tmp_path):
         load_config(path)
     for name in ("ppo", "sac", "vrs"):
         assert load_config(name).timesteps > 0
-
-
-@pytest.mark.parametrize(
-    "text", ["[1, 2]", "[" * 50_000 + "]" * 50_000, '{"env_id": 3}', "not json", ""]
-)
-def test_a_damaged_references_cache_is_computed_again(tmp_path, capsys, text):
-    path = tmp_path / "references.json"
-    path.write_text(text)
-    assert _cached_references(path, bound=True) is None
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and err[0].startswith(str(path)) and "computing" in err[0]
-    assert _cached_references(tmp_path / "none.json", bound=True) is None

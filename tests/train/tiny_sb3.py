@@ -55,8 +55,8 @@ def tiny_crossq(**fields) -> TrainConfig:
     """sb3-contrib's CrossQ with its own MLP policy on the SAC recipe's env-level pieces
     (random loads, the reward per load, action headroom 3; the probe
     ``studies/ablations/ablation_crossq.yaml``) shrunk to 1200 env steps on 2 sub-envs
-    (learning from 400 on, minibatches of 64, no checkpoint selection), with ``fields``
-    changed on top."""
+    (learning from 400 on, one gradient step of a minibatch of 64 per step, layers of 32
+    units, no checkpoint selection), with ``fields`` changed on top."""
     data = dict(
         algo="crossq",
         timesteps=1200,
@@ -74,8 +74,8 @@ def tiny_crossq(**fields) -> TrainConfig:
             "learning_starts": 400,
             "gamma": 0.995,
             "train_freq": 1,
-            "gradient_steps": 3,
-            "policy_kwargs": {"net_arch": {"pi": [256, 256], "qf": [256, 256]}},
+            "gradient_steps": 1,
+            "policy_kwargs": {"net_arch": {"pi": [32, 32], "qf": [32, 32]}},
         },
     )
     data.update(fields)

@@ -20,7 +20,6 @@ names (:func:`eval_episodes`, :func:`rollout_ise`, :func:`lqr_ise`, :func:`relat
 
 from __future__ import annotations
 
-import sys
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
@@ -49,7 +48,7 @@ from baselines.evaluation.seeds import (  # re-exported: the seed blocks' home
 )
 from baselines.policies import LQRPolicy, policies_for
 
-from .records import check_references, read_json
+from .records import check_references
 
 __all__ = [
     "CASES",
@@ -158,19 +157,6 @@ def validation_rollout(policy, env_id: str = DEFAULT_ENV_ID, seeds=None) -> tupl
     obs, _ = venv.reset(seed=seeds)
     (ret,), (steps,) = _side_by_side(policy, [venv], [obs], lambda r, info: r)
     return float(np.mean(-ret / steps)), int(steps.sum())
-
-
-def _cached_references(cache, bound: bool) -> dict | None:
-    """The references cache file ``cache`` if it is whole (:func:`train.core.records.
-    check_references`); None when there is none, and when it is damaged (said in one line:
-    it is computed again)."""
-    if cache is None or not Path(cache).is_file():
-        return None
-    try:
-        return check_references(read_json(cache), cache, bound)
-    except DataFileError as exc:
-        print(f"{exc}: computing the references again", file=sys.stderr)
-        return None
 
 
 def references(

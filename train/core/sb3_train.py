@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import copy
 import inspect
+import sys
 import time
 from collections.abc import Callable
 
@@ -15,7 +16,7 @@ import torch
 import torch.nn as nn
 from gymnasium import spaces
 from stable_baselines3.common.callbacks import BaseCallback
-from stable_baselines3.common.logger import Logger
+from stable_baselines3.common.logger import HumanOutputFormat, Logger
 from stable_baselines3.common.off_policy_algorithm import OffPolicyAlgorithm
 from stable_baselines3.common.vec_env import VecNormalize
 
@@ -180,9 +181,11 @@ def make_model(cfg: TrainConfig, venv, seed: int, **kwargs):
     cls = algo_class(cfg.algo)
     model_kwargs = _flat_n_step_buffer(cls, venv, {**model_kwargs, **kwargs})
     model = cls(policy, venv, seed=seed, device="cpu", **model_kwargs)
-    if not model_kwargs.get("verbose") and model_kwargs.get("tensorboard_log") is None:
-        # SB3's default logger makes an empty /tmp/SB3-<date> folder per model: log nowhere.
-        model.set_logger(Logger(folder=None, output_formats=[]))
+    if model_kwargs.get("tensorboard_log") is None:
+        # SB3's default logger makes an empty /tmp/SB3-<date> folder per model, quiet or
+        # not: log to the console (verbose) or nowhere, without a folder.
+        formats = [HumanOutputFormat(sys.stdout)] if model_kwargs.get("verbose") else []
+        model.set_logger(Logger(folder=None, output_formats=formats))
     return model
 
 

@@ -40,3 +40,16 @@ def test_case_references_hold_each_policy_and_the_bound_per_case():
     # JSON's string keys and the cases' own keys both divide
     assert ise.relative_ise(lqr, refs) == pytest.approx({c: 1.0 for c in EPISODES})
     assert ise.relative_ise(lqr, {"lqr": lqr}) == {c: 1.0 for c in EPISODES}
+
+
+def test_the_lqrs_ise_is_computed_once_per_id_and_episodes(monkeypatch):
+    """The yardstick is designed and run once per process for an id and a set of episodes:
+    a second call runs no episode and returns an equal dict of its own."""
+    first = ise.lqr_ise("ACLDBeam-v1", EPISODES)
+    calls = []
+    monkeypatch.setattr(ise, "rollout_ise", lambda *a, **k: calls.append(a) or {})
+    first[1] = -1.0  # the caller's copy
+    again = ise.lqr_ise("ACLDBeam-v1", {c: list(s) for c, s in EPISODES.items()})
+    assert not calls and again[1] > 0 and set(again) == set(EPISODES)
+    other = ise.lqr_ise("ACLDBeam-v1", {1: (1,)})  # other episodes: computed
+    assert calls and other == {}

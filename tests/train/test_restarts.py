@@ -262,11 +262,22 @@ def test_two_tiny_sac_runs_return_the_better_one():
 def test_runs_at_once_are_the_runs_one_after_another(restart_above, trained):
     """``workers=2`` trains the runs in worker processes, two at once: the same runs, taken
     in the same order, so the same policy (parameters and actions) and record; a run
-    started ahead and not needed is ended and counted nowhere but in the CPU time."""
+    started ahead and not needed is ended and counted nowhere but in the CPU time.
+
+    The worker pool's semaphores are released before ``train_algo`` returns, not when the
+    garbage collector next runs: in a Ray Tune trial that is at the process's exit, after
+    Ray has ended its resource tracker, which then printed a KeyError traceback for each
+    (the pool's objects hold one another in cycles)."""
+    import gc
+    from multiprocessing.synchronize import SemLock
+
     import numpy as np
     import torch
 
     from train.core.trials import CaseISE
+
+    def semaphores():
+        return {id(o) for o in gc.get_objects() if issubclass(type(o), SemLock)}
 
     cfg = tiny_sac_recipe(
         400,
@@ -275,7 +286,16 @@ def test_runs_at_once_are_the_runs_one_after_another(restart_above, trained):
         select={"episodes": 2, "every": 200, "start": 0},
     )
     curve = CaseISE("ACLDBeam-v1", evaluate.eval_episodes(1))  # pickles to the workers
-    (p1, r1), (p2, r2) = (train_algo(cfg, 3, "ACLDBeam-v1", curve, workers=w) for w in (1, 2))
+    p1, r1 = train_algo(cfg, 3, "ACLDBeam-v1", curve, workers=1)
+    gc.collect()
+    before = semaphores()
+    gc.disable()  # only the release under test may collect the pool's cycles
+    try:
+        p2, r2 = train_algo(cfg, 3, "ACLDBeam-v1", curve, workers=2)
+        left = semaphores() - before
+    finally:
+        gc.enable()
+    assert not left, f"{len(left)} semaphores of the worker pool still alive"
     assert len(r1["restarts"]["runs"]) == trained and r1["steps"] == 400 * trained
     assert "workers" not in r1["restarts"] and r2["restarts"].pop("workers") == 2
     for key in ("steps", "select", "curve", "restarts"):
@@ -310,30 +330,6 @@ def test_a_run_in_this_process_has_one_blas_thread_as_a_worker_has(monkeypatch):
         after = [d["num_threads"] for d in threadpool_info() if d["user_api"] == "blas"]
     assert seen and all(n == 1 for n in seen[0])
     assert after == [min(2, d) for d in after]  # the caller's setting is back afterwards
-
-
-def test_runs_at_once_release_their_semaphores():
-    """The worker pool's semaphores are released before ``train_algo`` returns, not when
-    the garbage collector next runs: in a Ray Tune trial that is at the process's exit,
-    after Ray has ended its resource tracker, which then printed a KeyError traceback
-    for each (the pool's objects hold one another in cycles)."""
-    import gc
-    from multiprocessing.synchronize import SemLock
-
-    def semaphores():
-        return {id(o) for o in gc.get_objects() if issubclass(type(o), SemLock)}
-
-    gc.collect()
-    before = semaphores()
-    gc.disable()  # only the release under test may collect the cycles
-    try:
-        cfg = tiny_sac_recipe(400, restarts=3, restart_above=1e9)  # one run; one ended
-        _, record = train_algo(cfg, 3, "ACLDBeam-v1", workers=2)
-        left = semaphores() - before
-    finally:
-        gc.enable()
-    assert record["restarts"]["workers"] == 2 and len(record["restarts"]["runs"]) == 1
-    assert not left, f"{len(left)} semaphores of the worker pool still alive"
 
 
 @pytest.mark.parametrize("workers", [0, -1, 1.5, True, "2"])

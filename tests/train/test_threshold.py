@@ -40,9 +40,12 @@ def test_the_retrying_recipes_are_ppo_and_sac_and_relative_to_the_lqg():
 @pytest.mark.parametrize("name", RETRYING)
 @pytest.mark.parametrize("env_id", LEVELS)
 def test_a_recipes_threshold_resolves_between_the_best_reference_and_passive(name, env_id):
-    cfg = load_config(name)
-    loads = cfg.select_config.episodes
-    got = RestartRule.parse(cfg.restart_above).resolve(env_id, validation_seeds(loads))
+    """On 16 validation loads (the recipes' own 256 and 64: the v1 test below; the rule and
+    its resolution do not depend on the count)."""
+    loads = 16
+    got = RestartRule.parse(load_config(name).restart_above).resolve(
+        env_id, validation_seeds(loads)
+    )
     t = got["threshold"]
     costs = {ref: _cost(ref, env_id, loads) for ref in REFERENCES}
     assert got["reference_cost"] == costs["lqg"] and got["loads"] == loads

@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import os
 import resource
+import runpy
 import signal
 import subprocess
 import sys
@@ -147,20 +148,29 @@ CONFIGS = {
 }
 
 
+def _python_m_train(argv, monkeypatch, capsys) -> tuple[int, str]:
+    """``python -m train ARGV`` run as the interpreter runs it (``train/__main__.py`` as
+    ``__main__``), in this process: its exit status and stderr. A traceback would escape
+    as the exception itself, not as ``SystemExit``."""
+    monkeypatch.setattr(sys, "argv", ["train", *argv])
+    monkeypatch.chdir(ROOT)
+    with pytest.raises(SystemExit) as exit_:
+        runpy.run_module("train", run_name="__main__", alter_sys=True)
+    return exit_.value.code, capsys.readouterr().err
+
+
 @pytest.mark.parametrize("case", sorted(CONFIGS))
-def test_training_cli_bad_config_is_one_line_and_creates_nothing(case, tmp_path):
+def test_training_cli_bad_config_is_one_line_and_creates_nothing(
+    case, tmp_path, monkeypatch, capsys
+):
     text, word = CONFIGS[case]
     cfg = tmp_path / "bad.yaml"
     cfg.write_text(text)
     out_dir = tmp_path / "run"
-    res = subprocess.run(
-        [sys.executable, "-m", "train", "ppo", "--config", str(cfg), "--out", str(out_dir)],
-        capture_output=True,
-        text=True,
-        cwd=ROOT,
-    )
-    assert res.returncode == 2 and "Traceback" not in res.stderr
-    assert word in res.stderr.strip().splitlines()[-1]
+    argv = ["ppo", "--config", str(cfg), "--out", str(out_dir)]
+    code, err = _python_m_train(argv, monkeypatch, capsys)
+    assert code == 2 and "Traceback" not in err
+    assert word in err.strip().splitlines()[-1]
     assert not out_dir.exists()
 
 
@@ -172,15 +182,27 @@ def test_training_cli_bad_config_is_one_line_and_creates_nothing(case, tmp_path)
         (["--param-noise", "0.5"], "--param-noise"),
     ],
 )
-def test_training_cli_bad_flags(flags, word, tmp_path):
+def test_training_cli_bad_flags(flags, word, tmp_path, monkeypatch, capsys):
+    out_dir = tmp_path / "run"
+    code, err = _python_m_train(["ppo", *flags, "--out", str(out_dir)], monkeypatch, capsys)
+    assert code == 2 and "Traceback" not in err and word in err
+    assert not out_dir.exists()
+
+
+def test_the_training_command_in_its_own_process_is_one_line(tmp_path):
+    """The entry point as a user runs it, once: the tests above run the same module in
+    this process."""
+    cfg = tmp_path / "bad.yaml"
+    cfg.write_text(CONFIGS["misspelled key"][0])
     out_dir = tmp_path / "run"
     res = subprocess.run(
-        [sys.executable, "-m", "train", "ppo", *flags, "--out", str(out_dir)],
+        [sys.executable, "-m", "train", "ppo", "--config", str(cfg), "--out", str(out_dir)],
         capture_output=True,
         text=True,
         cwd=ROOT,
     )
-    assert res.returncode == 2 and "Traceback" not in res.stderr and word in res.stderr
+    assert res.returncode == 2 and "Traceback" not in res.stderr
+    assert "n_stepz" in res.stderr.strip().splitlines()[-1]
     assert not out_dir.exists()
 
 

@@ -55,10 +55,11 @@ lint: $(STAMP)
 	$(BIN)/ruff format --check $(PYSRC)
 
 ## Lint + the test suite (slow tests excluded; see test-slow) + the documentation site.
-## pytest-xdist spreads the tests over the cores; the 15 slowest are listed at the end; the
-## session's temporary files go into one folder it removes (tests/conftest.py).
+## pytest-xdist spreads the tests over the cores (work stealing: a core left idle takes
+## tests queued for the other); the 15 slowest are listed at the end; the session's
+## temporary files go into one folder it removes (tests/conftest.py).
 test: lint
-	$(BIN)/python -m pytest -q -n auto --durations=15
+	$(BIN)/python -m pytest -q -n auto --dist worksteal --durations=15
 	$(MAKE) docs
 
 ## The core install: the wheel (compiled step, shipped agents as package data) in a clean
@@ -79,7 +80,7 @@ docs: $(STAMP)
 	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict
 
 test-slow: $(STAMP)
-	$(BIN)/python -m pytest -q -n auto --durations=15 -m slow
+	$(BIN)/python -m pytest -q -n auto --dist worksteal --durations=15 -m slow
 
 format: $(STAMP)
 	$(BIN)/ruff check --fix $(PYSRC)

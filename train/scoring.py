@@ -13,7 +13,9 @@ package scores its own agents and references:
   mean ISE per case divided by the LQR's designed on the same level.
 
 The policy may be a stable-baselines3 model (with its ``VecNormalize`` statistics: the
-observation normalization is applied, the reward normalization plays no part), a
+observation normalization is applied, the reward normalization plays no part; a model
+loaded with ``PPO.load(path)`` has no env, so it needs ``vec_normalize=`` the path of its
+saved ``vecnormalize.pkl``, or ``False`` if it was trained without one), a
 :class:`train.agent.TrainedAgent`, any object with SB3's
 ``predict(observation, state, episode_start, deterministic)`` (a stateful one, such as
 SB3's recurrent policies or an engineer's LQG, gets its state back at every step and
@@ -149,11 +151,14 @@ def score(
         The single-env wrappers it was trained with, innermost first: classes
         (``UnitAction``) or callables (``functools.partial(ObserveModes, modes=1)``,
         ``lambda e: RescaleAction(e, -1.0, 1.0)``).
-    vec_normalize : VecNormalize, path, or None
+    vec_normalize : VecNormalize, path, False or None
         SB3's ``VecNormalize`` the policy was trained under (its observation statistics
         are applied; it is not changed), or the path of its saved ``vecnormalize.pkl``
-        (unpickled: only from a source you trust). Default: the SB3 model's own env's, if
-        that is a ``VecNormalize``, else none.
+        (unpickled: only from a source you trust); ``False``: none (a policy trained
+        without one). None (default): the SB3 model's own env's if that is a
+        ``VecNormalize``, else none; an SB3 model without an env (``PPO.load(path)``) is
+        refused, since whether it was trained under a ``VecNormalize`` is unknown: pass its
+        file or ``False``. For other policies None is ``False``.
     episodes : int or None
         Score on the first ``episodes`` of the test set and of the held-out random loads
         (at most their 20): a reduced run, quick, not the published score. None: all.
@@ -171,7 +176,8 @@ def score(
     TypeError, ValueError
         One line naming the argument: a policy without ``predict`` that is not callable, an
         unknown ``env_id``, ``wrappers`` that do not fit the env or the policy, a
-        ``vec_normalize`` of another observation, ``episodes`` out of range.
+        ``vec_normalize`` of another observation or missing for a loaded SB3 model,
+        ``episodes`` out of range.
     """
     env_id = check_env_id(env_id, "env_id")
     test = evaluation_set(env_id)

@@ -99,10 +99,29 @@ class _Spaces(gym.Env):
         self.observation_space, self.action_space = observation_space, action_space
 
 
+def _own_vec_normalize(model):
+    """The ``VecNormalize`` of an SB3 ``model``'s own env, or None if its env is another;
+    ``ValueError`` naming ``vec_normalize`` if it has no env (``PPO.load(path)``): whether it
+    was trained under a ``VecNormalize`` is then unknown, and scoring it without the
+    statistics would give another policy's score without a word."""
+    from stable_baselines3.common.vec_env import VecNormalize
+
+    own = model.get_env()
+    if own is None:
+        raise ValueError(
+            f"vec_normalize: this {type(model).__name__} model has no env (loaded with "
+            "load(path)?), so its VecNormalize is unknown: pass the VecNormalize it was "
+            "trained under or the path of its saved vecnormalize.pkl, or vec_normalize=False "
+            "if it was trained without one"
+        )
+    return own if isinstance(own, VecNormalize) else None
+
+
 def as_policy(policy, vec_normalize, env: gym.Env, wrappers: tuple) -> ScoredPolicy:
     """``policy`` (an SB3 model, a ``TrainedAgent``, an object with ``predict``, a callable)
-    with its ``vec_normalize`` (a ``VecNormalize``, its file, or None: an SB3 model's own
-    env's) as a :class:`ScoredPolicy` on ``env`` (the wrapped env)."""
+    with its ``vec_normalize`` (a ``VecNormalize``, its file, False: none, or None: an SB3
+    model's own env's, refused for a model without an env) as a :class:`ScoredPolicy` on
+    ``env`` (the wrapped env)."""
     from .agent import TrainedAgent
 
     if not (callable(getattr(policy, "predict", None)) or callable(policy)):
@@ -117,17 +136,16 @@ def as_policy(policy, vec_normalize, env: gym.Env, wrappers: tuple) -> ScoredPol
             "normalization and action scaling are inside it): score it without wrappers"
         )
     if vec_normalize is None and _is_sb3(policy):
-        from stable_baselines3.common.vec_env import VecNormalize
-
-        own = policy.get_env()
-        vec_normalize = own if isinstance(own, VecNormalize) else None
+        vec_normalize = _own_vec_normalize(policy)
+    elif vec_normalize is False:  # said so: no VecNormalize
+        vec_normalize = None
     if isinstance(vec_normalize, (str, Path)):
         vec_normalize = load_vec_normalize(vec_normalize, env)
     if vec_normalize is not None:
         if not callable(getattr(vec_normalize, "normalize_obs", None)):
             raise TypeError(
-                f"vec_normalize must be SB3's VecNormalize, the path of its saved statistics "
-                f"or None, got {shown(vec_normalize)}"
+                f"vec_normalize must be SB3's VecNormalize, the path of its saved statistics, "
+                f"False (none) or None (the SB3 model's own), got {shown(vec_normalize)}"
             )
         mean = getattr(getattr(vec_normalize, "obs_rms", None), "mean", None)
         shape = env.observation_space.shape

@@ -80,6 +80,49 @@ def test_vec_normalize_from_its_file(ppo, tmp_path):
     assert a.iqm == b.iqm
 
 
+def test_loaded_sb3_model_needs_its_vec_normalize_named(ppo, tmp_path):
+    """A model loaded with PPO.load has no env: without ``vec_normalize`` it is refused in
+    one line (issue 69: it scored silently without its statistics); with the saved file it
+    scores as the in-memory model with its VecNormalize; ``False`` scores it on the raw
+    observation, as the in-memory model with an identity normalization."""
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.vec_env import DummyVecEnv
+
+    model, venv = ppo
+    model.save(tmp_path / "model.zip")
+    venv.save(str(tmp_path / "vecnormalize.pkl"))
+    loaded = PPO.load(tmp_path / "model.zip", device="cpu")
+    assert loaded.get_env() is None
+    with pytest.raises(ValueError, match=r"^vec_normalize: this PPO model has no env") as info:
+        score(loaded, V1, wrappers=[UnitAction], episodes=2)
+    msg = str(info.value)
+    assert "\n" not in msg and "vecnormalize.pkl" in msg and "vec_normalize=False" in msg
+    kept = score(model, V1, wrappers=[UnitAction], vec_normalize=venv, episodes=2)
+    got = score(loaded, V1, wrappers=[UnitAction], vec_normalize=tmp_path / "vecnormalize.pkl",
+                episodes=2)  # fmt: skip
+    np.testing.assert_array_equal(got.score.ise, kept.score.ise)
+    assert got.ise_rel_lqr == kept.ise_rel_lqr
+    raw = score(loaded, V1, wrappers=[UnitAction], vec_normalize=False, episodes=2)
+    want = score(model, V1, wrappers=[UnitAction], vec_normalize=_no_norm(venv), episodes=2)
+    np.testing.assert_array_equal(raw.score.ise, want.score.ise)
+    assert raw.ise_rel_lqr == want.ise_rel_lqr
+    assert np.all(np.abs(raw.score.ise / kept.score.ise - 1) > 1e-4)  # another law
+    # False overrides the model's own VecNormalize; a model whose env is no VecNormalize
+    # keeps None as none
+    mem = score(model, V1, wrappers=[UnitAction], vec_normalize=False, episodes=1)
+    assert mem.score.ise[0] == raw.score.ise[0]
+    plain = DummyVecEnv([lambda: UnitAction(gym.make(V1))])
+    with_env = PPO.load(tmp_path / "model.zip", env=plain, device="cpu")
+    assert score(with_env, V1, wrappers=[UnitAction], episodes=1).score.ise[0] == mem.score.ise[0]
+
+
+def test_vec_normalize_false_is_none_for_other_policies():
+    passive = lambda obs: np.zeros(1)  # noqa: E731
+    a = score(passive, V1, vec_normalize=False, episodes=1)
+    b = score(passive, V1, episodes=1)
+    assert a.score.ise[0] == b.score.ise[0] and a.iqm == 0.0
+
+
 #: Against the committed train/agents/compare.json, written on one machine: another CPU's
 #: BLAS kernels move an ISE ratio by ~4e-9 (OPENBLAS_CORETYPE=Nehalem or Sandybridge, by hand).
 COMMITTED_RTOL = 1e-6
@@ -185,6 +228,7 @@ def test_stateful_policy_gets_its_state_and_episode_start():
         ({"policy": lambda obs: np.full(1, np.nan)}, ValueError, "policy: returned"),
         ({"vec_normalize": "no/such/vecnormalize.pkl"}, ValueError, "vec_normalize: no file"),
         ({"vec_normalize": object()}, TypeError, "vec_normalize must be"),
+        ({"vec_normalize": True}, TypeError, "vec_normalize must be"),
     ],
 )
 def test_bad_input_names_the_argument(kwargs, error, name):

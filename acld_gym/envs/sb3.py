@@ -19,6 +19,9 @@ Example::
     venv = SB3VecEnv(num_envs=16, load_case="random", wrappers=[vector.UnitAction])
     PPO("MlpPolicy", venv).learn(100_000)
 
+    # another level: its id
+    venv = SB3VecEnv(16, env_id="ACLDBeamLab-v1", load_case="random", wrappers=[vector.UnitAction])
+
     # the same: a wrapped vector env of gym.make_vec, adapted
     envs = vector.UnitAction(gym.make_vec("ACLDBeam-v1", num_envs=16, load_case="random"))
     venv = SB3VecEnv(venv=envs)
@@ -44,6 +47,7 @@ from gymnasium.vector import (
 from stable_baselines3.common.vec_env import VecEnv
 
 from acld_gym.envs.config import EnvConfig
+from acld_gym.envs.sb3_args import build_venv, count_of
 from acld_gym.envs.step import INFO_KEYS
 from acld_gym.envs.vector_env import ACLDBeamVectorEnv
 from acld_gym.util.validate import check_int, check_seed, shown
@@ -149,14 +153,25 @@ class SB3VecEnv(VecEnv):
     ----------
     num_envs : int, optional
         Number of sub-envs (default 1) when the adapter builds the env; with ``venv=``,
-        omitted or ``venv``'s own count (another count is refused).
+        omitted or ``venv``'s own count (another count is refused). The first positional
+        argument or a keyword; a string there (a level id) is refused: pass ``env_id=``.
     venv : gymnasium.vector.VectorEnv, optional
         An existing env: an :class:`ACLDBeamVectorEnv` (``gym.make_vec`` of an acld_gym
         id), bare or in vector action, observation and reward wrappers (e.g.
         ``vector.ObserveModes(vector.UnitAction(gym.make_vec(...)))``; see
-        :func:`wrapper_chain`). Not together with ``config`` or the env's keywords.
+        :func:`wrapper_chain`). Not together with ``env_id``, ``config`` or the env's
+        keywords.
     config : acld_gym.envs.config.EnvConfig, optional
         The env's configuration, with or instead of its fields as keywords (``**env_kwargs``).
+        Not together with ``env_id`` (a level's configuration with changes:
+        ``config=acld_gym.envs.presets.preset(id, ...)``).
+    env_id : str, optional
+        One of this package's ids (``"ACLDBeamLab-v1"``, ...; keyword only): the level's
+        env, built as ``gym.make_vec(env_id, num_envs=num_envs, **env_kwargs)`` builds it
+        (its preset configuration, the keywords on top), e.g.
+        ``SB3VecEnv(8, env_id="ACLDBeamLab-v1", load_case="random")``. Without it (and
+        without ``venv``/``config``) the env is ``ACLDBeam-v1``'s defaults with the
+        keywords.
     seed_group : int
         (default 1) :meth:`seed` gives each run of ``seed_group`` consecutive sub-envs one
         seed, so they draw the same episodes (loads, sensor noise) as long as they end
@@ -189,17 +204,19 @@ class SB3VecEnv(VecEnv):
     def __init__(
         self,
         num_envs: int | None = None,
+        /,
         venv: VectorEnv | None = None,
         config: EnvConfig | None = None,
         seed_group: int = 1,
         wrappers: Sequence[Callable[[VectorEnv], VectorEnv]] | None = None,
+        *,
+        env_id: str | None = None,
         **env_kwargs,
     ):
-        if venv is None:
-            n = 1 if num_envs is None else num_envs
-            venv = ACLDBeamVectorEnv(num_envs=n, config=config, **env_kwargs)
-        elif env_kwargs or config is not None:
-            raise ValueError("pass either venv= or the env's configuration, not both")
+        # num_envs is positional-only so that SB3VecEnv("ACLDBeamLab-v1", num_envs=8) reaches
+        # count_of (which names num_envs and env_id=), not Python's "multiple values"
+        num_envs = count_of(num_envs, env_kwargs)
+        venv = build_venv(num_envs, venv, config, env_id, env_kwargs)
         base, _ = wrapper_chain(venv)  # checked before the wrappers are applied
         if num_envs is not None and num_envs != base.num_envs:
             raise ValueError(

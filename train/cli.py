@@ -103,7 +103,8 @@ def build_parser() -> argparse.ArgumentParser:
         "--timesteps",
         type=_positive_int,
         default=None,
-        help="env steps per run (default: the config's timesteps)",
+        help="env steps per run, the whitening's included (ppo and sac: whiten_steps of "
+        "the initial policy first; default: the config's timesteps)",
     )
     p.add_argument(
         "--n-envs",

@@ -62,6 +62,13 @@ def check_config(cfg) -> None:
             f"whiten_steps must be a non-negative integer (SB3 algorithms "
             f"other than ars; vrs: model.whiten), got {cfg.whiten_steps!r}"
         )
+    if cfg.whiten_steps and cfg.whiten_steps >= cfg.timesteps:
+        raise ValueError(
+            f"timesteps ({cfg.timesteps}) must be more than whiten_steps "
+            f"({cfg.whiten_steps}): the whitening's env steps of the initial policy are "
+            f"counted in each run's budget (give more timesteps, or a config with fewer "
+            f"whiten_steps)"
+        )
     if not isinstance(cfg.normalize, dict):
         raise ValueError(f"normalize must be a mapping, got {cfg.normalize!r}")
     if cfg.whiten_steps and (cfg.features is not None or cfg.normalize.get("norm_obs", False)):

@@ -37,7 +37,7 @@ def score(rec: dict, lqr: dict) -> float:
 
 
 def trial(config: dict, out: str | Path) -> dict:
-    """Train the recipe ``config["algo"]`` (overridden: seed, timesteps, optional
+    """Train the recipe ``config["algo"]`` (overridden: seed; optional timesteps,
     learning_rate / n_envs) as one benchmark trial, save the agent in ``out``; returns
     ``{"ise_rel_lqr": score}`` (:func:`score`)."""
     from .config import read_config
@@ -45,7 +45,8 @@ def trial(config: dict, out: str | Path) -> dict:
     from .core.trials import run_trial, save_agent
 
     name, data = read_config(config["algo"])
-    data = dict(data, timesteps=int(config["timesteps"]))
+    if config.get("timesteps") is not None:  # else the recipe's
+        data = dict(data, timesteps=int(config["timesteps"]))
     if config.get("learning_rate") is not None:
         data["model"] = {**data["model"], "learning_rate": float(config["learning_rate"])}
     if config.get("n_envs") is not None:
@@ -86,7 +87,10 @@ def build_parser() -> argparse.ArgumentParser:
         help="grid of learning rates in (0, 1] (default: the config's)",
     )
     p.add_argument(
-        "--timesteps", type=arg_type(int, 1, 10**12), default=200_000, help="env steps per trial"
+        "--timesteps",
+        type=arg_type(int, 1, 10**12),
+        default=None,
+        help="env steps per trial (default: the recipe's timesteps)",
     )
     p.add_argument(
         "--num-cpus",
@@ -111,7 +115,8 @@ def check_args(args: argparse.Namespace) -> None:
         if values and len(set(values)) != len(values):
             raise ValueError(f"{flag} must be distinct, got {values}")
     _, data = read_config(args.algo)
-    data = dict(data, timesteps=args.timesteps)
+    if args.timesteps is not None:
+        data = dict(data, timesteps=args.timesteps)
     for lr in args.learning_rates or [None]:
         model = data["model"] if lr is None else {**data["model"], "learning_rate": lr}
         try:

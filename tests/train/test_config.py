@@ -37,10 +37,13 @@ def test_recipes_are_from_scratch_unless_named_so():
 
 def test_overrides_revalidate():
     cfg = load_config("ppo")
-    assert cfg.with_overrides(timesteps=10, n_envs=None).timesteps == 10
-    assert cfg.with_overrides(timesteps=10).n_envs == cfg.n_envs
+    many = cfg.whiten_steps + 10
+    assert cfg.with_overrides(timesteps=many, n_envs=None).timesteps == many
+    assert cfg.with_overrides(timesteps=many).n_envs == cfg.n_envs
     with pytest.raises(ValueError, match="timesteps"):
         cfg.with_overrides(timesteps=-5)
+    with pytest.raises(ValueError, match="must be more than whiten_steps"):
+        cfg.with_overrides(timesteps=cfg.whiten_steps)  # the whitening is in the budget
 
 
 BASE = dict(algo="ppo", timesteps=10, n_envs=2, model={"policy": "MlpPolicy"})
@@ -161,10 +164,10 @@ def test_base_applies_the_recipe_under_a_files_own_settings(tmp_path):
     """``base:`` names a recipe; the file's settings go on top, nested mappings key by key."""
     _, ppo = read_config("ppo")
     (tmp_path / "a.yaml").write_text(
-        "base: ppo\ntimesteps: 10\nmodel: {policy_kwargs: {log_std_init: -2.0}}\n"
+        "base: ppo\ntimesteps: 300000\nmodel: {policy_kwargs: {log_std_init: -2.0}}\n"
     )
     _, data = read_config(tmp_path / "a.yaml")
-    assert data["timesteps"] == 10 and "base" not in data
+    assert data["timesteps"] == 300000 and "base" not in data
     assert data["model"]["policy_kwargs"] == {**ppo["model"]["policy_kwargs"], "log_std_init": -2.0}
     assert data["model"]["n_steps"] == ppo["model"]["n_steps"]
     (tmp_path / "b.yaml").write_text(f"base: {tmp_path / 'a.yaml'}\nn_envs: 8\n")
@@ -176,16 +179,16 @@ def test_a_base_name_is_first_a_file_beside_the_config(tmp_path):
     """``base: NAME`` is ``NAME.yaml`` in the config's own folder if there is one (a chain
     kept together, as ``studies/ablations/``), else the recipe ``NAME``; and a sibling
     named like a recipe takes precedence over the recipe for that folder only."""
-    (tmp_path / "first.yaml").write_text("base: ppo\ntimesteps: 10\n")
+    (tmp_path / "first.yaml").write_text("base: ppo\ntimesteps: 300000\n")
     (tmp_path / "second.yaml").write_text("base: first\nn_envs: 8\n")
     _, ppo = read_config("ppo")
     assert read_config(tmp_path / "second.yaml") == (
         "second",
-        {**ppo, "timesteps": 10, "n_envs": 8},
+        {**ppo, "timesteps": 300000, "n_envs": 8},
     )
     (tmp_path / "ppo.yaml").write_text("base: sac\n")  # not the recipe ppo, beside first.yaml
     _, sac = read_config("sac")
-    assert read_config(tmp_path / "first.yaml")[1] == {**sac, "timesteps": 10}
+    assert read_config(tmp_path / "first.yaml")[1] == {**sac, "timesteps": 300000}
     assert read_config("ppo")[1] == ppo  # the recipe itself is untouched
     (tmp_path / "loop.yaml").write_text("base: loop\n")
     with pytest.raises(ValueError, match="leads back to itself"):

@@ -53,13 +53,18 @@ def test_the_default_config_is_the_benchmark_recipe():
 
 def test_overrides_of_the_command_line():
     args = build_parser().parse_args(
-        ["ppo", "--timesteps", "100", "--n-envs", "4", "--load-case", "2", "--param-noise", "0.02"]
+        ["ppo", "--timesteps", "300000", "--n-envs", "4", "--load-case", "2"]
+        + ["--param-noise", "0.02"]
     )
     name, data = configure(args)
-    assert name == "ppo" and data["timesteps"] == 100 and data["n_envs"] == 4
+    assert name == "ppo" and data["timesteps"] == 300000 and data["n_envs"] == 4
     assert data["loads"] == {2: 1}
     assert data["env_kwargs"]["param_noise"] == 0.02
     assert data["env_kwargs"]["reward_scale"] == "passive"  # the recipe's options stay
+    # a budget that the recipe's whitening (counted in it) would use up is refused
+    short = build_parser().parse_args(["ppo", "--timesteps", "20000"])
+    with pytest.raises(ValueError, match=r"timesteps \(20000\) must be more than whiten_steps"):
+        configure(short)
     odd = build_parser().parse_args(["ppo", "--n-envs", "3"])  # the recipe pairs its sub-envs
     with pytest.raises(ValueError, match="overrides: paired_loads needs an even number"):
         configure(odd)

@@ -1,19 +1,27 @@
-"""``python -m train.compare``: the shipped agents against the reference policies.
+"""``python -m train.compare``: the agents of a folder against the reference policies of
+their level.
+
+The level is one of this package's env ids: ``--env-id ID``, or else the level every agent
+of ``--agents`` (default: the shipped ``train/agents``) was trained on, as its metadata
+records it; the first line of the output names it. Agents of different levels are refused
+in one line, as an agent of another level than ``--env-id``, before anything is computed.
 
 For each thesis load case (1, 2, 3) and a fixed held-out set of random loads (``case
-"random"``: the mean over the set; seeds disjoint from training), runs the references
-(:func:`reference_policies`: the thesis's delay-free LQR and SMC, the nominal MPC,
-``mpc_reward``, the engineer's designs, the plant oracle ``mpc_oracle``), every shipped
-agent (labelled by how it was trained) and the bound through ``ACLDBeam-v1``; prints peak
-[mm], 5 % settling [s], ISE [m^2 s] (and / LQR, / bound), max |V| [V], return, ms per
-step, the effort after settling (:mod:`baselines.analysis.effort`), and score v2 on the
-test set (:mod:`baselines.evaluation.score`: passive 0, bound 1; ``--score-episodes``)
-beside the mean ISE relative to the thesis LQR's.
+"random"``: the mean over the set; seeds disjoint from training), runs the level's
+references (:func:`reference_policies`: the thesis's delay-free LQR and SMC, the nominal
+MPC, ``mpc_reward``, the engineer's designs for the level's actuator, the plant oracle
+``mpc_oracle``; :mod:`baselines.marks`), every agent (labelled by how it was trained) and
+the bound through the level's env; prints peak [mm], 5 % settling [s], ISE [m^2 s] (and /
+LQR, / bound), max |V| [V], return, ms per step, the effort after settling
+(:mod:`baselines.analysis.effort`), and score v2 on the level's test set
+(:mod:`baselines.evaluation.score`: passive 0, bound 1; ``--score-episodes``) beside the
+mean ISE relative to the thesis LQR's.
 
-``--param-noise X``: per-episode parameter randomization (the same plants for every
-policy; the bound knows the plant). ``--json PATH``: the rows (``baselines.evaluate``'s,
-plus ``ise_rel_lqr``, ``ise_rel_bound``, ``score``); ``--markdown PATH``: the table and
-the score table; ``--plots DIR``: a figure per thesis case and the learning curves.
+``--mesh`` and ``--param-noise X`` change the level's truth plant and its per-episode
+parameter randomization (the same plants for every policy; the bound knows the plant).
+``--json PATH``: the rows (``baselines.evaluate``'s, plus ``ise_rel_lqr``,
+``ise_rel_bound``, ``score``, ``env_id``); ``--markdown PATH``: the table and the score
+table; ``--plots DIR``: a figure per thesis case and the learning curves.
 """
 
 from __future__ import annotations
@@ -22,19 +30,20 @@ import argparse
 import sys
 from pathlib import Path
 
+from acld_gym import ENV_ID
 from acld_gym.envs.beam_env import ACLDBeamEnv
+from acld_gym.envs.presets import PRESETS, check_env_id
 from acld_gym.physics.truth import MESHES
 from acld_gym.util.atomic import write_json, write_text
 from acld_gym.util.progress import Progress
 from acld_gym.util.text import plain, prog
 from acld_gym.util.validate import arg_type, run_main
-from baselines.arguments import folder_name, input_directory, outputs, param_noise
+from baselines.arguments import folder_name, input_directory, outputs
 from baselines.evaluate import (
     EvalRow,
     add_score_episodes_argument,
     add_scores,
     check_score_episodes,
-    default_policies,
     episode_rows,
     format_tables,
     mean_rows,
@@ -42,9 +51,10 @@ from baselines.evaluate import (
 )
 from baselines.evaluation.score import SCORE_NAME
 from baselines.marks import marks_for
-from baselines.policies import RewardMPCPolicy, mpc_available
+from baselines.policies import RewardMPCPolicy, mpc_available, policies_for
 
 from .agent_dirs import AGENTS_DIR, agent_names, load_agents
+from .compare_level import check_agents_fit, level_config, resolve_level
 from .core.evaluate import HELDOUT_SEEDS  # re-exported (defined with the other eval seeds)
 from .curves_figure import learning_curves_figure, plot_learning_curves
 
@@ -65,15 +75,18 @@ __all__ = [
 ]
 
 
-def reference_policies(mesh: str = "converged") -> dict:
-    """Passive, LQR, SMC, MPC (:func:`baselines.evaluate.default_policies`) and, with osqp,
-    the MPC of the env's reward (``"mpc_reward"``, :class:`baselines.policies.
-    RewardMPCPolicy`) on the nominal ``mesh`` plant; the engineer's designs and the plant
-    oracle (:func:`baselines.marks.marks_for`)."""
-    out = default_policies(mesh)
+def reference_policies(mesh: str | None = None, env_id: str = ENV_ID) -> dict:
+    """The references of the level ``env_id`` (``mesh``: its truth plant; None: the
+    level's), as :func:`baselines.marks.level_references` gives them, with the MPC of the
+    env's reward: passive, LQR, SMC, MPC (:func:`baselines.policies.policies_for`) and,
+    with osqp, ``"mpc_reward"`` (:class:`baselines.policies.RewardMPCPolicy`) on the
+    level's nominal model; the engineer's designs and the plant oracle
+    (:func:`baselines.marks.marks_for`)."""
+    probe = ACLDBeamEnv(config=level_config(env_id, mesh))
+    out = policies_for(probe)
     if mpc_available():
-        out[RewardMPCPolicy.name] = RewardMPCPolicy(mesh=mesh)
-    return out | marks_for(ACLDBeamEnv(mesh=mesh))
+        out[RewardMPCPolicy.name] = RewardMPCPolicy.for_env(probe)
+    return out | marks_for(probe)
 
 
 def training_labels(policies: dict) -> dict[str, str]:
@@ -211,11 +224,18 @@ def build_parser() -> argparse.ArgumentParser:
         help="directory of agent directories (default: the shipped train/agents)",
     )
     p.add_argument(
+        "--env-id",
+        metavar="ID",
+        default=None,
+        help=f"the level to compare on, one of {', '.join(PRESETS)}; every agent must have "
+        "been trained on it (default: the level the agents were trained on)",
+    )
+    p.add_argument(
         "--only",
         metavar="NAME",
         nargs="*",
         default=(),
-        help="these agents only (default: every agent trained on --mesh)",
+        help="these agents only (default: every agent of --agents trained on the mesh)",
     )
     p.add_argument(
         "--random-episodes",
@@ -226,8 +246,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--param-noise",
         type=arg_type(float, 0.0, 0.1),
-        default=0.0,
-        help="per-episode parameter randomization of the plant (default 0)",
+        default=None,
+        help="per-episode parameter randomization of the plant (default: the level's, 0 "
+        "except on ACLDBeamHard-v1)",
     )
     p.add_argument(
         "--seed",
@@ -238,8 +259,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--mesh",
         choices=MESHES,
-        default="converged",
-        help="truth plant (default: the converged beam); the agents trained on it",
+        default=None,
+        help="truth plant (default: the level's, the converged beam except on ACLDBeam-v0); "
+        "the agents trained on it",
     )
     add_score_episodes_argument(p)
     p.add_argument("--quiet", action="store_true", help="no progress line")
@@ -247,52 +269,61 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """The command; the level is settled first (:mod:`train.compare_level`)."""
     parser = build_parser()
     args = parser.parse_args(argv)
-    try:  # every argument is checked now, before any computing
+    try:  # every argument and every agent's level are checked now, before any computing
         outputs({"--json": args.json, "--markdown": args.markdown}, {"--plots": args.plots})
+        if args.env_id is not None:  # a plain string, never handed to an importer
+            check_env_id(args.env_id, "--env-id")
         input_directory(args.agents, "--agents")
         for name in args.only:
             folder_name(name, "--only")
-        param_noise(args.param_noise, args.mesh)
-        check_score_episodes(args.score_episodes)
-    except ValueError as exc:
-        parser.error(str(exc))
-    try:
-        names = None if not args.only else args.only
-        agents = load_agents(args.agents, names, mesh=args.mesh)
+        level = resolve_level(args.agents, args.only, args.env_id, args.mesh)
+        config = level_config(level.env_id, args.mesh, args.param_noise)
+        check_score_episodes(args.score_episodes, level.env_id)
+        if not level.names:
+            raise ValueError(
+                f"--agents: no agent trained on --mesh {config.mesh} in {args.agents!r}"
+            )
+        agents = load_agents(args.agents, list(level.names))
+        check_agents_fit(agents, ACLDBeamEnv(config=config))
     except (OSError, ValueError) as exc:
         parser.error(str(exc))
-    if not agents:
-        parser.error(f"--agents: no agent trained on --mesh {args.mesh} in {args.agents!r}")
-    policies = {**reference_policies(args.mesh), **agents}
+    print(level.first_line(), flush=True)
+    env_id = level.env_id
+    policies = {**reference_policies(config.mesh, env_id), **agents}
     seeds = tuple(range(HELDOUT_SEEDS[0], HELDOUT_SEEDS[0] + args.random_episodes))
     episodes: dict = {}
     rows = compare(
         policies,
         random_seeds=seeds,
         seed=args.seed,
-        env_kwargs={"param_noise": args.param_noise, "mesh": args.mesh},
+        env_kwargs={"config": config},
         episodes=episodes,
         quiet=args.quiet,
     )
     labels = training_labels(policies)
-    title = f" (param_noise = {args.param_noise})" if args.param_noise else ""
-    print(
-        f"Agents vs reference policies{title}; 'random' = mean over {len(seeds)} "
+    noise = f", param_noise = {config.param_noise}" if config.param_noise else ""
+    title = (
+        f"Agents vs reference policies on {env_id}{noise}; 'random' = mean over {len(seeds)} "
         "held-out random-load episodes"
     )
+    print(title)
     print(format_tables(rows))
-    env_kwargs = {"param_noise": args.param_noise, "mesh": args.mesh}
-    scores = add_scores(policies, args.score_episodes, env_kwargs, args.quiet, labels)
-    table = [dict(d, score=scores.get(d["policy"])) for d in relative(rows, labels)]
+    base = level_config(env_id)  # the test set's env: the level, with what the user changed
+    changed = {k: getattr(config, k) for k in ("mesh", "param_noise")}
+    changed = {k: v for k, v in changed.items() if v != getattr(base, k)}
+    scores = add_scores(policies, args.score_episodes, changed, args.quiet, labels, env_id)
+    table = [dict(d, score=scores.get(d["policy"]), env_id=env_id) for d in relative(rows, labels)]
     if args.json:
         write_json(args.json, table)
         print(f"\nwrote {args.json}")
     if args.markdown:
         scored = markdown_scores(table)
         write_text(
-            args.markdown, markdown_table(table) + "\n" + (f"\n{scored}\n" if scored else "")
+            args.markdown,
+            f"{title}.\n\n{markdown_table(table)}\n" + (f"\n{scored}\n" if scored else ""),
         )
         print(f"wrote {args.markdown}")
     if args.plots:

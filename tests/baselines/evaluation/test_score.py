@@ -6,6 +6,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from acld_gym.util.stats import iqm_with_ci
 from baselines.evaluation.references import references
 from baselines.evaluation.rollout import bound_episode, metrics_row, rollout
 from baselines.evaluation.score import (
@@ -90,10 +91,16 @@ def test_replaying_the_bounds_voltages_open_loop_scores_one(refs5):
 
 
 def test_the_interval_shrinks_as_episodes_are_added():
-    widths = [
-        (lambda s: s.ci_high - s.ci_low)(score_policy(SMCPolicy(), n_episodes=n))
-        for n in (10, 20, 40)
-    ]
+    """The first n episodes' scores are the first n of the 40-episode run's (each episode's
+    score depends on its own references only), so their intervals come from one run."""
+    full = score_policy(SMCPolicy(), n_episodes=40)
+    assert (full.ci_low, full.ci_high) == pytest.approx(
+        [iqm_with_ci(full.scores)[k] for k in ("ci_low", "ci_high")], rel=1e-12
+    )
+    widths = []
+    for n in (10, 20, 40):
+        stats = iqm_with_ci(full.scores[:n])
+        widths.append(stats["ci_high"] - stats["ci_low"])
     assert widths[0] > widths[1] > widths[2] > 0
 
 

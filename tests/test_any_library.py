@@ -1,8 +1,10 @@
 """The guide page "Train on any level with any library" (docs/any-library.md): its scripts
 (docs/examples/) run end to end on a tiny budget on ACLDBeam-v1 and on another level and
-print a finite score, CleanRL's additions run as the diff gives them, the rl-zoo3 files
-hold the scripts' hyperparameters on every registered id, and the page includes every
-example verbatim (pymdownx.snippets)."""
+print a finite score, refuse each bad argument in one line before training or loading
+anything (zoo_score.py takes the level and the algorithm from the run's own args.yml, read
+as plain data), the docs' rl-zoo3 commands run torch on one thread, CleanRL's additions
+run as the diff gives them, the rl-zoo3 files hold the scripts' hyperparameters on every
+registered id, and the page includes every example verbatim (pymdownx.snippets)."""
 
 from __future__ import annotations
 
@@ -12,9 +14,12 @@ import io
 import math
 import os
 import re
+import runpy
+import shlex
 import subprocess
 import sys
 import types
+from collections import OrderedDict
 from pathlib import Path
 
 import gymnasium as gym
@@ -22,6 +27,8 @@ import numpy as np
 import pytest
 import torch
 import yaml
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from acld_gym.envs.presets import PRESETS, preset
 
@@ -69,34 +76,259 @@ def test_sb3_script_runs_on_a_tiny_budget(script, steps, env_id, tmp_path):
     _check_score(out, env_id, 2)
 
 
-def test_scripts_refuse_an_unknown_level_in_one_line(tmp_path):
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
+# -- bad arguments: one line, before anything is trained or loaded -----------------------------
+
+
+def _fake_run(root: Path, algo: str, env_id: str, **more) -> Path:
+    """A run folder of rl-zoo3: ``<env id>/args.yml`` written as rl-zoo3's ExpManager writes
+    it (PyYAML's dump of an OrderedDict of the arguments: a python tag; ``more`` changes or
+    adds arguments), and empty files in the places of its other files."""
+    run = root / "logs" / algo / f"{env_id}_1"
+    (run / env_id).mkdir(parents=True)
+    args = {"algo": algo, "env": env_id, "seed": 0, "gym_packages": ["acld_gym"]}
+    args |= {"hyperparams": {"n_envs": 8}, "env_kwargs": None, "n_timesteps": 2048} | more
+    (run / env_id / "args.yml").write_text(yaml.dump(OrderedDict(sorted(args.items()))))
+    for name in (f"{env_id}/config.yml", f"{env_id}/vecnormalize.pkl", f"{env_id}.zip"):
+        (run / name).write_text("")  # never read: the tests stop the script before
+    return run
+
+
+def _error_line(stderr: str, script: str) -> str:
+    """The one error line of a refusal: argparse's usage and ``<script>: error: ...`` (or
+    that line alone), no traceback."""
+    assert "Traceback" not in stderr, stderr
+    lines = stderr.strip().splitlines()
+    errors = [line for line in lines if "error" in line]
+    assert len(errors) == 1 and errors[0] == lines[-1], stderr
+    assert lines[-1].startswith(f"{script}: error: "), stderr
+    assert all(line.startswith(("usage: ", " ")) for line in lines[:-1]), stderr
+    return lines[-1]
+
+
+@pytest.fixture
+def refused(monkeypatch, capsys):
+    """``refused(script, *args)``: docs/examples/<script> run in this process as
+    ``__main__`` (runpy) with those arguments, every step that builds an env, trains, loads
+    or scores replaced by a failure; its exit status and its one error line."""
+    import rl_zoo3.utils
+    from stable_baselines3 import PPO, SAC
+    from stable_baselines3.common.base_class import BaseAlgorithm
+
+    import acld_gym.envs
+    import train.scoring
+
+    def never(*args, **kwargs):
+        raise AssertionError("the script went past its argument checks")
+
+    monkeypatch.setattr(gym, "make_vec", never)
+    monkeypatch.setattr(acld_gym.envs, "SB3VecEnv", never)
+    for cls, name in ((PPO, "learn"), (SAC, "learn"), (BaseAlgorithm, "load")):
+        monkeypatch.setattr(cls, name, never)
+    monkeypatch.setattr(rl_zoo3.utils, "get_saved_hyperparams", never)
+    monkeypatch.setattr(train.scoring, "score", never)
+
+    def run(script: str, *args: str) -> tuple[int, str]:
+        monkeypatch.setattr(sys, "argv", [script, *map(str, args)])
+        capsys.readouterr()
+        with pytest.raises(SystemExit) as stop:
+            runpy.run_path(str(EXAMPLES / script), run_name="__main__")
+        code, err = stop.value.code, capsys.readouterr().err
+        if isinstance(code, str):  # sys.exit("message"): the interpreter prints it, status 1
+            code, err = 1, err + code + "\n"
+        return code, _error_line(err, script)
+
+    return run
+
+
+BAD_ARGS = [
+    (["ACLDBeam-v9"], "argument env_id: invalid choice: 'ACLDBeam-v9'"),
+    (["--episodes", "0"], "argument --episodes: expected an integer in [1, 100], got 0"),
+    (
+        ["ACLDBeamLab-v1", "--episodes", "101"],
+        "argument --episodes: expected an integer in [1, 100]",
+    ),
+    (["--episodes", "2.5"], "argument --episodes: invalid int value: '2.5'"),
+    (["--timesteps", "0"], "argument --timesteps: expected an integer in [1, inf], got '0'"),
+    (["--timesteps", "-5"], "argument --timesteps: expected an integer in [1, inf]"),
+    (["--timesteps", "1e6"], "argument --timesteps: expected an integer, got '1e6'"),
+    (["--seed", "-1"], "argument --seed: expected an integer in [0, 4294967295], got '-1'"),
+    (["--seed", str(2**32)], "argument --seed: expected an integer in [0, 4294967295]"),
+    (["--seed", "x"], "argument --seed: expected an integer, got 'x'"),
+]
+
+
+@pytest.mark.parametrize("script", ["sb3_ppo.py", "sb3_sac.py"])
+@pytest.mark.parametrize("args, message", BAD_ARGS, ids=[" ".join(a) for a, _ in BAD_ARGS])
+def test_sb3_scripts_refuse_each_bad_argument_before_training(script, args, message, refused):
+    code, line = refused(script, *args)
+    assert code == 2 and line.startswith(f"{script}: error: {message}"), line
+
+
+def test_the_checks_let_a_good_command_line_through_to_training(refused):
+    """The stand-ins above do stop a script that passes its checks (the refusals are the
+    checks', not theirs)."""
+    with pytest.raises(AssertionError, match="past its argument checks"):
+        refused(
+            "sb3_ppo.py", "ACLDBeamHard-v1", "--timesteps", "1", "--seed", "0", "--episodes", "100"
+        )
+
+
+def test_zoo_score_takes_the_level_from_the_run_and_refuses_a_mismatch(refused, tmp_path):
+    """The level and the algorithm are the run's own (its args.yml): a wrong algorithm or
+    level, a folder that is no run, or ``--episodes`` out of range is one line naming the
+    argument, before anything is loaded; with the run's algorithm and no level it gets past
+    the checks to loading the run (here a stand-in that fails)."""
+    run = _fake_run(tmp_path, "ppo", "ACLDBeamLab-v1")
+    code, line = refused("zoo_score.py", "sac", run)
+    assert code == 2 and line.endswith(f"argument algo: {run} is an rl-zoo3 ppo run, not sac")
+    code, line = refused("zoo_score.py", "ppo", run, "ACLDBeam-v1")
+    assert code == 2
+    assert line.endswith(f"argument env_id: {run} trained on ACLDBeamLab-v1, not ACLDBeam-v1")
+    for folder in (tmp_path, run / "ACLDBeamLab-v1", tmp_path / "nowhere"):
+        code, line = refused("zoo_score.py", "ppo", folder)
+        assert code == 2 and "argument run: expected rl-zoo3's run folder" in line, line
+    code, line = refused("zoo_score.py", "ppo", run, "--episodes", "0")
+    assert code == 2 and "argument --episodes: expected an integer in [1, 100], got 0" in line
+    (run / "ACLDBeamLab-v1.zip").unlink()  # a run that stopped before saving its model
+    code, line = refused("zoo_score.py", "ppo", run)
+    assert code == 1 and line.endswith(
+        f"{run / 'ACLDBeamLab-v1.zip'}: not found (a run that did not finish?)"
+    )
+    (run / "ACLDBeamLab-v1.zip").write_text("")
+    # the run's own level, its own algorithm: through the checks (no level given, or the same)
+    for level in ([], ["ACLDBeamLab-v1"]):
+        with pytest.raises(AssertionError, match="past its argument checks"):
+            refused("zoo_score.py", "ppo", run, *level, "--episodes", "2")
+
+
+def test_zoo_score_reads_args_yml_as_plain_data(refused, tmp_path):
+    """A run whose args.yml names no level of this package, or is damaged, or tags a python
+    call, is one line naming the file (exit 1); the tag's call is never made."""
+    run = _fake_run(tmp_path, "ppo", "ACLDBeam-v1", env="os:system")
+    code, line = refused("zoo_score.py", "ppo", run)
+    assert code == 1 and f"{run / 'ACLDBeam-v1' / 'args.yml'}: not rl-zoo3's args.yml" in line
+    assert "env must be one of this package's ids" in line
+    marker = tmp_path / "ran"
+    args_yml = run / "ACLDBeam-v1" / "args.yml"
+    for text in (
+        f"!!python/object/apply:os.system [touch {marker}]\n",
+        "!!python/object/apply:collections.OrderedDict [[[algo, "
+        f"!!python/object/apply:os.system [touch {marker}]], [env, ACLDBeam-v1]]]\n",
+        "algo: ppo\nenv: ACLDBeam-v1\n",  # a plain mapping: not what rl-zoo3 writes
+        "[" * 5000,
+        "",
+    ):
+        args_yml.write_text(text)
+        code, line = refused("zoo_score.py", "ppo", run)
+        assert not marker.exists()
+        assert code == 1 and str(args_yml) in line, (text[:80], line)
+
+
+@settings(
+    max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(damage=st.one_of(st.binary(max_size=200), st.integers(0, 400)))
+def test_a_damaged_args_yml_is_one_line(damage, refused, tmp_path_factory):
+    """Random bytes, or rl-zoo3's own file cut short, as args.yml: one line and exit 1 (or,
+    where the cut leaves a readable record, through the checks)."""
+    run = _fake_run(tmp_path_factory.mktemp("run"), "ppo", "ACLDBeam-v1")
+    args_yml = run / "ACLDBeam-v1" / "args.yml"
+    whole = args_yml.read_bytes()
+    args_yml.write_bytes(damage if isinstance(damage, bytes) else whole[:damage])
+    try:
+        code, line = refused("zoo_score.py", "ppo", run)
+    except AssertionError as exc:  # a record complete enough to pass: the stand-in's stop
+        assert "past its argument checks" in str(exc) and isinstance(damage, int)
+        return
+    assert code == 1 and str(args_yml) in line
+
+
+@pytest.mark.parametrize(
+    "script, args, message",
+    [
+        ("sb3_ppo.py", ["ACLDBeamLab-v1", "--episodes", "0"], "argument --episodes"),
+        ("zoo_score.py", ["sac", "{run}"], "argument algo"),
+    ],
+)
+def test_a_refusal_as_a_user_sees_it(script, args, message, tmp_path):
+    """In its own interpreter, as a user runs it: exit status 2, argparse's one error line,
+    no traceback, nothing written, within the time an interpreter takes to start."""
+    run = _fake_run(tmp_path / "in", "ppo", "ACLDBeamLab-v1")
+    args = [a.format(run=run) for a in args]
+    work = tmp_path / "work"
+    work.mkdir()
+    env = dict(os.environ, PYTHONPATH=str(ROOT), OMP_NUM_THREADS="1")
     done = subprocess.run(
-        [sys.executable, str(EXAMPLES / "sb3_ppo.py"), "ACLDBeam-v9"],
-        cwd=tmp_path,
+        [sys.executable, str(EXAMPLES / script), *args],
+        cwd=work,
         env=env,
         capture_output=True,
         text=True,
-        timeout=120,
+        timeout=120,  # training the default budget takes minutes
     )
-    assert done.returncode == 2 and "Traceback" not in done.stderr
-    assert "invalid choice: 'ACLDBeam-v9'" in done.stderr.splitlines()[-1]
+    assert done.returncode == 2 and done.stdout == ""
+    assert f"{script}: error: {message}" in _error_line(done.stderr, script)
+    assert not any(work.iterdir())
+
+
+def _shell_commands(page: Path) -> list[str]:
+    """The commands of the page's ```bash blocks, continued lines joined, comments cut."""
+    text = page.read_text()
+    commands = []
+    for block in re.findall(r"^```bash[^\n]*\n(.*?)^```", text, flags=re.S | re.M):
+        for command in block.replace("\\\n", " ").splitlines():
+            commands.append(" ".join(command.split("  #")[0].split()))
+    return commands
+
+
+def test_every_rl_zoo3_command_of_the_docs_runs_torch_on_one_thread():
+    """Every ``python -m rl_zoo3.<train | enjoy | ...>`` of the docs sets torch's threads
+    with rl-zoo3's own flag (its default is torch's, one per core: 4.5x the wall time of the
+    same run on the shared 2-core machine, issue 69's walkthrough)."""
+    found = {}
+    for page in sorted((ROOT / "docs").rglob("*.md")):
+        for command in _shell_commands(page):
+            if command.startswith("python -m rl_zoo3."):
+                found[command] = page.name
+                words = shlex.split(command)
+                assert "--num-threads" in words, (page, command)
+                assert words[words.index("--num-threads") + 1] == "1", (page, command)
+    assert {"any-library.md", "training.md"} <= set(found.values()), found
+
+
+def _page_zoo(algo: str, env_id: str) -> tuple[list[str], list[str]]:
+    """The page's rl-zoo3 training command and zoo_score.py command for ``algo`` (arguments
+    after ``python``), on the level ``env_id`` instead of the page's, the repository's files
+    by absolute path (the commands run in a temporary folder)."""
+    commands = _shell_commands(PAGE)
+    (train,) = [c for c in commands if c.startswith(f"python -m rl_zoo3.train --algo {algo} ")]
+    (score,) = [c for c in commands if c.startswith(f"python docs/examples/zoo_score.py {algo} ")]
+    page_env = shlex.split(train)[shlex.split(train).index("--env") + 1]
+    out = []
+    for command in (train, score):
+        command = command.replace(page_env, env_id)
+        for folder in ("train/zoo/", "docs/examples/"):
+            command = command.replace(f" {folder}", f" {ROOT / folder}/")
+        out.append(shlex.split(command)[1:])
+    return out[0], out[1]
 
 
 @pytest.mark.parametrize("algo, env_id", [("ppo", "ACLDBeam-v1"), ("sac", OTHER)])
 def test_rl_zoo3_trains_from_the_mlp_file_and_zoo_score_scores_it(algo, env_id, tmp_path):
-    """rl-zoo3 trains from ``train/zoo/<algo>_mlp.yml`` (2048 steps, 8 sub-envs)
-    and ``docs/examples/zoo_score.py`` scores the run with the wrappers and the
-    ``VecNormalize`` it saved."""
-    train = ["-m", "rl_zoo3.train", "--algo", algo, "--env", env_id, "--gym-packages"]
-    train += ["acld_gym", "--conf-file", str(ROOT / f"train/zoo/{algo}_mlp.yml"), "-f", "logs"]
-    train += ["--seed", "0", "--eval-freq", "-1", "-n", "2048", "--hyperparams", "n_envs:8"]
+    """The page's commands: rl-zoo3 trains from ``train/zoo/<algo>_mlp.yml`` (2048 steps,
+    8 sub-envs, torch on one thread as the page's command says) and
+    ``docs/examples/zoo_score.py`` scores the run, with no level given (the run's own) and
+    with the wrappers and the ``VecNormalize`` it saved."""
+    train, score = _page_zoo(algo, env_id)
+    assert train[train.index("--num-threads") + 1] == "1" and "-f" in train
+    train += ["-n", "2048", "--hyperparams", "n_envs:8"]
     if algo == "sac":
         train.append("learning_starts:1024")
     _run(train, tmp_path)
     run = tmp_path / "logs" / algo / f"{env_id}_1"
-    score = [str(EXAMPLES / "zoo_score.py"), algo, str(run), env_id, "--episodes", "2"]
-    out = _run(score, tmp_path)
+    assert score[:3] == [str(EXAMPLES / "zoo_score.py"), algo, str(run.relative_to(tmp_path))]
+    assert not any(a in PRESETS for a in score), score  # the level is the run's
+    out = _run([*score, "--episodes", "2"], tmp_path)
     _check_score(out, env_id, 2)
 
 
@@ -238,7 +470,7 @@ def test_scripts_set_one_torch_thread_and_take_a_budget_and_a_seed():
     for script in ("sb3_ppo.py", "sb3_sac.py", "zoo_score.py"):
         text = (EXAMPLES / script).read_text()
         assert "torch.set_num_threads(1)  # " in text, script
-        assert len(text.splitlines()) <= 45, script
+        assert len(text.splitlines()) <= 50, script
     for script in ("sb3_ppo.py", "sb3_sac.py"):
         text = (EXAMPLES / script).read_text()
         assert '"--timesteps"' in text and '"--seed"' in text and "score(model" in text

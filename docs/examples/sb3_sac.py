@@ -10,15 +10,20 @@ from stable_baselines3.common.vec_env import VecNormalize
 
 from acld_gym.envs import SB3VecEnv
 from acld_gym.envs.presets import PRESETS, preset
+from acld_gym.test_sets import evaluation_set
+from acld_gym.util.validate import arg_type
 from acld_gym.wrappers import ObserveModes, UnitAction, vector
 from train.scoring import score
 
 p = argparse.ArgumentParser()
 p.add_argument("env_id", nargs="?", default="ACLDBeam-v1", choices=list(PRESETS))
-p.add_argument("--timesteps", type=int, default=300_000)
-p.add_argument("--seed", type=int, default=0)
+p.add_argument("--timesteps", type=arg_type(int, 1), default=300_000)
+p.add_argument("--seed", type=arg_type(int, 0, 2**32 - 1), default=0)  # numpy's range
 p.add_argument("--episodes", type=int, help="score on the first N test loads (default: all)")
 args = p.parse_args()
+n_test = len(evaluation_set(args.env_id).seeds)  # checked now, not after training
+if args.episodes is not None and not 1 <= args.episodes <= n_test:
+    p.error(f"argument --episodes: expected an integer in [1, {n_test}], got {args.episodes}")
 torch.set_num_threads(1)  # torch's default threads make SB3 15-25x slower on 2 cores
 
 modes = preset(args.env_id).obs_mode == "estimate"  # mode 1 and the tip, where observed

@@ -10,7 +10,7 @@ validation loads (:func:`train.core.evaluate.validation_cost`, disjoint from the
 set) and LQR's there, by which the recipes' ``restarts`` choose between runs. Not a test::
 
     python -m rl_zoo3.train --algo ppo --env ACLDBeam-v1 --gym-packages acld_gym \\
-        --conf-file train/zoo/ppo.yml -f logs --seed 0 --eval-freq -1
+        --conf-file train/zoo/ppo.yml -f logs --seed 0 --eval-freq -1 --num-threads 1
     python benchmarks/zoo_eval.py ppo logs/ppo/ACLDBeam-v1_1 --validation 256
 """
 
@@ -39,7 +39,10 @@ def main(argv=None) -> int:
         help="also the cost on the first N validation loads (default 0: not computed)",
     )
     args = p.parse_args(argv)
+    import torch
     from stable_baselines3 import PPO, SAC
+
+    torch.set_num_threads(1)  # torch's default threads make small policies slow on few cores
 
     from train.core.evaluate import (
         ise_rel_lqr,

@@ -22,6 +22,13 @@ _mp_util.Finalize(
     None, shutil.rmtree, args=(_SESSION_TMP,), kwargs={"ignore_errors": True}, exitpriority=-1000
 )
 
+try:  # torch's default intra-op threads make small policies many times slower on few cores,
+    import torch  # and far worse on a loaded machine (a plain SB3 test took 464 s, not 4 s):
+
+    torch.set_num_threads(1)  # one, as the package's own training sets it
+except ImportError:  # the core install has no torch
+    pass
+
 
 @pytest.fixture(scope="session")
 def v1_references(tmp_path_factory):

@@ -198,6 +198,7 @@ def test_benchmark_runs_end_to_end(tmp_path, capsys, monkeypatch, v1_references)
             "sac",
             {
                 "timesteps": 300,
+                "whiten_steps": 128,  # counted in the budget (the recipe's 16384: its 8M)
                 "n_envs": 2,
                 "restarts": 1,
                 "restart_above": None,

@@ -71,7 +71,15 @@ def test_the_reference_has_the_modes_the_4x_mesh_lacks(fine_modes):
     assert np.sum(np.abs(below.imag - 24300.0) < 200.0) == 2
 
 
-@pytest.mark.parametrize("dt", [1e-4, 2e-4, 3e-4, 4e-4])
+@pytest.mark.parametrize(  # the smallest and the largest in the default run; between: slow
+    "dt",
+    [
+        1e-4,
+        pytest.param(2e-4, marks=pytest.mark.slow),
+        pytest.param(3e-4, marks=pytest.mark.slow),
+        4e-4,
+    ],
+)
 def test_converged_plant_is_accurate_for_small_dt(dt, fine_modes, fine_responses):
     plant = build_converged_plant(dt, BeamParameters(), REFINEMENT)
     _check_plant(plant, band_of(dt), fine_modes, fine_responses)

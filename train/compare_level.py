@@ -17,11 +17,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from acld_gym import ENV_ID
-from acld_gym.envs.presets import PRESETS, preset
-from acld_gym.physics.truth import MESHES
+from acld_gym.envs.presets import preset
 from baselines.evaluation.rollout import check_compatible
 
-from .agent_dirs import agent_names
+from .agent_dirs import agent_folders, agent_mesh
 from .agent_files import read_metadata
 
 __all__ = [
@@ -50,18 +49,17 @@ class Level:
 
 
 def agent_level(path: str | Path) -> tuple[str, str]:
-    """``(env id, mesh)`` the agent folder ``path`` was trained on (its metadata; the mesh
-    is its env's ``mesh`` keyword, else its level's); ``OSError`` /
-    :class:`train.agent.AgentFileError` naming the folder or the file if it does not read."""
+    """``(env id, mesh)`` the agent folder ``path`` was trained on (its metadata,
+    :func:`train.agent_dirs.agent_mesh`); ``OSError`` / :class:`train.agent.AgentFileError`
+    naming the folder or the file if it does not read."""
     env = read_metadata(path)["env"]
-    mesh = env.get("kwargs", {}).get("mesh", PRESETS[env["id"]].get("mesh", "converged"))
-    return env["id"], mesh
+    return env["id"], agent_mesh(env)
 
 
 def folder_agents(directory: str | Path) -> list[str]:
     """Every agent folder under ``directory``, whatever its mesh (sorted; a folder whose
     metadata does not read included, so that reading it names the fault)."""
-    return sorted({n for mesh in MESHES for n in agent_names(directory, mesh)})
+    return [name for name, _ in agent_folders(directory)]
 
 
 def resolve_level(

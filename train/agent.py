@@ -63,6 +63,7 @@ from .agent_program import (
     observation_width,
 )
 from .agent_schema import FORMAT, AgentFileError, parse_metadata
+from .commands import CommandMemory
 from .sb3_export import actor_extractor, actor_parts, export_sb3
 from .voltage import VoltageMap
 
@@ -123,7 +124,10 @@ class TrainedAgent:
             self.map = VoltageMap(
                 self.metadata.get("residual"), headroom=self.metadata.get("action_headroom", 1.0)
             )
-        except ValueError as exc:
+            commands = self.metadata.get("commands")
+            #: Its memory of its own commands (trained with ``observe_commands``), or None.
+            self.commands = None if commands is None else CommandMemory(**commands)
+        except (TypeError, ValueError) as exc:
             raise AgentFileError(f"{META_FILE}: {exc}") from None
 
     # --- what it was trained on --------------------------------------------------------
@@ -217,19 +221,28 @@ class TrainedAgent:
                 f"than {env_id}'s today: " + "; ".join(diff)
             )
         try:
-            self.actor.check_width(width)
+            self.actor.check_width(width + self.observed_commands)
         except AgentFileError as exc:
             raise AgentFileError(f"{where}/{exc}") from None
 
     # --- policy -----------------------------------------------------------------------
+    @property
+    def observed_commands(self) -> int:
+        """How many of its own last commands it appends to the env's observation."""
+        return 0 if self.commands is None else self.commands.observed
+
     def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
-        """SB3 protocol: ``(voltages, state)``, shape (n, 1) for a batch or (1,)."""
+        """SB3 protocol: ``(voltages, state)``, shape (n, 1) for a batch or (1,). An agent
+        trained with ``observe_commands`` (:attr:`commands`) keeps its last commands in
+        ``state``: pass it back at every step (None, or ``episode_start`` true, at the
+        start of an episode), as to any SB3 recurrent policy; the state of any other
+        agent is returned as given."""
         if not deterministic:
             raise ValueError(
                 "deterministic must be True: TrainedAgent evaluates the deterministic policy"
             )
         obs = np.asarray(observation, dtype=np.float32)
-        width = self.actor.input_width
+        width = self.actor.input_width - self.observed_commands
         if obs.shape not in ((width,),) and not (obs.ndim == 2 and obs.shape[1] == width):
             raise ValueError(
                 f"observation: expected shape ({width},) or (n, {width}) (the observation of "
@@ -237,5 +250,10 @@ class TrainedAgent:
             )
         batched = obs.ndim == 2
         obs2 = np.atleast_2d(obs)
-        v = self.map(self.actor(obs2), obs2)
+        if self.commands is None:
+            v = self.map(self.actor(obs2), obs2)
+        else:
+            x, state = self.commands.observe(obs2, state, episode_start)
+            v = self.map(self.actor(x), obs2)
+            state = self.commands.remember(state, v)
         return (v if batched else v[0]), state

@@ -204,13 +204,14 @@ def linear_program(
 
 
 def observation_width(metadata: dict) -> int | None:
-    """The width of the observation an agent's metadata records (the ``"estimate"``
-    observation: the design order + 1), or None when it does not say."""
+    """The width of the input an agent's metadata records: the ``"estimate"`` observation
+    (the design order + 1) and the commands it remembers (``commands``, checked by
+    :func:`train.agent_schema.check_metadata`), or None when it does not say."""
     obs = metadata.get("observation")
     if (
         isinstance(obs, dict)
         and obs.get("obs_mode") == "estimate"
         and isinstance(obs.get("xr_scale"), list)
     ):
-        return len(obs["xr_scale"]) + 1
+        return len(obs["xr_scale"]) + 1 + int((metadata.get("commands") or {}).get("observed", 0))
     return None

@@ -20,6 +20,7 @@ import numbers
 import numpy as np
 
 from acld_gym.envs.config import EnvConfig
+from acld_gym.envs.limits import MAX_DELAY
 from acld_gym.envs.presets import check_env_id
 from acld_gym.util.validate import json_depth, shown
 from acld_gym.wrappers import MAX_HEADROOM, check_headroom
@@ -143,6 +144,8 @@ def check_metadata(meta, where: str = "metadata.json") -> dict:
             )
     if meta.get("residual") not in (None, "lqr"):
         raise _fail(where, "residual", f"expected null or 'lqr', got {shown(meta['residual'])}")
+    if meta.get("commands") is not None:
+        _check_commands(meta["commands"], where)
     if "action_headroom" in meta:
         headroom = meta["action_headroom"]
         try:  # is_real first: check_headroom cannot take an integer beyond the float range
@@ -154,6 +157,25 @@ def check_metadata(meta, where: str = "metadata.json") -> dict:
                 f"expected a number in [1, {MAX_HEADROOM:g}], got {shown(headroom)}",
             ) from None
     return meta
+
+
+def _check_commands(commands, where: str) -> None:
+    """``commands``: ``{"memory": m, "observed": k}``, integers with 1 <= m <= the
+    largest delay and 0 <= k <= m (:class:`train.commands.CommandMemory`)."""
+    ok = isinstance(commands, dict) and set(commands) == {"memory", "observed"}
+    values = [commands.get(k) for k in ("memory", "observed")] if ok else []
+    if ok and all(isinstance(v, int) and not isinstance(v, bool) for v in values):
+        m, k = values
+        ok = 1 <= m <= MAX_DELAY and 0 <= k <= m
+    else:
+        ok = False
+    if not ok:
+        raise _fail(
+            where,
+            "commands",
+            f"expected null or {{'memory': m, 'observed': k}} with integers "
+            f"1 <= m <= {MAX_DELAY}, 0 <= k <= m, got {shown(commands)}",
+        )
 
 
 def _check_env(env, where: str) -> None:

@@ -89,11 +89,12 @@ def check_config(cfg) -> None:
     if not isinstance(cfg.env_kwargs, dict):
         raise ValueError(f"env_kwargs must be a mapping of env options, got {cfg.env_kwargs!r}")
     if cfg.env_kwargs:
-        if not sb3 and cfg.env_kwargs.get("observe_reward_scale"):
-            raise ValueError(
-                "env_kwargs: observe_reward_scale is for the SB3 algorithms (vrs's "
-                "actor reads the whole observation, log c included)"
-            )
+        for key, why in (
+            ("observe_reward_scale", "vrs's actor reads the whole observation, log c included"),
+            ("observe_commands", "vrs's exported actor has no memory of its commands"),
+        ):
+            if not sb3 and cfg.env_kwargs.get(key):
+                raise ValueError(f"env_kwargs: {key} is for the SB3 algorithms ({why})")
         if "load_case" in cfg.env_kwargs:
             raise ValueError("env_kwargs: the training loads are the loads: field, not load_case")
         try:  # the training env's options, validated by the env's own config

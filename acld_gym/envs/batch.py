@@ -33,6 +33,8 @@ from acld_gym.envs.step import (
     TERMINATED_BY,
     Y_SCALE,
     StepLayout,
+    appended_size,
+    commands_in_flight,
     estimate_map,
     load_schedule,
     observation_size,
@@ -109,9 +111,12 @@ class BatchStep:
         self.observer = obs = nom.observer(c.observer)
         self.est = estimate_map(obs, nom.xr_scale)
         self.layout = lay = StepLayout.of(c, nom, obs)
-        #: The observation's size: the design's (:func:`acld_gym.envs.step.observation_size`),
-        #: plus log(reward scale) last with ``observe_reward_scale``.
-        self.n_obs = observation_size(nom, c.obs_mode) + int(c.observe_reward_scale)
+        #: The observation's size: the design's plus the appended entries (the commands in
+        #: flight, then log c: :func:`acld_gym.envs.step.appended_size`).
+        self.n_obs = observation_size(nom, c.obs_mode) + appended_size(c)
+        #: The slots of Z the observation appends (the commands in flight, oldest first).
+        n_cmd = commands_in_flight(c.obs_mode, c.actuator_delay) if c.observe_commands else 0
+        self.command_slots = np.arange(lay.buffer.start, lay.buffer.start + n_cmd)
         #: The reward scale c of each env's episode (:mod:`acld_gym.envs.scale`; ones
         #: unless ``reward_scale``): every reward is divided by it.
         self.reward_scale = np.ones(N)
@@ -181,7 +186,7 @@ class BatchStep:
             times=self.times,
             **self.layout.core_kwargs(),
             obs_mode=("estimate", "measurement", "full").index(c.obs_mode),
-            n_obs=self.n_obs - int(c.observe_reward_scale),
+            n_obs=self.n_obs - appended_size(c),
             dt=c.dt,
             y_ref=c.y_ref,
             lam=c.lam,
@@ -275,27 +280,25 @@ class BatchStep:
         self.scale_info(info)
         return r.obs, r.reward, r.code != 0, r.truncated, info
 
-    # --- the reward scale (acld_gym.envs.scale) ----------------------------------------------
+    # --- the appended entries and the reward scale (acld_gym.envs.scale) -------------------
     def scaled(self, res):
-        """A compiled vector step's 5-tuple with the reward scale applied (the reward divided
-        by :attr:`reward_scale`, ``info["reward_scale"]``, log c appended to the
-        observation): ``res`` itself without ``reward_scale``."""
-        if self.scale_cost is None:
+        """A compiled vector step's 5-tuple with the options applied (the commands in flight
+        and log c appended, the reward divided by :attr:`reward_scale`, its info)."""
+        if self.scale_cost is None and not self.command_slots.size:
             return res
         obs, reward, terminated, truncated, info = res
         self.scale_info(info)
-        return self._append_scale(obs), reward / self.reward_scale, terminated, truncated, info
+        return self._append(obs), reward / self.reward_scale, terminated, truncated, info
 
     def scaled_one(self, res):
         """:meth:`scaled` for the compiled ``step_one`` of env 0 (None stays None)."""
-        if res is None or self.scale_cost is None:
+        if res is None or (self.scale_cost is None and not self.command_slots.size):
             return res
         obs, reward, terminated, truncated, info = res
         s = float(self.reward_scale[0])
-        info["reward_scale"] = s
-        if self.config.observe_reward_scale:
-            obs = np.append(obs, np.float32(np.log(s)))
-        return obs, reward / s, terminated, truncated, info
+        if self.scale_cost is not None:
+            info["reward_scale"] = s
+        return self._append(obs[None], [0])[0], reward / s, terminated, truncated, info
 
     def scale_info(self, info: dict, rows=None) -> None:
         """Add ``info["reward_scale"]`` (and its mask) of ``rows`` (default all) to a vector
@@ -305,11 +308,13 @@ class BatchStep:
             info["reward_scale"] = s.copy()
             info["_reward_scale"] = np.ones(s.shape, dtype=bool)
 
-    def _append_scale(self, obs: np.ndarray, rows=None) -> np.ndarray:
-        if not self.config.observe_reward_scale:
-            return obs
-        s = self.reward_scale if rows is None else self.reward_scale[rows]
-        return np.concatenate([obs, np.log(s).astype(np.float32)[:, None]], axis=-1)
+    def _append(self, obs: np.ndarray, rows=None) -> np.ndarray:
+        """The observations ``obs`` of ``rows`` (default all) with the appended entries."""
+        rows = slice(None) if rows is None else rows
+        extra = [self.Z[rows][:, self.command_slots] / V_LIMIT] if self.command_slots.size else []
+        if self.config.observe_reward_scale:
+            extra.append(np.log(self.reward_scale[rows])[:, None])
+        return np.concatenate([obs, *extra], axis=-1, dtype=np.float32) if extra else obs
 
     def advance(self, v: np.ndarray, inputs: np.ndarray | None = None) -> StepResult:
         """The step in numpy (the reference of the compiled one): voltages ``v`` (N,) [V]
@@ -377,7 +382,7 @@ class BatchStep:
             )
         else:
             out = self.Z[rows, lay.x]
-        return self._append_scale(out.astype(np.float32), rows)
+        return self._append(out.astype(np.float32), rows)
 
     def tip_loads(self, rows=None) -> np.ndarray:
         """The tip load [N] of ``rows`` (default all) at their current time ``k dt``."""

@@ -166,6 +166,10 @@ class ACLDBeamEnv(BatchView, ConfigAttributes, FigureOwner, gym.Env):
     | | | the episode's cost relative to LQR's |
     | ``observe_reward_scale`` | False | append log c to the observation as its last entry |
     | | | (privileged, for a critic; n + 1 entries); needs ``reward_scale`` |
+    | ``observe_commands`` | False | append the commands still in flight, the oldest first, |
+    | | | in units of 120 V, before any log c: ``actuator_delay`` entries (one fewer with |
+    | | | ``obs_mode="measurement"``, which ends with the newest; none without a delay). |
+    | | | What a delay-aware controller knows: the thesis's observer does not |
     | ``env_id`` | ``"ACLDBeam-v1"`` | the registered id of the configuration (fingerprint) |
 
     The actuator chain, per period: the action is clipped (the command, which the

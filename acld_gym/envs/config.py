@@ -176,6 +176,14 @@ class EnvConfig:
         "append log(reward scale) to the observation as its last entry: "
         "privileged, for a critic only; needs reward_scale",
     )
+    observe_commands: bool = _f(
+        False,
+        "-",
+        "append the commands still in flight (actuator_delay of them, the oldest first, "
+        "in units of 120 V; the 'measurement' observation already ends with the newest) "
+        "before any log(reward scale): what a delay-aware controller knows; none "
+        "without a delay",
+    )
     env_id: str = _f(
         "ACLDBeam-v1",
         "-",
@@ -248,6 +256,11 @@ class EnvConfig:
                 "observe_reward_scale=True needs a reward_scale (e.g. "
                 "reward_scale='passive'), got reward_scale=None"
             )
+        if not isinstance(self.observe_commands, (bool, np.bool_)):
+            raise ValueError(
+                f"observe_commands must be True or False, got {self.observe_commands!r}"
+            )
+        set_(self, "observe_commands", bool(self.observe_commands))
         check_env_id(self.env_id, "env_id")
         check_episode_size(self.episode_length, self.dt)
         check_consistent(self)  # no field that another one silently overrides

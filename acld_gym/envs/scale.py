@@ -116,6 +116,7 @@ class LQRCost:
         self.config = config.replace(
             reward_scale=None,
             observe_reward_scale=False,
+            observe_commands=False,
             obs_mode="estimate",
             sensor_noise=0.0,
             param_noise=0.0,

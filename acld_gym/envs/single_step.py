@@ -60,11 +60,12 @@ class BatchView:
 
 
 def fast_step(b: BatchStep):
-    """The compiled step of the env whose batch is ``b`` (with the reward scale applied, if
-    set), or :func:`no_fast_path`."""
+    """The compiled step of the env whose batch is ``b`` (with the reward scale and the
+    appended observation entries, if set: :meth:`BatchStep.scaled_one`), or
+    :func:`no_fast_path`."""
     if b.core is None:
         return no_fast_path
-    if b.scale_cost is None:
+    if b.scale_cost is None and not b.command_slots.size:
         return b.core.step_one
     step_one, scaled_one = b.core.step_one, b.scaled_one
     return lambda action: scaled_one(step_one(action))

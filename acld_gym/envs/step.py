@@ -24,6 +24,8 @@ __all__ = [
     "INFO_KEYS",
     "TERMINATED_BY",
     "observation_size",
+    "commands_in_flight",
+    "appended_size",
     "estimate_slots",
     "estimate_map",
     "output_matrix",
@@ -242,6 +244,23 @@ def observation_size(nom: NominalDesign, obs_mode: str, hist: int = OBS_HIST) ->
         "measurement": hist + 1,
         "full": nom.plant.Ad.shape[0],
     }[obs_mode]
+
+
+def commands_in_flight(obs_mode: str, delay: int) -> int:
+    """How many commands ``observe_commands`` appends to the observation: the ``delay``
+    commands still in flight after a step (the delay line, the oldest first: the oldest
+    drives the next period), less the newest in the ``"measurement"`` observation, which
+    already ends with it. None without a delay (nothing is in flight)."""
+    return max(int(delay) - int(obs_mode == "measurement"), 0)
+
+
+def appended_size(config) -> int:
+    """The entries appended to the design's observation (:func:`observation_size`) by the
+    options of ``config`` (:class:`acld_gym.envs.config.EnvConfig`), in this order: the
+    commands in flight (``observe_commands``, :func:`commands_in_flight`), then log c
+    (``observe_reward_scale``), always last."""
+    commands = commands_in_flight(config.obs_mode, config.actuator_delay)
+    return commands * bool(config.observe_commands) + int(config.observe_reward_scale)
 
 
 def estimate_slots(order: int, modes: int) -> np.ndarray:

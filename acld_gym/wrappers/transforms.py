@@ -94,8 +94,8 @@ class UnitMap:
 
 class ModeSlots:
     """The ``"estimate"`` observation's entries of the first ``modes`` modes and the tip
-    (:func:`acld_gym.envs.step.estimate_slots`), then any appended entries (``log c`` of
-    ``observe_reward_scale``) as they are.
+    (:func:`acld_gym.envs.step.estimate_slots`), then any appended entries (the commands
+    in flight of ``observe_commands``, ``log c`` of ``observe_reward_scale``) as they are.
 
     Parameters
     ----------
@@ -121,12 +121,12 @@ class ModeSlots:
             raise ValueError(f"env: {owner} needs an ACLDBeam env with obs_mode='estimate'")
         if isinstance(modes, bool) or not isinstance(modes, (int, np.integer)):
             raise ValueError(f"modes must be an integer, got {modes!r}")
-        from acld_gym.envs.step import estimate_slots, observation_size
+        from acld_gym.envs.step import appended_size, estimate_slots, observation_size
 
         # the layout's owner (acld_gym.envs.step) says where the modes are and how many
         nom = config.nominal()
         base = observation_size(nom, config.obs_mode)
-        n = base + int(bool(config.observe_reward_scale))
+        n = base + appended_size(config)
         if tuple(shape) != (n,):
             raise ValueError(
                 f"env: {owner} needs the ACLDBeam env's own observation of "

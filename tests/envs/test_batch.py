@@ -53,6 +53,10 @@ OPTIONS = {
     "reward": dict(load_case=1, y_ref=5e-4, lam=0.3),
     "v0": dict(PRESETS["ACLDBeam-v0"], load_case="random"),
     "delay": dict(load_case="random", actuator_delay=3),
+    "commands": dict(load_case="random", actuator_delay=3, observe_commands=True),
+    "commands-measurement": dict(
+        load_case="random", actuator_delay=2, obs_mode="measurement", observe_commands=True
+    ),
     "lag": dict(load_case=2, amplifier_bandwidth=400.0),
     "slew": dict(load_case="random", slew_rate=3e4, obs_mode="measurement"),
     "actuator": dict(

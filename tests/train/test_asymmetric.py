@@ -69,7 +69,11 @@ def test_recipe_trains_and_exports_onto_the_plain_observation():
     from train.core.algos import train_algo
 
     data = yaml.safe_load(open("train/recipes/ppo.yaml"))
-    assert data["env_kwargs"] == {"reward_scale": "passive", "observe_reward_scale": True}
+    assert data["env_kwargs"] == {
+        "reward_scale": "passive",
+        "observe_reward_scale": True,
+        "observe_commands": True,  # appends nothing on v1 (no delay)
+    }
     data.update(timesteps=2048, n_envs=4, whiten_steps=256, eval_points=1)
     data["model"] = {**data["model"], "n_steps": 128, "batch_size": 256, "n_epochs": 1}
     policy, record = train_algo(

@@ -11,6 +11,7 @@ import torch
 from stable_baselines3.common.vec_env import VecNormalize
 
 from ..agent import actor_extractor
+from ..commands import CommandMemory
 from ..features import DropLast, direction_features
 from ..voltage import VoltageMap
 
@@ -37,7 +38,10 @@ class SB3Policy:
     """A trained SB3 model with its frozen ``VecNormalize`` statistics as a policy on the
     env's raw observation, ``predict`` in volts (``voltage_map``: the training env's
     :class:`train.voltage.VoltageMap`, default ``V = 120 clip(a, -1, 1)``);
-    ``transform``: the agent's whitening matrix (:class:`train.vec.VecWhiten`), or None."""
+    ``transform``: the agent's whitening matrix (:class:`train.vec.VecWhiten`), or None;
+    ``commands``: the memory of its own commands of a model trained with
+    ``observe_commands`` (:class:`train.commands.CommandMemory`, carried in ``state``), or
+    None."""
 
     def __init__(
         self,
@@ -46,8 +50,10 @@ class SB3Policy:
         features: str | None,
         transform: np.ndarray | None = None,
         voltage_map=None,
+        commands: CommandMemory | None = None,
     ):
         self.model = model
+        self.commands = commands
         self.obs_norm = obs_norm
         self.features = features
         self.transform = None if transform is None else np.asarray(transform, np.float64)
@@ -71,6 +77,7 @@ class SB3Policy:
             self.features,
             self.transform,
             self.voltage_map,
+            self.commands,
         )
 
     def predict(self, observation, state=None, episode_start=None, deterministic: bool = True):
@@ -78,6 +85,8 @@ class SB3Policy:
         batched = obs.ndim == 2
         raw = np.atleast_2d(obs)
         x = raw
+        if self.commands is not None:
+            x, state = self.commands.observe(raw, state, episode_start)
         if self.transform is not None:
             x = (x.astype(np.float64) @ self.transform).astype(np.float32)
         if self.features == "direction":
@@ -89,4 +98,6 @@ class SB3Policy:
         with torch.no_grad():  # the deterministic action of model.predict, without its checks
             a = self.model.policy._predict(torch.as_tensor(x), deterministic=True).numpy()
         v = self.voltage_map(a, raw)
+        if self.commands is not None:
+            state = self.commands.remember(state, v)
         return (v if batched else v[0]), state

@@ -24,6 +24,7 @@ import acld_gym  # noqa: F401  (registers the env ids)
 from acld_gym.wrappers import whitening
 
 from ..agent import actor_parts
+from ..commands import command_memory
 from ..config import TrainConfig, algo_class
 from ..distill import distill
 from ..vec import VecWhiten, make_vec_env
@@ -293,6 +294,7 @@ def train_sb3(
     model = make_model(cfg, venv, seed)
     ent_sched = ent_coef_schedule(cfg)
     vmap = VoltageMap(cfg.residual, cfg.mesh, cfg.action_headroom)
+    commands = command_memory(env_id, cfg.env_kwargs)
     distilled = None
     if cfg.distill is not None:
         t0 = time.perf_counter()
@@ -311,7 +313,7 @@ def train_sb3(
             norm = copy.deepcopy(venv)
             norm.venv = None
             norm.training = False
-        return SB3Policy(model, norm, cfg.features, transform, vmap)
+        return SB3Policy(model, norm, cfg.features, transform, vmap, commands)
 
     if cfg.whiten_steps:
         assert isinstance(white, VecWhiten)

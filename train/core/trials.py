@@ -175,6 +175,7 @@ def save_agent(
     observation fingerprint of the env it was trained on, ``learning_curve.csv`` and the
     text ``files``), the folder written whole (:meth:`train.agent.TrainedAgent.save`)."""
     cfg = TrainConfig.from_dict(rec["config"])
+    memory = getattr(policy, "commands", None)  # an SB3Policy trained with observe_commands
     probe = gym.make(rec["env_id"])
     meta = {
         "algo": rec["algo"],
@@ -194,6 +195,7 @@ def save_agent(
         "final_ise": rec["final_ise"],
         "versions": versions(),
         "env": {"id": rec["env_id"], "kwargs": {}},
+        "commands": None if memory is None else memory.as_dict(),
         "observation": observation_fingerprint(probe),
     }
     probe.close()

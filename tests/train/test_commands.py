@@ -1,0 +1,139 @@
+"""An agent trained with ``observe_commands`` carries its own commands
+(train.commands.CommandMemory in SB3's recurrent ``state``) and so runs on the plain env:
+its episode there is the one its actor has on the env that appends the commands; the
+exported agent (``metadata.json`` ``commands``) is the SB3 policy, in single and batched
+evaluation; a bad state or a bad ``commands`` field is one clear line."""
+
+from __future__ import annotations
+
+import json
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import acld_gym  # noqa: F401
+from baselines.evaluation.rollout import rollout
+from tests.train.tiny_sb3 import tiny_ppo
+from train.agent import TrainedAgent
+from train.agent_schema import AgentFileError, check_metadata
+from train.commands import CommandMemory, command_memory
+from train.config import TrainConfig
+from train.core import evaluate
+from train.core.algos import train_algo
+from train.core.sb3_inference import SB3Policy
+from train.core.trials import policy_program, save_agent
+
+LAB = "ACLDBeam" + "Lab-v1"
+
+
+def test_the_memory_is_what_the_env_appends():
+    """Driven by the same clipped actions from rest, the memory appended to the plain
+    observation is the observation of the env with ``observe_commands``, step by step,
+    across an episode's start (the memory at rest again)."""
+    kw = dict(load_case="random", actuator_delay=3, obs_mode="measurement")
+    plain, wide = gym.make(LAB, **kw), gym.make(LAB, observe_commands=True, **kw)
+    memory = command_memory(LAB, dict(kw, observe_commands=True))
+    assert memory.as_dict() == {"memory": 3, "observed": 2}
+    acts = np.random.default_rng(2).uniform(-300, 300, size=(40, 1))
+    state = None
+    for episode in range(2):
+        p, _ = plain.reset(seed=episode)
+        w, _ = wide.reset(seed=episode)
+        for k, a in enumerate(acts):
+            x, state = memory.observe(p[None], state, np.array([k == 0]))
+            np.testing.assert_array_equal(x[0], w)
+            state = memory.remember(state, a)
+            p, *_ = plain.step(a)
+            w, *_ = wide.step(a)
+
+
+@pytest.mark.parametrize(
+    "env_id, kwargs, expected",
+    [
+        (LAB, {"observe_commands": True}, {"memory": 1, "observed": 1}),
+        (LAB, {}, None),
+        ("ACLDBeamHard-v1", {"observe_commands": True}, None),  # it observes its command
+        ("ACLDBeam-v1", {"observe_commands": True}, None),  # no delay: nothing in flight
+    ],
+)
+def test_a_memory_only_where_the_env_appends_commands(env_id, kwargs, expected):
+    memory = command_memory(env_id, kwargs)
+    assert (memory and memory.as_dict()) == expected
+
+
+def test_a_state_of_another_shape_is_refused_in_one_line():
+    memory = CommandMemory(2, 2)
+    with pytest.raises(
+        ValueError, match=r"^state: expected the policy's last state, shape \(3, 2\)"
+    ):
+        memory.observe(np.zeros((3, 9), np.float32), np.zeros((2, 2)), None)
+    with pytest.raises(ValueError, match="observed must be at most memory"):
+        CommandMemory(1, 2)
+
+
+@pytest.fixture(scope="module")
+def lab_ppo():
+    """The PPO recipe on the lab rig, shrunk to 1536 env steps: it observes its commands."""
+    cfg = tiny_ppo(restarts=1, restart_above=None, select=None)
+    assert cfg.env_kwargs["observe_commands"] is True
+    policy, record = train_algo(cfg, 0, LAB, lambda steps, pol: None)
+    return cfg, policy, record
+
+
+def test_the_policy_on_the_plain_env_is_its_actor_on_the_wide_env(lab_ppo):
+    _, policy, _ = lab_ppo
+    assert policy.commands.as_dict() == {"memory": 1, "observed": 1}
+    stateless = SB3Policy(
+        policy.model, policy.obs_norm, policy.features, policy.transform, policy.voltage_map
+    )
+    a = rollout(policy, gym.make(LAB, load_case=1).unwrapped, seed=3)
+    b = rollout(stateless, gym.make(LAB, load_case=1, observe_commands=True).unwrapped, seed=3)
+    np.testing.assert_allclose(a.voltage, b.voltage, rtol=1e-6, atol=1e-6)
+    np.testing.assert_allclose(a.y, b.y, rtol=1e-6, atol=1e-12)
+    assert np.ptp(a.voltage) > 1.0  # it acts: the comparison is not of two silent policies
+
+
+@pytest.fixture(scope="module")
+def lab_agent(lab_ppo, tmp_path_factory):
+    """The tiny lab policy saved as an agent folder (train.core.trials.save_agent)."""
+    cfg, policy, _ = lab_ppo
+    rec = {
+        "algo": "ppo", "seed": 0, "name": "ppo", "command": "test", "config": cfg.as_dict(),
+        "env_id": LAB, "record": {}, "steps": 1536, "budget": 1536, "train_seconds": 1.0,
+        "train_cpu_seconds": 1.0, "final_ise": {}, "curve": [],
+    }  # fmt: skip
+    return save_agent(policy, rec, tmp_path_factory.mktemp("lab") / "agent")
+
+
+def test_the_saved_agent_keeps_its_memory(lab_ppo, lab_agent):
+    _, policy, _ = lab_ppo
+    agent = TrainedAgent.load(lab_agent)
+    assert agent.metadata["commands"] == {"memory": 1, "observed": 1}
+    assert agent.actor.input_width == 10  # the 9 entries of the lab rig's estimate + 1
+    a = rollout(agent, gym.make(LAB, load_case=2).unwrapped, seed=1)
+    b = rollout(policy, gym.make(LAB, load_case=2).unwrapped, seed=1)
+    np.testing.assert_allclose(a.voltage, b.voltage, rtol=1e-3, atol=1e-2)
+    # batched: the validation episodes side by side, the state per sub-env
+    seeds = evaluate.validation_seeds(3)
+    assert evaluate.validation_cost(agent, LAB, seeds) == pytest.approx(
+        evaluate.validation_cost(policy, LAB, seeds), rel=1e-4
+    )
+    assert policy_program(policy).input_width == 10
+
+
+@pytest.mark.parametrize(
+    "bad", [{"memory": 0, "observed": 0}, {"memory": 1, "observed": 2}, {"memory": "1"}, [1, 1]]
+)
+def test_a_bad_commands_field_is_refused(bad, lab_agent):
+    meta = json.loads((lab_agent / "metadata.json").read_text())
+    assert check_metadata(dict(meta)) is not None  # the saved one is well formed
+    with pytest.raises(AgentFileError, match=r"metadata.json: commands: expected null or"):
+        check_metadata(dict(meta, commands=bad))
+
+
+def test_the_search_cannot_observe_commands():
+    with pytest.raises(ValueError, match="env_kwargs: observe_commands is for the SB3"):
+        TrainConfig.from_dict(
+            {"algo": "vrs", "timesteps": 1000, "env_kwargs": {"observe_commands": True}}
+        )

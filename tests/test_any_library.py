@@ -1,5 +1,5 @@
 """The guide page "Train on any level with any library" (docs/any-library.md): its scripts
-(docs/examples/) run end to end on a tiny budget on ACLDBeam-v1 and on another level and
+(docs/examples/) run end to end (in this process) on a tiny budget on ACLDBeam-v1 and on another level and
 print a finite score, refuse each bad argument in one line before training or loading
 anything (zoo_score.py takes the level and the algorithm from the run's own args.yml, read
 as plain data), the docs' rl-zoo3 commands run torch on one thread, CleanRL's additions
@@ -53,6 +53,58 @@ def _run(args: list[str], cwd: Path, timeout: int = 600) -> str:
     return done.stdout
 
 
+@contextlib.contextmanager
+def _as_found():
+    """The process-wide state a script or rl-zoo3 run in this process changes, put back as
+    it was: torch's threads, the global random generators (SB3's ``set_random_seed``),
+    gymnasium's registry and ``TimeLimit`` (rl-zoo3 registers its NoVel ids and replaces
+    ``TimeLimit`` when first imported)."""
+    import random
+
+    from gymnasium.envs import registration
+    from gymnasium.wrappers import common
+
+    registry, threads = dict(gym.envs.registry), torch.get_num_threads()
+    rngs = random.getstate(), np.random.get_state(), torch.get_rng_state()  # noqa: NPY002
+    modules = (gym.wrappers, common, registration)  # rl-zoo3 sets TimeLimit in each
+    limits = [vars(m).get("TimeLimit") for m in modules]
+    try:
+        yield
+    finally:
+        gym.envs.registry.clear()
+        gym.envs.registry.update(registry)
+        torch.set_num_threads(threads)
+        random.setstate(rngs[0])
+        np.random.set_state(rngs[1])  # noqa: NPY002  (the global state SB3 seeds)
+        torch.set_rng_state(rngs[2])
+        for module, limit in zip(modules, limits, strict=True):
+            if limit is None:
+                vars(module).pop("TimeLimit", None)
+            else:
+                module.TimeLimit = limit
+
+
+def _run_here(args: list[str], cwd: Path, monkeypatch, capsys) -> str:
+    """``python ARGS`` (a script path, or ``-m module`` and its arguments) run in this
+    process as ``__main__`` (runpy) in ``cwd``, as :func:`_run` runs it in a fresh
+    interpreter (each of those paid 2-3 s of CPU to import torch, SB3 and rl-zoo3 again);
+    its standard output. A failure raises here, with its traceback."""
+    module = args[1] if args[0] == "-m" else None
+    argv = args[2:] if module else args[1:]
+    monkeypatch.chdir(cwd)
+    monkeypatch.setattr(sys, "argv", [module or args[0], *argv])
+    capsys.readouterr()
+    with _as_found():
+        try:
+            if module:
+                runpy.run_module(module, run_name="__main__", alter_sys=True)
+            else:
+                runpy.run_path(args[0], run_name="__main__")
+        except SystemExit as stop:  # a script's sys.exit(0) is a success
+            assert stop.code in (0, None), (stop.code, capsys.readouterr().err[-3000:])
+    return capsys.readouterr().out
+
+
 def _check_score(stdout: str, env_id: str, episodes: int) -> None:
     """The last line is a score of ``env_id`` on ``episodes`` test loads, every number
     finite, the ratios positive."""
@@ -69,10 +121,9 @@ def _check_score(stdout: str, env_id: str, episodes: int) -> None:
 @pytest.mark.parametrize(
     "script, steps, env_id", [("sb3_ppo.py", 16_384, "ACLDBeam-v1"), ("sb3_sac.py", 12_000, OTHER)]
 )
-def test_sb3_script_runs_on_a_tiny_budget(script, steps, env_id, tmp_path):
-    out = _run(
-        [str(EXAMPLES / script), env_id, "--timesteps", str(steps), "--episodes", "2"], tmp_path
-    )
+def test_sb3_script_runs_on_a_tiny_budget(script, steps, env_id, tmp_path, monkeypatch, capsys):
+    args = [str(EXAMPLES / script), env_id, "--timesteps", str(steps), "--episodes", "2"]
+    out = _run_here(args, tmp_path, monkeypatch, capsys)
     _check_score(out, env_id, 2)
 
 
@@ -314,7 +365,9 @@ def _page_zoo(algo: str, env_id: str) -> tuple[list[str], list[str]]:
 
 
 @pytest.mark.parametrize("algo, env_id", [("ppo", "ACLDBeam-v1"), ("sac", OTHER)])
-def test_rl_zoo3_trains_from_the_mlp_file_and_zoo_score_scores_it(algo, env_id, tmp_path):
+def test_rl_zoo3_trains_from_the_mlp_file_and_zoo_score_scores_it(
+    algo, env_id, tmp_path, monkeypatch, capsys
+):
     """The page's commands: rl-zoo3 trains from ``train/zoo/<algo>_mlp.yml`` (2048 steps,
     8 sub-envs, torch on one thread as the page's command says) and
     ``docs/examples/zoo_score.py`` scores the run, with no level given (the run's own) and
@@ -324,11 +377,11 @@ def test_rl_zoo3_trains_from_the_mlp_file_and_zoo_score_scores_it(algo, env_id, 
     train += ["-n", "2048", "--hyperparams", "n_envs:8"]
     if algo == "sac":
         train.append("learning_starts:1024")
-    _run(train, tmp_path)
+    _run_here(train, tmp_path, monkeypatch, capsys)
     run = tmp_path / "logs" / algo / f"{env_id}_1"
     assert score[:3] == [str(EXAMPLES / "zoo_score.py"), algo, str(run.relative_to(tmp_path))]
     assert not any(a in PRESETS for a in score), score  # the level is the run's
-    out = _run([*score, "--episodes", "2"], tmp_path)
+    out = _run_here([*score, "--episodes", "2"], tmp_path, monkeypatch, capsys)
     _check_score(out, env_id, 2)
 
 

@@ -1,10 +1,10 @@
 """The guide page "Train on any level with any library" (docs/any-library.md): its scripts
-(docs/examples/) run end to end (in this process) on a tiny budget on ACLDBeam-v1 and on another level and
-print a finite score, refuse each bad argument in one line before training or loading
-anything (zoo_score.py takes the level and the algorithm from the run's own args.yml, read
-as plain data), the docs' rl-zoo3 commands run torch on one thread, CleanRL's additions
-run as the diff gives them, the rl-zoo3 files hold the scripts' hyperparameters on every
-registered id, and the page includes every example verbatim (pymdownx.snippets)."""
+(docs/examples/) run end to end (in this process) on a tiny budget on ACLDBeam-v1 and on
+another level and print a finite score, refuse each bad argument in one line before training
+or loading anything (zoo_score.py takes the level and the algorithm from the run's own
+args.yml, read as plain data), the docs' rl-zoo3 commands run torch on one thread, CleanRL's
+additions run as the diff gives them, the rl-zoo3 files hold the scripts' hyperparameters on
+every registered id, and the page includes every example verbatim (pymdownx.snippets)."""
 
 from __future__ import annotations
 

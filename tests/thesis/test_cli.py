@@ -29,6 +29,8 @@ def reproduce_out(tmp_path_factory):
     base = tmp_path_factory.mktemp("repro")
     p = base / "sub" / "rows.json"  # parent directory created by the CLI
     plots = base / "figs"
+    plots.mkdir()  # an old figure of a former run, which the run replaces (test_reproduce_plots)
+    (plots / "hankel_singular_values.png").write_bytes(b"old")
     # A short window keeps this to a few seconds; the full run is tested in test_reproduce.
     assert (
         main(["reproduce", "--json", str(p), "--plots", str(plots), "--quiet", "--t-end", "0.1"])
@@ -84,7 +86,7 @@ def test_reproduce_plots(reproduce_out):
     }
     expected |= {"hankel_singular_values.png", "frequency_response.png"}
     assert files == expected  # 20 distinct figures
-    for name in files:
+    for name in files:  # the old figure among them replaced
         assert (plots / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 

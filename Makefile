@@ -74,6 +74,7 @@ wheel-check: $(STAMP)
 	! $(WHEEL_VENV)/bin/python -c "import osqp" 2>/dev/null
 	cp .ci/core_install_check.py $(WHEEL_VENV)/
 	cd $(WHEEL_VENV) && bin/python core_install_check.py --compiled
+	rm -rf $(WHEEL_VENV)  # nothing left in /tmp (the check failing leaves it to inspect)
 
 ## The documentation site (mkdocs.yml, docs/) into site/, strict: any warning fails.
 docs: $(STAMP)

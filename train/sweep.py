@@ -36,21 +36,30 @@ def score(rec: dict, lqr: dict) -> float:
     return sum(rec["final_ise"][c] / lqr[c] for c in THESIS) / len(THESIS)
 
 
-def trial(config: dict, out: str | Path) -> dict:
-    """Train the recipe ``config["algo"]`` (overridden: seed; optional timesteps,
-    learning_rate / n_envs) as one benchmark trial, save the agent in ``out``; returns
-    ``{"ise_rel_lqr": score}`` (:func:`score`)."""
+def trial_data(config: dict) -> tuple[str, dict]:
+    """The recipe ``config["algo"]``'s name and data with a trial's overrides: timesteps,
+    learning_rate, n_envs where given (not None), else the recipe's. The one place they
+    are applied, for the trials and for the checks before any (:func:`check_args`)."""
     from .config import read_config
-    from .core.evaluate import lqr_ise
-    from .core.trials import run_trial, save_agent
 
     name, data = read_config(config["algo"])
-    if config.get("timesteps") is not None:  # else the recipe's
+    if config.get("timesteps") is not None:
         data = dict(data, timesteps=int(config["timesteps"]))
     if config.get("learning_rate") is not None:
         data["model"] = {**data["model"], "learning_rate": float(config["learning_rate"])}
     if config.get("n_envs") is not None:
         data["n_envs"] = int(config["n_envs"])
+    return name, data
+
+
+def trial(config: dict, out: str | Path) -> dict:
+    """Train the recipe ``config["algo"]`` (overridden: seed; optional timesteps,
+    learning_rate / n_envs) as one benchmark trial, save the agent in ``out``; returns
+    ``{"ise_rel_lqr": score}`` (:func:`score`)."""
+    from .core.evaluate import lqr_ise
+    from .core.trials import run_trial, save_agent
+
+    name, data = trial_data(config)
     rec, policy = run_trial(
         name,
         data,
@@ -108,19 +117,16 @@ def check_args(args: argparse.Namespace) -> None:
     learning rates, the recipe with every override of the grid valid and buildable
     (:func:`train.config_checks.check_buildable`), ``--out`` not a file (its directory is
     checked, and made, once Ray is there). Nothing is computed, Ray not started."""
-    from .config import TrainConfig, read_config
+    from .config import TrainConfig
     from .config_checks import check_buildable
 
     for flag, values in (("--seeds", args.seeds), ("--learning-rates", args.learning_rates)):
         if values and len(set(values)) != len(values):
             raise ValueError(f"{flag} must be distinct, got {values}")
-    _, data = read_config(args.algo)
-    if args.timesteps is not None:
-        data = dict(data, timesteps=args.timesteps)
     for lr in args.learning_rates or [None]:
-        model = data["model"] if lr is None else {**data["model"], "learning_rate": lr}
+        config = {"algo": args.algo, "timesteps": args.timesteps, "learning_rate": lr}
         try:
-            cfg = TrainConfig.from_dict({**data, "model": model})
+            cfg = TrainConfig.from_dict(trial_data(config)[1])
         except ValueError as exc:
             raise ValueError(f"--timesteps / --learning-rates: {exc}") from None
     check_buildable(cfg)

@@ -135,6 +135,7 @@ def score(
     vec_normalize=None,
     episodes: int | None = None,
     quiet: bool = True,
+    env_kwargs: dict | None = None,
 ) -> PolicyScore:
     """Score ``policy`` on the level ``env_id`` (module docstring).
 
@@ -164,6 +165,11 @@ def score(
         (at most their 20): a reduced run, quick, not the published score. None: all.
     quiet : bool
         No progress line while the references are computed (once per test set, cached).
+    env_kwargs : dict or None
+        The observation options the policy was trained with, for its episodes only:
+        ``{"observe_commands": True}`` (the commands in flight appended, on a rig with a
+        delay). The plant, the loads and the reward are the level's, and so are the
+        references'; any other key is refused.
 
     Returns
     -------
@@ -184,7 +190,8 @@ def score(
     if episodes is not None:
         test = test.first(check_int("episodes", episodes, 1, len(test.seeds)))
     wrappers = _check_wrappers(wrappers)
-    probe = wrap(make_env(test), wrappers, env_id)
+    kw = _check_env_kwargs(env_kwargs)
+    probe = wrap(make_env(test, kw), wrappers, env_id)
     try:
         pol = as_policy(policy, vec_normalize, probe, wrappers)
         try:
@@ -196,7 +203,7 @@ def score(
         probe.close()
 
     refs = references(test, quiet=quiet)
-    ise = policy_ise(pol, lambda: wrap(make_env(test), wrappers, env_id), test.seeds)
+    ise = policy_ise(pol, lambda: wrap(make_env(test, kw), wrappers, env_id), test.seeds)
     n_random = len(HELDOUT_SEEDS) if episodes is None else min(len(HELDOUT_SEEDS), len(test.seeds))
     cases = eval_episodes(n_random)
     case_ise = {
@@ -204,7 +211,9 @@ def score(
             np.mean(
                 policy_ise(
                     pol,
-                    lambda case=case: wrap(gym.make(env_id, load_case=case), wrappers, env_id),
+                    lambda case=case: wrap(
+                        gym.make(env_id, load_case=case, **kw), wrappers, env_id
+                    ),
                     seeds,
                 )
             )
@@ -212,6 +221,26 @@ def score(
         for case, seeds in cases.items()
     }
     return PolicyScore(score_of(ise, refs), case_ise, lqr_ise(env_id, cases), env_id)
+
+
+#: The env options :func:`score` passes to the policy's episodes: they change what it
+#: observes, not what is scored.
+OBSERVATION_OPTIONS = ("observe_commands",)
+
+
+def _check_env_kwargs(env_kwargs) -> dict:
+    """``env_kwargs`` as a dict of :data:`OBSERVATION_OPTIONS`; one line naming it else."""
+    if env_kwargs is None:
+        return {}
+    if not isinstance(env_kwargs, dict):
+        raise TypeError(f"env_kwargs: expected a dict or None, got {shown(env_kwargs)}")
+    other = sorted(set(map(str, env_kwargs)) - set(OBSERVATION_OPTIONS))
+    if other:
+        raise ValueError(
+            f"env_kwargs: only the observation options {list(OBSERVATION_OPTIONS)} (the "
+            f"level's plant, loads and reward are what is scored), got {other}"
+        )
+    return dict(env_kwargs)
 
 
 def _check_wrappers(wrappers) -> tuple:

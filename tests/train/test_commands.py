@@ -122,6 +122,22 @@ def test_the_saved_agent_keeps_its_memory(lab_ppo, lab_agent):
     assert policy_program(policy).input_width == 10
 
 
+def test_score_runs_a_library_policy_on_the_observation_it_was_trained_on(lab_ppo, lab_agent):
+    """A policy without a memory, trained with ``observe_commands``, scores on the env that
+    appends them (``env_kwargs``) exactly as the agent that remembers them on the plain
+    env: the same episodes, the level's references."""
+    from train.scoring import score
+
+    _, policy, _ = lab_ppo
+    stateless = SB3Policy(
+        policy.model, policy.obs_norm, policy.features, policy.transform, policy.voltage_map
+    )
+    wide = score(stateless, LAB, episodes=2, env_kwargs={"observe_commands": True})
+    own = score(TrainedAgent.load(lab_agent), LAB, episodes=2)
+    np.testing.assert_allclose(wide.score.scores, own.score.scores, rtol=1e-4, atol=1e-4)
+    assert wide.ise_rel_lqr == pytest.approx(own.ise_rel_lqr, rel=1e-3)
+
+
 @pytest.mark.parametrize(
     "bad", [{"memory": 0, "observed": 0}, {"memory": 1, "observed": 2}, {"memory": "1"}, [1, 1]]
 )

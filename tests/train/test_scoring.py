@@ -214,6 +214,8 @@ def test_stateful_policy_gets_its_state_and_episode_start():
         ({"vec_normalize": "no/such/vecnormalize.pkl"}, ValueError, "vec_normalize: no file"),
         ({"vec_normalize": object()}, TypeError, "vec_normalize must be"),
         ({"vec_normalize": True}, TypeError, "vec_normalize must be"),
+        ({"env_kwargs": {"lam": 1.0}}, ValueError, "env_kwargs: only the observation options"),
+        ({"env_kwargs": [("observe_commands", True)]}, TypeError, "env_kwargs: expected a dict"),
     ],
 )
 def test_bad_input_names_the_argument(kwargs, error, name):

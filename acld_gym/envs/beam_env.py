@@ -208,7 +208,7 @@ class ACLDBeamEnv(BatchView, ConfigAttributes, FigureOwner, gym.Env):
       ``slew_rate``), temperature (``temperature``, ``temperature_range``) and reward
       scale (``reward_scale``, ``observe_reward_scale``) options exist, all off by
       default: v1's dynamics, rewards and observations are unchanged. acld-gym 0.7.0 adds
-      ``reward_scale="lqr"`` (off by default).
+      ``reward_scale="lqr"`` and 0.23.0 ``observe_commands`` (both off by default).
     * v0: the thesis configuration (``acld_gym.envs.presets.PRESETS["ACLDBeam-v0"]``):
       the thesis's 38-state mesh, its 6-state design model and observers, the same
       dynamics, reward, spaces and episode. It differs from v1 with ``mesh="thesis"`` in

@@ -99,7 +99,10 @@ def test_benchmark_runs_end_to_end(tmp_path, capsys, monkeypatch, v1_references)
     tables and statistics, its agents shippable (the exported actor acts as the trained
     policy did), a resume that trains nothing, and damaged files computed again. The
     references come from the session's file (``v1_references``: the same command's
-    cache, computed once), which the command checks and reads."""
+    cache, computed once), which the command checks and reads. ``--quiet``: no validation
+    score per learning-curve point on the console (those lines are
+    tests/train/test_levels.py's and the stack trials' of tests/train/test_stack.py)."""
+    import train.benchmark as benchmark
     import train.core.evaluate as evaluate
     from train.benchmark import main
     from train.compare import agent_names
@@ -118,6 +121,7 @@ def test_benchmark_runs_end_to_end(tmp_path, capsys, monkeypatch, v1_references)
         "--random-episodes",
         "1",
         "--no-bound",
+        "--quiet",
         "--out",
         str(out),
     ]
@@ -155,6 +159,10 @@ def test_benchmark_runs_end_to_end(tmp_path, capsys, monkeypatch, v1_references)
     _check_shippable(out, "tiny_vrs", 0, tmp_path / "agents")
     _check_shippable(out, "tiny_ppo", 1, tmp_path / "agents")
     assert agent_names(tmp_path / "agents") == ["tiny_ppo_shipped", "tiny_vrs_shipped"]
+    # the figure is drawn above (learning_curves.png); the repeats below hand their
+    # summaries to the same call, recorded here instead of drawing the figure twice more
+    drawn = []
+    monkeypatch.setattr(benchmark, "plot_curves", lambda summary, path: drawn.append(path))
     # a repeat with --resume trains nothing
     assert main([*argv, "--resume"]) == 0
     assert "0 runs to train (4 reused)" in capsys.readouterr().out
@@ -183,6 +191,7 @@ def test_benchmark_runs_end_to_end(tmp_path, capsys, monkeypatch, v1_references)
     assert "2 runs to train (2 reused)" in said
     assert json.loads(refs_file.read_text())["env_id"] == "ACLDBeam-v1"
     assert json.loads(record.read_text())["seed"] == 0
+    assert drawn == [out / "learning_curves.png"] * 2
 
 
 @pytest.mark.parametrize(

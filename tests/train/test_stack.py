@@ -90,6 +90,8 @@ def test_train_cli_is_a_benchmark_trial(algo, cpus, tmp_path, capsys, v1_referen
     )
     out = capsys.readouterr().out
     assert "ISE / LQR" in out and "case random" in out
+    # a line per learning-curve point with its validation score: the run's start and end
+    assert sum("validation cost" in line and "(32 loads)" in line for line in out.splitlines()) >= 2
     (tmp_path / "bench").mkdir()  # the session's references (tests/conftest.py), read back
     shutil.copyfile(v1_references, tmp_path / "bench" / "references-ACLDBeam-v1.json")
     recipe = yaml.safe_load(cfg.read_text())  # a run is retried only while it fails:
@@ -110,6 +112,7 @@ def test_train_cli_is_a_benchmark_trial(algo, cpus, tmp_path, capsys, v1_referen
                 "--random-episodes",
                 "1",
                 "--no-bound",
+                "--quiet",  # (the lines per curve point: the command above)
                 "--out",
                 str(tmp_path / "bench"),
             ]

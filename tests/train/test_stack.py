@@ -71,14 +71,20 @@ def test_overrides_of_the_command_line():
 
 
 @pytest.mark.parametrize("algo, cpus", [("ppo", 1), ("sac", 2)])
-def test_train_cli_is_a_benchmark_trial(algo, cpus, tmp_path, capsys, v1_references):
+def test_train_cli_is_a_benchmark_trial(algo, cpus, tmp_path, capsys, monkeypatch, v1_references):
     """``python -m train ALGO --seed N`` and ``python -m train.benchmark --seeds N`` give the
-    same agent, bit for bit, the one training its runs one after another, the other in this
-    process (``--cpus-per-trial 1``, PPO) or two at once in worker processes
-    (``--cpus-per-trial 2``, SAC; every algorithm's runs at once:
-    tests/train/test_restarts.py); it loads (validated) and acts in volts."""
+    same agent, bit for bit, the one training its runs one after another, the other asked
+    for ``--cpus-per-trial`` runs at once (1, PPO; 2, SAC); it loads (validated) and acts in
+    volts. The benchmark's trial hands ``train_algo`` ``workers=cpus`` (asserted), which
+    trains here one run after another: that two runs at once in worker processes are the
+    same runs, the same policy and record, is
+    tests/train/test_restarts.py::test_runs_at_once_are_the_runs_one_after_another's (the
+    two worker processes had cost this test ~9 s of CPU importing torch and SB3)."""
+    import inspect
+
     from train.benchmark import main as bench_main
     from train.cli import main as train_main
+    from train.core import algos
 
     cfg = _tiny(tmp_path, algo)
     a = tmp_path / "cli"
@@ -98,6 +104,15 @@ def test_train_cli_is_a_benchmark_trial(algo, cpus, tmp_path, capsys, v1_referen
     runs, timesteps = recipe["restarts"], recipe["timesteps"]  # the budget is the most
     assert recipe["restart_above"] is not None and runs > 1
     assert f"for up to {runs * timesteps} env steps (up to {runs} runs of {timesteps})" in out
+    real, asked = algos.train_algo, []
+
+    def train_here(*args, **kwargs):
+        call = inspect.signature(real).bind(*args, **kwargs)
+        asked.append(call.arguments.get("workers", 1))
+        call.arguments["workers"] = 1
+        return real(*call.args, **call.kwargs)
+
+    monkeypatch.setattr(algos, "train_algo", train_here)
     assert (
         bench_main(
             [
@@ -119,6 +134,7 @@ def test_train_cli_is_a_benchmark_trial(algo, cpus, tmp_path, capsys, v1_referen
         )
         == 0
     )
+    assert asked == [cpus]
     b = tmp_path / "bench" / "agents" / f"tiny_{algo}-s3"
     pa, pb = np.load(a / "policy.npz"), np.load(b / "policy.npz")
     assert sorted(pa.files) == sorted(pb.files)

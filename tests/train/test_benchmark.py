@@ -247,8 +247,8 @@ def test_ppo_with_whitening_and_quadratic_critic():
     from train.core.sb3_policies import SplitCriticPolicy
 
     data = yaml.safe_load(open("train/recipes/ppo.yaml"))
-    data.update(timesteps=4000, n_envs=2, whiten_steps=1000, eval_points=1)
-    data["model"] = {**data["model"], "n_steps": 500, "batch_size": 500, "n_epochs": 1}
+    data.update(timesteps=2000, n_envs=2, whiten_steps=500, eval_points=1)
+    data["model"] = {**data["model"], "n_steps": 250, "batch_size": 500, "n_epochs": 1}
     seen = []
     policy, record = train_algo(
         TrainConfig.from_dict(data),
@@ -256,8 +256,8 @@ def test_ppo_with_whitening_and_quadratic_critic():
         "ACLDBeam-v1",
         lambda steps, pol: seen.append((steps, pol.transform)),
     )
-    assert seen[0] == (0, None) and record["whiten_steps"] == 1000
-    assert record["steps"] >= 4000 and np.asarray(record["transform"]).shape == (9, 9)
+    assert seen[0] == (0, None) and record["whiten_steps"] == 500
+    assert record["steps"] >= 2000 and np.asarray(record["transform"]).shape == (9, 9)
     assert any(t is not None for _, t in seen[1:])  # whitened while training
     assert isinstance(policy.model.policy, SplitCriticPolicy) and policy.transform is None
     z = np.random.default_rng(1).normal(size=(4, 9)).astype(np.float32)

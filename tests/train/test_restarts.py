@@ -283,7 +283,7 @@ def test_runs_at_once_are_the_runs_one_after_another(restart_above, trained):
         400,
         restarts=3,
         restart_above=restart_above,
-        select={"episodes": 2, "every": 200, "start": 0},
+        select={"episodes": 2, "every": 400, "start": 0},
     )
     curve = CaseISE("ACLDBeam-v1", evaluate.eval_episodes(1))  # pickles to the workers
     p1, r1 = train_algo(cfg, 3, "ACLDBeam-v1", curve, workers=1)

@@ -11,6 +11,7 @@ import os
 import shutil
 import tempfile
 from multiprocessing import util as _mp_util
+from pathlib import Path
 
 import pytest
 
@@ -18,6 +19,9 @@ _SESSION_TMP = tempfile.mkdtemp(prefix="acld-gym-tests-")
 os.environ["TMPDIR"] = _SESSION_TMP  # subprocesses
 tempfile.tempdir = _SESSION_TMP  # this process: tempfile.gettempdir(), pytest's tmp_path
 os.environ.setdefault("ACLD_GYM_CACHE_DIR", os.path.join(_SESSION_TMP, "plant-cache"))
+#: The session's folder shared by its xdist workers: the controller's (the workers inherit
+#: its environment, so their plant cache above is the controller's too).
+os.environ.setdefault("ACLD_GYM_TESTS_SHARED_TMP", _SESSION_TMP)
 _mp_util.Finalize(
     None, shutil.rmtree, args=(_SESSION_TMP,), kwargs={"ignore_errors": True}, exitpriority=-1000
 )
@@ -34,14 +38,19 @@ except ImportError:  # the core install has no torch
 def v1_references(tmp_path_factory):
     """The references of ``python -m train.benchmark --no-bound --random-episodes 1`` on
     ACLDBeam-v1 (:func:`train.core.evaluate.references`: passive, LQR, SMC and MPC on the
-    thesis cases and one held-out load, and the validation cost on 256 loads), computed
-    once per session (per xdist worker) and written by the command's own cache writer.
-    The tiny benchmarks of ``tests/train`` copy the file into their ``--out`` folder as
-    ``references-ACLDBeam-v1.json``; the command checks its key and reads it back instead
-    of computing it again (its MPC episodes and validation loads were most of each test's
-    time)."""
+    thesis cases and one held-out load, and the validation cost on 256 loads), written by
+    the command's own cache writer into the session's shared folder: computed once per
+    session (~3 s of CPU), by the first xdist worker that asks, and read back (its key
+    checked) by the others. The tiny benchmarks of ``tests/train`` copy the file into
+    their ``--out`` folder as ``references-ACLDBeam-v1.json``; the command checks its key
+    and reads it back instead of computing it again (its MPC episodes and validation
+    loads were most of each test's time)."""
+    import fcntl
+
     from train.core.evaluate import references
 
-    path = tmp_path_factory.mktemp("references") / "references-ACLDBeam-v1.json"
-    references("ACLDBeam-v1", path, 1, bound=False)
+    path = Path(os.environ["ACLD_GYM_TESTS_SHARED_TMP"]) / "references-ACLDBeam-v1.json"
+    with open(path.with_suffix(".lock"), "w") as lock:  # a second worker waits, then reads
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        references("ACLDBeam-v1", path, 1, bound=False)
     return path

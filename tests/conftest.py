@@ -35,7 +35,7 @@ except ImportError:  # the core install has no torch
 
 
 @pytest.fixture(scope="session")
-def v1_references(tmp_path_factory):
+def v1_references():
     """The references of ``python -m train.benchmark --no-bound --random-episodes 1`` on
     ACLDBeam-v1 (:func:`train.core.evaluate.references`: passive, LQR, SMC and MPC on the
     thesis cases and one held-out load, and the validation cost on 256 loads), written by

@@ -62,8 +62,8 @@ from .agent_program import (
     linear_program,
     observation_width,
 )
-from .agent_schema import FORMAT, AgentFileError, parse_metadata
-from .commands import CommandMemory
+from .agent_schema import FORMAT, FORMAT_PLAIN, AgentFileError, check_commands, parse_metadata
+from .commands import CommandMemory, command_memory
 from .sb3_export import actor_extractor, actor_parts, export_sb3
 from .voltage import VoltageMap
 
@@ -124,11 +124,13 @@ class TrainedAgent:
             self.map = VoltageMap(
                 self.metadata.get("residual"), headroom=self.metadata.get("action_headroom", 1.0)
             )
-            commands = self.metadata.get("commands")
-            #: Its memory of its own commands (trained with ``observe_commands``), or None.
-            self.commands = None if commands is None else CommandMemory(**commands)
-        except (TypeError, ValueError) as exc:
+        except ValueError as exc:
             raise AgentFileError(f"{META_FILE}: {exc}") from None
+        commands = self.metadata.get("commands")
+        if commands is not None:
+            check_commands(commands, META_FILE)
+        #: Its memory of its own commands (trained with ``observe_commands``), or None.
+        self.commands = None if commands is None else CommandMemory(**commands)
 
     # --- what it was trained on --------------------------------------------------------
     @property
@@ -150,7 +152,8 @@ class TrainedAgent:
         (:func:`train.agent_write.write_folder`): what was there before is replaced, or,
         if the write fails, left as it was. ``ValueError`` if ``directory`` holds other
         files than an agent's or a training run's."""
-        meta = dict(self.metadata, format=FORMAT, actor=self.actor.ops)
+        fmt = FORMAT if self.commands is not None else FORMAT_PLAIN  # older readers: 1-2
+        meta = dict(self.metadata, format=fmt, actor=self.actor.ops)
         return write_folder(directory, self.actor.arrays, meta, dict(files or {}))
 
     @classmethod
@@ -220,6 +223,14 @@ class TrainedAgent:
                 f"agent {str(where)!r} was trained on another observation "
                 f"than {env_id}'s today: " + "; ".join(diff)
             )
+        if self.commands is not None:  # its memory must be the commands that env has in flight
+            kwargs = {**env_meta.get("kwargs", {}), "observe_commands": True}
+            want = command_memory(env_id, kwargs)
+            if want is None or want.as_dict() != self.commands.as_dict():
+                raise AgentFileError(
+                    f"{meta_file}: commands: {self.commands.as_dict()} are not the commands "
+                    f"{env_id} has in flight ({None if want is None else want.as_dict()})"
+                )
         try:
             self.actor.check_width(width + self.observed_commands)
         except AgentFileError as exc:

@@ -28,6 +28,8 @@ from acld_gym.wrappers import MAX_HEADROOM, check_headroom
 __all__ = [
     "AgentFileError",
     "FORMAT",
+    "FORMAT_PLAIN",
+    "check_commands",
     "MAX_DEPTH",
     "MAX_OPS",
     "OP_KEYS",
@@ -38,7 +40,10 @@ __all__ = [
 ]
 
 #: Version of the agent format this package writes (and the newest it reads).
-FORMAT = 2
+FORMAT = 3
+#: The format of an agent without a memory of its commands (format 3 adds ``commands``),
+#: written so that packages reading formats 1-2 still read it.
+FORMAT_PLAIN = 2
 #: Deepest nesting of lists and objects a metadata file may have (a shipped one has 5).
 MAX_DEPTH = 32
 #: Most operations an actor program may have (a shipped one has 3).
@@ -145,7 +150,7 @@ def check_metadata(meta, where: str = "metadata.json") -> dict:
     if meta.get("residual") not in (None, "lqr"):
         raise _fail(where, "residual", f"expected null or 'lqr', got {shown(meta['residual'])}")
     if meta.get("commands") is not None:
-        _check_commands(meta["commands"], where)
+        check_commands(meta["commands"], where)
     if "action_headroom" in meta:
         headroom = meta["action_headroom"]
         try:  # is_real first: check_headroom cannot take an integer beyond the float range
@@ -159,14 +164,14 @@ def check_metadata(meta, where: str = "metadata.json") -> dict:
     return meta
 
 
-def _check_commands(commands, where: str) -> None:
+def check_commands(commands, where: str) -> None:
     """``commands``: ``{"memory": m, "observed": k}``, integers with 1 <= m <= the
-    largest delay and 0 <= k <= m (:class:`train.commands.CommandMemory`)."""
+    largest delay and 1 <= k <= m (:class:`train.commands.CommandMemory`)."""
     ok = isinstance(commands, dict) and set(commands) == {"memory", "observed"}
     values = [commands.get(k) for k in ("memory", "observed")] if ok else []
     if ok and all(isinstance(v, int) and not isinstance(v, bool) for v in values):
         m, k = values
-        ok = 1 <= m <= MAX_DELAY and 0 <= k <= m
+        ok = 1 <= m <= MAX_DELAY and 1 <= k <= m
     else:
         ok = False
     if not ok:
@@ -174,7 +179,7 @@ def _check_commands(commands, where: str) -> None:
             where,
             "commands",
             f"expected null or {{'memory': m, 'observed': k}} with integers "
-            f"1 <= m <= {MAX_DELAY}, 0 <= k <= m, got {shown(commands)}",
+            f"1 <= m <= {MAX_DELAY}, 1 <= k <= m, got {shown(commands)}",
         )
 
 

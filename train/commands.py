@@ -37,12 +37,12 @@ class CommandMemory:
     memory : int
         The commands kept, the rig's ``actuator_delay`` (1 .. MAX_DELAY).
     observed : int
-        The oldest of them the observation gets, 0 .. ``memory``
+        The oldest of them the observation gets, 1 .. ``memory``
         (:func:`acld_gym.envs.step.commands_in_flight`).
     """
 
     def __init__(self, memory: int, observed: int):
-        for name, value, low in (("memory", memory, 1), ("observed", observed, 0)):
+        for name, value, low in (("memory", memory, 1), ("observed", observed, 1)):
             if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
                 raise ValueError(f"{name} must be an integer, got {value!r}")
             if not low <= value <= MAX_DELAY:
@@ -59,7 +59,8 @@ class CommandMemory:
         """``(x, state)``: the observations ``obs`` (n, d) with the remembered commands
         appended (n, d + observed), and the memory (n, memory) with the rows whose
         ``episode_start`` is true (every row if ``state`` is None) at rest. ``ValueError``
-        naming ``state`` if it is not this memory's for n envs."""
+        naming ``state`` if it is not this memory's for n envs, or ``episode_start`` if it
+        is not n flags."""
         n = obs.shape[0]
         if state is None:
             state = np.zeros((n, self.memory), np.float32)
@@ -74,8 +75,12 @@ class CommandMemory:
             state = state.copy()
         if episode_start is not None:
             start = np.asarray(episode_start, dtype=bool).reshape(-1)
-            if start.shape == (n,):
-                state[start] = 0.0
+            if start.shape != (n,):
+                raise ValueError(
+                    f"episode_start: expected {n} flags (one per observation), got shape "
+                    f"{np.shape(episode_start)}"
+                )
+            state[start] = 0.0
         x = np.concatenate([obs, state[:, : self.observed].astype(obs.dtype)], axis=1)
         return x, state
 

@@ -121,6 +121,11 @@ def check_config(cfg) -> None:
             "distill needs residual: null (the action's sign is the "
             f"voltage's), got residual {cfg.residual!r}"
         )
+    if (cfg.residual or cfg.distill is not None) and cfg.env_kwargs.get("observe_commands"):
+        raise ValueError(
+            "env_kwargs: observe_commands cannot go with residual or distill (the LQR "
+            "residual and the teacher read the env's own observation)"
+        )
     if cfg.select is not None and cfg.normalize.get("norm_obs", False):
         raise ValueError(
             "select needs norm_obs: false (the chosen parameters would "

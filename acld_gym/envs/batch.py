@@ -112,11 +112,12 @@ class BatchStep:
         self.est = estimate_map(obs, nom.xr_scale)
         self.layout = lay = StepLayout.of(c, nom, obs)
         #: The observation's size: the design's plus the appended entries (the commands in
-        #: flight, then log c: :func:`acld_gym.envs.step.appended_size`).
+        #: flight, then log c: :func:`acld_gym.envs.step.appended_size`), the slots of Z of
+        #: those commands, and whether a step's result changes after the product (the gate).
         self.n_obs = observation_size(nom, c.obs_mode) + appended_size(c)
-        #: The slots of Z the observation appends (the commands in flight, oldest first).
         n_cmd = commands_in_flight(c.obs_mode, c.actuator_delay) if c.observe_commands else 0
         self.command_slots = np.arange(lay.buffer.start, lay.buffer.start + n_cmd)
+        self.appends = appended_size(c) > 0 or c.reward_scale is not None
         #: The reward scale c of each env's episode (:mod:`acld_gym.envs.scale`; ones
         #: unless ``reward_scale``): every reward is divided by it.
         self.reward_scale = np.ones(N)
@@ -282,9 +283,9 @@ class BatchStep:
 
     # --- the appended entries and the reward scale (acld_gym.envs.scale) -------------------
     def scaled(self, res):
-        """A compiled vector step's 5-tuple with the options applied (the commands in flight
-        and log c appended, the reward divided by :attr:`reward_scale`, its info)."""
-        if self.scale_cost is None and not self.command_slots.size:
+        """A compiled vector step's 5-tuple with the options applied (:meth:`_append`, the
+        reward divided by :attr:`reward_scale`, its info)."""
+        if not self.appends:
             return res
         obs, reward, terminated, truncated, info = res
         self.scale_info(info)
@@ -292,7 +293,7 @@ class BatchStep:
 
     def scaled_one(self, res):
         """:meth:`scaled` for the compiled ``step_one`` of env 0 (None stays None)."""
-        if res is None or (self.scale_cost is None and not self.command_slots.size):
+        if res is None or not self.appends:
             return res
         obs, reward, terminated, truncated, info = res
         s = float(self.reward_scale[0])
@@ -301,8 +302,7 @@ class BatchStep:
         return self._append(obs[None], [0])[0], reward / s, terminated, truncated, info
 
     def scale_info(self, info: dict, rows=None) -> None:
-        """Add ``info["reward_scale"]`` (and its mask) of ``rows`` (default all) to a vector
-        info, with ``reward_scale`` set."""
+        """Add ``info["reward_scale"]`` and its mask (``rows``, default all) to a vector info."""
         if self.scale_cost is not None:
             s = self.reward_scale if rows is None else self.reward_scale[rows]
             info["reward_scale"] = s.copy()

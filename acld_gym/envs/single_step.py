@@ -65,7 +65,7 @@ def fast_step(b: BatchStep):
     :func:`no_fast_path`."""
     if b.core is None:
         return no_fast_path
-    if b.scale_cost is None and not b.command_slots.size:
+    if not b.appends:
         return b.core.step_one
     step_one, scaled_one = b.core.step_one, b.scaled_one
     return lambda action: scaled_one(step_one(action))

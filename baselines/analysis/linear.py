@@ -117,7 +117,7 @@ def small_signal_law(
     if state is not None:
         return None, (
             "the policy has a state (a dynamic law, e.g. its own observer on the "
-            "measurements): no static law of the observation"
+            "measurements, or a memory of its own commands): no static law of the observation"
         )
     v0 = float(_voltages(policy, np.zeros((1, obs_size)))[0])
     room = v_max - abs(v0)

@@ -297,7 +297,7 @@ MALFORMED = [
         lambda m: {k: v for k, v in m.items() if k != "observation"},
         r"lacks \['observation'\]",
     ),
-    (lambda m: {**m, "format": 99}, "format: expected an agent format 1 to 2"),
+    (lambda m: {**m, "format": 99}, "format: expected an agent format 1 to 3"),
     (lambda m: {**m, "residual": "mpc"}, "residual: expected null or 'lqr'"),
     (lambda m: {**m, "algo": ["x"]}, "algo: expected null or one printable line"),
     (lambda m: {**m, "training": "ok\x1b[2J"}, "training: expected null or one printable"),

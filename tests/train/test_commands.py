@@ -62,6 +62,34 @@ def test_a_memory_only_where_the_env_appends_commands(env_id, kwargs, expected):
     assert (memory and memory.as_dict()) == expected
 
 
+def test_episode_start_of_another_shape_is_refused_in_one_line():
+    memory = CommandMemory(1, 1)
+    with pytest.raises(ValueError, match=r"^episode_start: expected 3 flags"):
+        memory.observe(np.zeros((3, 9), np.float32), None, np.array([True]))
+
+
+def test_a_memory_is_checked_against_the_commands_its_env_has_in_flight(lab_agent, tmp_path):
+    """An agent whose memory is not its level's delay line (another delay, or a memory on
+    a rig without one) is refused at load, naming the field; the one saved is format 3,
+    which packages reading formats 1-2 refuse by its number."""
+    meta = json.loads((lab_agent / "metadata.json").read_text())
+    assert meta["format"] == 3
+    for i, (commands, kwargs) in enumerate(
+        [
+            ({"memory": 3, "observed": 1}, {}),  # a memory longer than the lab rig's delay
+            (meta["commands"], {"actuator_delay": 2}),  # trained where two are in flight
+            (meta["commands"], {"actuator_delay": 0}),  # a rig without a delay
+        ]
+    ):
+        bad = tmp_path / f"bad-{i}"
+        bad.mkdir()
+        (bad / "policy.npz").write_bytes((lab_agent / "policy.npz").read_bytes())
+        changed = dict(meta, commands=commands, env={"id": LAB, "kwargs": kwargs})
+        (bad / "metadata.json").write_text(json.dumps(changed))
+        with pytest.raises(AgentFileError, match=r"metadata.json: commands: .* are not the"):
+            TrainedAgent.load(bad)
+
+
 def test_a_state_of_another_shape_is_refused_in_one_line():
     memory = CommandMemory(2, 2)
     with pytest.raises(
@@ -139,7 +167,14 @@ def test_score_runs_a_library_policy_on_the_observation_it_was_trained_on(lab_pp
 
 
 @pytest.mark.parametrize(
-    "bad", [{"memory": 0, "observed": 0}, {"memory": 1, "observed": 2}, {"memory": "1"}, [1, 1]]
+    "bad",
+    [
+        {"memory": 0, "observed": 0},
+        {"memory": 1, "observed": 0},
+        {"memory": 1, "observed": 2},
+        {"memory": "1"},
+        [1, 1],
+    ],
 )
 def test_a_bad_commands_field_is_refused(bad, lab_agent):
     meta = json.loads((lab_agent / "metadata.json").read_text())
@@ -153,3 +188,10 @@ def test_the_search_cannot_observe_commands():
         TrainConfig.from_dict(
             {"algo": "vrs", "timesteps": 1000, "env_kwargs": {"observe_commands": True}}
         )
+
+
+def test_an_lqr_residual_cannot_observe_commands():
+    """The LQR residual reads the env's own observation: refused before any training."""
+    data = {"algo": "sac", "timesteps": 1000, "residual": "lqr", "model": {"policy": "MlpPolicy"}}
+    with pytest.raises(ValueError, match="observe_commands cannot go with residual"):
+        TrainConfig.from_dict({**data, "env_kwargs": {"observe_commands": True}})

@@ -63,7 +63,7 @@ from .agent_program import (
     observation_width,
 )
 from .agent_schema import FORMAT, FORMAT_PLAIN, AgentFileError, check_commands, parse_metadata
-from .commands import CommandMemory, command_memory
+from .commands import CommandMemory, memory_of
 from .sb3_export import actor_extractor, actor_parts, export_sb3
 from .voltage import VoltageMap
 
@@ -216,6 +216,8 @@ class TrainedAgent:
                 self.observation_fingerprint, observation_fingerprint(env)
             )
             width = env.observation_space.shape[0]
+            # the memory it must have: the commands that env has in flight
+            want = memory_of(env.unwrapped.config.replace(observe_commands=True))
         finally:
             env.close()
         if diff:
@@ -223,9 +225,7 @@ class TrainedAgent:
                 f"agent {str(where)!r} was trained on another observation "
                 f"than {env_id}'s today: " + "; ".join(diff)
             )
-        if self.commands is not None:  # its memory must be the commands that env has in flight
-            kwargs = {**env_meta.get("kwargs", {}), "observe_commands": True}
-            want = command_memory(env_id, kwargs)
+        if self.commands is not None:
             if want is None or want.as_dict() != self.commands.as_dict():
                 raise AgentFileError(
                     f"{meta_file}: commands: {self.commands.as_dict()} are not the commands "

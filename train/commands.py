@@ -21,10 +21,10 @@ import numpy as np
 
 from acld_gym.envs.limits import MAX_DELAY
 from acld_gym.envs.presets import preset
-from acld_gym.envs.step import commands_in_flight
+from acld_gym.envs.step import observed_commands
 from acld_gym.physics.actuator import V_LIMIT
 
-__all__ = ["CommandMemory", "command_memory"]
+__all__ = ["CommandMemory", "command_memory", "memory_of"]
 
 
 class CommandMemory:
@@ -98,8 +98,12 @@ def command_memory(env_id: str, env_kwargs: dict | None) -> CommandMemory | None
     """The memory of a policy trained on ``env_id`` with ``env_kwargs``: None unless
     ``observe_commands`` appends commands there (a delay, and not only the newest command
     in the ``"measurement"`` observation, which has it)."""
-    config = preset(env_id, **dict(env_kwargs or {}))
-    observed = commands_in_flight(config.obs_mode, config.actuator_delay)
-    if not config.observe_commands or observed == 0:
-        return None
-    return CommandMemory(config.actuator_delay, observed)
+    return memory_of(preset(env_id, **dict(env_kwargs or {})))
+
+
+def memory_of(config) -> CommandMemory | None:
+    """The memory of a policy trained on the env of ``config`` (an
+    :class:`acld_gym.envs.config.EnvConfig`): None unless its observation appends commands
+    (:func:`acld_gym.envs.step.observed_commands`)."""
+    observed = observed_commands(config)
+    return CommandMemory(config.actuator_delay, observed) if observed else None

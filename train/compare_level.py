@@ -26,7 +26,6 @@ from .agent_files import read_metadata
 __all__ = [
     "Level",
     "agent_level",
-    "folder_agents",
     "resolve_level",
     "level_config",
     "check_agents_fit",
@@ -54,12 +53,6 @@ def agent_level(path: str | Path) -> tuple[str, str]:
     naming the folder or the file if it does not read."""
     env = read_metadata(path)["env"]
     return env["id"], agent_mesh(env)
-
-
-def folder_agents(directory: str | Path) -> list[str]:
-    """Every agent folder under ``directory``, whatever its mesh (sorted; a folder whose
-    metadata does not read included, so that reading it names the fault)."""
-    return [name for name, _ in agent_folders(directory)]
 
 
 def resolve_level(
@@ -96,8 +89,13 @@ def resolve_level(
         A named agent's folder that is missing or unreadable.
     """
     directory = Path(directory)
-    names = list(only) or folder_agents(directory)
-    levels = {name: agent_level(directory / name) for name in names}
+    if only:
+        levels = {name: agent_level(directory / name) for name in only}
+    else:  # each metadata read once; one that does not read names its fault here
+        levels = {
+            n: agent_level(directory / n) if env is None else (env["id"], agent_mesh(env))
+            for n, env in agent_folders(directory)
+        }
     if not only and mesh is not None:  # --mesh chooses the agents, as before levels
         levels = {n: lv for n, lv in levels.items() if lv[1] == mesh}
     ids = {n: lv[0] for n, lv in levels.items()}

@@ -34,10 +34,10 @@ from acld_gym.envs.step import (
     Y_SCALE,
     StepLayout,
     appended_size,
-    commands_in_flight,
     estimate_map,
     load_schedule,
     observation_size,
+    observed_commands,
     output_matrix,
     rest_output,
     reward_terms,
@@ -115,8 +115,7 @@ class BatchStep:
         #: flight, then log c: :func:`acld_gym.envs.step.appended_size`), the slots of Z of
         #: those commands, and whether a step's result changes after the product (the gate).
         self.n_obs = observation_size(nom, c.obs_mode) + appended_size(c)
-        n_cmd = commands_in_flight(c.obs_mode, c.actuator_delay) if c.observe_commands else 0
-        self.command_slots = np.arange(lay.buffer.start, lay.buffer.start + n_cmd)
+        self.command_slots = slice(lay.buffer.start, lay.buffer.start + observed_commands(c))
         self.appends = appended_size(c) > 0 or c.reward_scale is not None
         #: The reward scale c of each env's episode (:mod:`acld_gym.envs.scale`; ones
         #: unless ``reward_scale``): every reward is divided by it.
@@ -311,7 +310,8 @@ class BatchStep:
     def _append(self, obs: np.ndarray, rows=None) -> np.ndarray:
         """The observations ``obs`` of ``rows`` (default all) with the appended entries."""
         rows = slice(None) if rows is None else rows
-        extra = [self.Z[rows][:, self.command_slots] / V_LIMIT] if self.command_slots.size else []
+        slots = self.command_slots
+        extra = [self.Z[rows, slots] / V_LIMIT] if slots.stop > slots.start else []
         if self.config.observe_reward_scale:
             extra.append(np.log(self.reward_scale[rows])[:, None])
         return np.concatenate([obs, *extra], axis=-1, dtype=np.float32) if extra else obs

@@ -25,6 +25,7 @@ __all__ = [
     "TERMINATED_BY",
     "observation_size",
     "commands_in_flight",
+    "observed_commands",
     "appended_size",
     "estimate_slots",
     "estimate_map",
@@ -254,13 +255,21 @@ def commands_in_flight(obs_mode: str, delay: int) -> int:
     return max(int(delay) - int(obs_mode == "measurement"), 0)
 
 
+def observed_commands(config) -> int:
+    """How many commands the observation of ``config`` (an
+    :class:`acld_gym.envs.config.EnvConfig`) appends: :func:`commands_in_flight` with
+    ``observe_commands``, else none."""
+    if not config.observe_commands:
+        return 0
+    return commands_in_flight(config.obs_mode, config.actuator_delay)
+
+
 def appended_size(config) -> int:
     """The entries appended to the design's observation (:func:`observation_size`) by the
     options of ``config`` (:class:`acld_gym.envs.config.EnvConfig`), in this order: the
     commands in flight (``observe_commands``, :func:`commands_in_flight`), then log c
     (``observe_reward_scale``), always last."""
-    commands = commands_in_flight(config.obs_mode, config.actuator_delay)
-    return commands * bool(config.observe_commands) + int(config.observe_reward_scale)
+    return observed_commands(config) + int(config.observe_reward_scale)
 
 
 def estimate_slots(order: int, modes: int) -> np.ndarray:

@@ -6,7 +6,6 @@
 from __future__ import annotations
 
 import importlib
-import importlib.metadata
 import re
 import subprocess
 import sys
@@ -64,10 +63,16 @@ def test_the_command_table_names_this_package_only():
     assert "os" not in COMMANDS and "train.console" not in COMMANDS
 
 
-def test_version_is_the_installed_metadata(capsys):
+def test_version_is_the_running_package_and_the_project_file(capsys):
+    import tomllib
+
+    import acld_gym
+
     code, out, err = run(["--version"], capsys)
     assert (code, err) == (0, "")
-    assert out == f"acld-gym {importlib.metadata.version('acld-gym')}\n"
+    assert out == f"acld-gym {acld_gym.__version__}\n"
+    project = tomllib.loads((Path(__file__).parents[1] / "pyproject.toml").read_text())
+    assert project["project"]["version"] == acld_gym.__version__  # one version, two places
 
 
 @pytest.mark.parametrize(

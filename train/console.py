@@ -92,17 +92,11 @@ EXTRA_MODULES: dict[str, tuple[str, ...]] = {
 
 
 def version() -> str:
-    """The installed package's version (its metadata; in a checkout that is not installed,
-    ``acld_gym.__version__``)."""
-    from importlib.metadata import PackageNotFoundError
-    from importlib.metadata import version as installed
+    """The version of the package that runs: ``acld_gym.__version__`` (an editable install's
+    metadata keeps the version it was installed at; the code imported is what answers)."""
+    import acld_gym
 
-    try:
-        return installed("acld-gym")
-    except PackageNotFoundError:
-        import acld_gym
-
-        return acld_gym.__version__
+    return acld_gym.__version__
 
 
 def help_text() -> str:

@@ -66,11 +66,13 @@ def _short(score: dict, full: int) -> str:
     return " (reduced)" if score["n_episodes"] < full else ""
 
 
-def replace_block(text: str, block: str, path: str | Path) -> str:
-    """``text`` with what lies between :data:`START` and :data:`END` (markers included)
-    replaced by ``block``; ``DataFileError`` naming ``path`` unless each marker is there
-    once, in order."""
-    if text.count(START) != 1 or text.count(END) != 1 or text.index(START) > text.index(END):
-        raise file_error(path, None, f"expected one {START} and one {END} after it")
-    head, rest = text.split(START)
-    return head + block + rest.split(END, 1)[1]
+def replace_block(
+    text: str, block: str, path: str | Path, start: str = START, end: str = END
+) -> str:
+    """``text`` with what lies between ``start`` and ``end`` (markers included; default
+    :data:`START` and :data:`END`) replaced by ``block``; ``DataFileError`` naming ``path``
+    unless each marker is there once, in order."""
+    if text.count(start) != 1 or text.count(end) != 1 or text.index(start) > text.index(end):
+        raise file_error(path, None, f"expected one {start} and one {end} after it")
+    head, rest = text.split(start)
+    return head + block + rest.split(end, 1)[1]

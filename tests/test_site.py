@@ -172,6 +172,64 @@ def test_api_links_and_type_columns(site):
     assert not sentences, sentences[:10]
 
 
+#: a parameter table's Description that opens with a type: a dotted path
+#: (``gymnasium.vector.VectorEnv The env ...``) or a numpydoc container type
+TYPE_FIRST = re.compile(
+    r"(?:[A-Za-z_]\w*(?:\.[A-Za-z_]\w*)+|(?:sequence|list|tuple|dict|iterable|mapping) of \w+)"
+    r"[,\s]"
+)
+SECTION = re.compile(r'doc-section-title">(\w+):</span></p>\s*<table>(.*?)</table>', re.S)
+
+
+def _text(cell: str) -> str:
+    return " ".join(html.unescape(re.sub("<[^>]+>", "", cell)).split())
+
+
+def misplaced_types(page: str) -> list[tuple[str, list[str]]]:
+    """Rows of a page's typed sections whose Description starts with a type (the
+    docstring's type moved out of the Type column) or, for a parameter or attribute, is
+    empty, and rows whose Type holds a whole ``name : type`` line."""
+    bad = []
+    for kind, table in SECTION.findall(page):
+        head = re.findall(r"<th>(.*?)</th>", table)
+        if "Description" not in head:
+            continue
+        col, typ = head.index("Description"), head.index("Type") if "Type" in head else None
+        for row in re.findall(r"<tr[^>]*>(.*?)</tr>", table, re.S):
+            cells = [_text(c) for c in re.findall(r"<td[^>]*>(.*?)</td>", row, re.S)]
+            if len(cells) <= col:
+                continue
+            empty = kind in ("Parameters", "Attributes") and not cells[col]
+            named = typ is not None and " : " in cells[typ]
+            if empty or named or TYPE_FIRST.match(cells[col]):
+                bad.append((kind, cells))
+    return bad
+
+
+def test_misplaced_types_are_found():
+    def table(kind, *rows):
+        body = "".join("<tr>" + "".join(f"<td>{c}</td>" for c in r) + "</tr>" for r in rows)
+        head = "<th>Name</th><th>Type</th><th>Description</th>"
+        return f'<p><span class="doc-section-title">{kind}:</span></p>\n<table>{head}{body}</table>'
+
+    good = table("Parameters", ("env", "VectorEnv", "A vector env. See <code>a.b</code>."))
+    assert misplaced_types(good) == []
+    moved = table("Parameters", ("env", "", "gymnasium.vector.VectorEnv A vector env."))
+    assert misplaced_types(moved) == [
+        ("Parameters", ["env", "", "gymnasium.vector.VectorEnv A vector env."])
+    ]
+    for desc in ("sequence of callables env -> env The wrappers.", "a.b.C, optional The x."):
+        assert len(misplaced_types(table("Parameters", ("x", "", desc)))) == 1
+    assert len(misplaced_types(table("Attributes", ("passthrough", "int", "")))) == 1
+    assert misplaced_types(table("Returns", ("", "BoundSolution", ""))) == []
+    assert len(misplaced_types(table("Returns", ("", "(low, high) : tuple of float", "")))) == 1
+
+
+def test_types_stay_in_the_type_column(site):
+    bad = {page: misplaced_types(text) for page, text in site.items() if page.startswith("api/")}
+    assert not any(bad.values()), {page: rows[:5] for page, rows in bad.items() if rows}
+
+
 def test_public_api_comes_first(site):
     public = site["api/public/index.html"]
     headings = re.findall(r'<h[23][^>]*id="([^"]+)"', public)

@@ -141,16 +141,18 @@ def score(
 
     Parameters
     ----------
-    policy : SB3 model, TrainedAgent, object with ``predict``, or callable
-        The policy, on the observation the ``wrappers`` give; its deterministic action.
+    policy : BaseAlgorithm, TrainedAgent, object or callable
+        The policy (an SB3 model, a :class:`train.agent.TrainedAgent`, any object with SB3's
+        ``predict``, or a callable ``observation -> action``), on the observation the
+        ``wrappers`` give; its deterministic action.
         A :class:`train.agent.TrainedAgent` acts on the raw observation in volts (no
         wrappers), and is refused on a level whose observation differs from the one it was
         trained on (its fingerprint).
     env_id : str
         One of this package's ids (``ACLDBeam-v1``, ``ACLDBeamLab-v1``, ...).
-    wrappers : sequence of callables env -> env
-        The single-env wrappers it was trained with, innermost first: classes
-        (``UnitAction``) or callables (``functools.partial(ObserveModes, modes=1)``,
+    wrappers : sequence of callable
+        The single-env wrappers it was trained with (each ``env -> env``), innermost first:
+        classes (``UnitAction``) or callables (``functools.partial(ObserveModes, modes=1)``,
         ``lambda e: RescaleAction(e, -1.0, 1.0)``).
     vec_normalize : VecNormalize, path, False or None
         SB3's ``VecNormalize`` the policy was trained under (its observation statistics

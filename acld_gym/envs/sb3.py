@@ -155,13 +155,13 @@ class SB3VecEnv(VecEnv):
         Number of sub-envs (default 1) when the adapter builds the env; with ``venv=``,
         omitted or ``venv``'s own count (another count is refused). The first positional
         argument or a keyword; a string there (a level id) is refused: pass ``env_id=``.
-    venv : gymnasium.vector.VectorEnv, optional
+    venv : VectorEnv, optional
         An existing env: an :class:`ACLDBeamVectorEnv` (``gym.make_vec`` of an acld_gym
         id), bare or in vector action, observation and reward wrappers (e.g.
         ``vector.ObserveModes(vector.UnitAction(gym.make_vec(...)))``; see
         :func:`wrapper_chain`). Not together with ``env_id``, ``config`` or the env's
         keywords.
-    config : acld_gym.envs.config.EnvConfig, optional
+    config : EnvConfig, optional
         The env's configuration, with or instead of its fields as keywords (``**env_kwargs``).
         Not together with ``env_id`` (a level's configuration with changes:
         ``config=acld_gym.envs.presets.preset(id, ...)``).
@@ -189,7 +189,7 @@ class SB3VecEnv(VecEnv):
     ----------
     venv : ACLDBeamVectorEnv
         The native env (unwrapped): ``get_attr``, ``set_attr`` and ``env_method`` reach it.
-    vector_env : gymnasium.vector.VectorEnv
+    vector_env : VectorEnv
         The env this adapter steps: ``venv`` in the wrappers (``venv`` itself without).
 
     Notes

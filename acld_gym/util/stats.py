@@ -44,7 +44,12 @@ def stratified_bootstrap_ci(
 
     Returns
     -------
-    (low, high) : tuple of float
+    low : float
+        The interval's lower end: the ``(1 - confidence) / 2`` quantile of the replicates'
+        statistic (the score's units).
+    high : float
+        Its upper end, the ``(1 + confidence) / 2`` quantile; the pair is returned as a
+        tuple ``(low, high)``.
     """
     x = np.asarray(scores, dtype=np.float64)
     if x.ndim == 1:

@@ -48,7 +48,7 @@ class UnitMap:
 
     Parameters
     ----------
-    action_space : gymnasium.spaces.Box
+    action_space : spaces.Box
         The wrapped env's action space (one sub-env's): a symmetric 1-D Box
         :math:`[-v_{max}, v_{max}]` [V] of shape (1,).
     headroom : float
@@ -61,7 +61,7 @@ class UnitMap:
     ----------
     headroom, v_max : float
         k and :math:`v_{max}` [V].
-    space : gymnasium.spaces.Box
+    space : spaces.Box
         ``Box(-1, 1, (1,), float32)``, the action space one sub-env offers.
     """
 
@@ -99,8 +99,9 @@ class ModeSlots:
 
     Parameters
     ----------
-    config : acld_gym.envs.config.EnvConfig or None
-        The wrapped ACLDBeam env's configuration (None: not an ACLDBeam env, refused).
+    config : EnvConfig or None
+        The wrapped ACLDBeam env's configuration (:class:`acld_gym.envs.config.EnvConfig`;
+        None: not an ACLDBeam env, refused).
     shape : tuple of int
         The shape of one observation of the wrapped env, which must be the env's own.
     modes : int
@@ -112,7 +113,7 @@ class ModeSlots:
     ----------
     slots : numpy.ndarray
         The indices kept, in order.
-    space : gymnasium.spaces.Box
+    space : spaces.Box
         The observation space of one sub-env after the map (float32, unbounded).
     """
 
@@ -166,7 +167,8 @@ class LinearMap:
     transform : numpy.ndarray
         T in float64.
     passthrough : int
-    space : gymnasium.spaces.Box
+        How many trailing entries pass unchanged (the argument, as an int).
+    space : spaces.Box
         The observation space of one sub-env after the map (float32, unbounded).
     """
 

@@ -61,7 +61,7 @@ class UnitAction(VectorActionWrapper, gym.utils.RecordConstructorArgs):
 
     Parameters
     ----------
-    env : gymnasium.vector.VectorEnv
+    env : VectorEnv
         A vector env whose sub-env action is one voltage [V] in a symmetric Box.
     headroom : float
         k in [1, 100] (dimensionless): the actuator's limit is the action :math:`\pm 1/k`.
@@ -87,7 +87,7 @@ class ObserveModes(VectorObservationWrapper, gym.utils.RecordConstructorArgs):
 
     Parameters
     ----------
-    env : gymnasium.vector.VectorEnv
+    env : VectorEnv
         A vector env of ACLDBeam envs with ``obs_mode="estimate"`` (``gym.make_vec`` of
         ``ACLDBeam-v1``, ``-v0`` or ``ACLDBeamLab-v1``), its observation not yet changed.
     modes : int
@@ -115,7 +115,7 @@ class WhitenObservation(VectorObservationWrapper, gym.utils.RecordConstructorArg
 
     Parameters
     ----------
-    env : gymnasium.vector.VectorEnv
+    env : VectorEnv
         A vector env whose sub-env observation is a 1-D Box of n entries.
     transform : array_like
         T, a finite (d, d) matrix, d = n - ``passthrough`` (dimensionless on the env's

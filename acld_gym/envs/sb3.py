@@ -9,22 +9,33 @@ sub-env), its reset observation passed through the observation wrappers, and its
 observation (wrapped) is in ``infos[i]["terminal_observation"]``;
 ``infos[i]["TimeLimit.truncated"]`` is ``truncated and not terminated``.
 
-Example::
+Example, with what the guide gives any library (actions in [-1, 1], the reward per load,
+mode 1 and the tip where the level observes the estimate, normalized observations, one
+torch thread; ``docs/examples/sb3_ppo.py`` is the complete script, with its budget)::
+
+    from functools import partial
 
     import gymnasium as gym
+    import torch
     from stable_baselines3 import PPO
+    from stable_baselines3.common.vec_env import VecNormalize
+
     from acld_gym.envs import SB3VecEnv
     from acld_gym.wrappers import vector
 
-    venv = SB3VecEnv(num_envs=16, load_case="random", wrappers=[vector.UnitAction])
-    PPO("MlpPolicy", venv).learn(100_000)
+    torch.set_num_threads(1)  # torch's default threads make SB3 many times slower
+    # mode 1 and the tip: on the levels that observe the estimate (all but ACLDBeamHard-v1)
+    wrappers = [vector.UnitAction, partial(vector.ObserveModes, modes=1)]
+    venv = SB3VecEnv(16, load_case="random", reward_scale="passive", wrappers=wrappers)
+    PPO("MlpPolicy", VecNormalize(venv)).learn(100_000)
 
     # another level: its id
-    venv = SB3VecEnv(16, env_id="ACLDBeamLab-v1", load_case="random", wrappers=[vector.UnitAction])
+    venv = SB3VecEnv(16, env_id="ACLDBeamLab-v1", load_case="random",
+                     reward_scale="passive", wrappers=wrappers)
 
     # the same: a wrapped vector env of gym.make_vec, adapted
-    envs = vector.UnitAction(gym.make_vec("ACLDBeam-v1", num_envs=16, load_case="random"))
-    venv = SB3VecEnv(venv=envs)
+    envs = gym.make_vec("ACLDBeam-v1", 16, load_case="random", reward_scale="passive")
+    venv = SB3VecEnv(venv=vector.ObserveModes(vector.UnitAction(envs), modes=1))
 
 Without wrappers the actions are volts (+/-120); ``VecNormalize`` goes outside, as usual.
 """

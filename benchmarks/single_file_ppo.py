@@ -1,8 +1,9 @@
-"""A plain single-file PyTorch PPO on ACLDBeam-v1, with only what the README's "Training with
-any RL library" section tells it to add, and its ISE / LQR through the env.
+"""A plain single-file PyTorch PPO on ACLDBeam-v1, with only what docs/training.md's section
+"Any library: the Gymnasium env, and what to add" tells it to add (its paragraph "A plain
+single-file PyTorch PPO"), and its ISE / LQR through the env.
 
 The file is the user's own copy of CleanRL's ``cleanrl/ppo_continuous_action.py`` (not part of
-this repository). This script makes the README's edits to a temporary copy, nothing else:
+this repository). This script makes that paragraph's edits to a temporary copy, nothing else:
 
 1. ``import acld_gym`` and ``from acld_gym.wrappers import ObserveModes, UnitAction``;
 2. in ``make_env``, ``gym.make(env_id)`` becomes
@@ -20,7 +21,8 @@ clipped to [-1, 1], times 120 V, on the observation slots ``ObserveModes`` keeps
 plain env: thesis cases 1, 2, 3 (seed 0) and the held-out random set, divided by LQR's ISE
 (:mod:`train.core.evaluate`).
 
-Needs ``pip install tyro tensorboard`` (the file's own imports). Not a test::
+Needs ``pip install tyro`` (the file's own import; tensorboard, its other one, comes with
+the ``[train]`` extra). Not a test::
 
     python benchmarks/single_file_ppo.py path/to/ppo_continuous_action.py --seed 1
 """
@@ -66,8 +68,9 @@ with open({out!r}, "wb") as _f:
 
 
 def edited_source(text: str, out: Path) -> str:
-    """The README's two edits and the instrumentation block; ``ValueError`` if the file is not
-    the expected CleanRL script."""
+    """The page's edits (the imports, ``make_env``'s env, ``TransformObservation``'s space)
+    and the instrumentation block; ``ValueError`` if the file is not the expected CleanRL
+    script."""
     if text.count(MAKE) < 1 or "def make_env" not in text or "__main__" not in text:
         raise ValueError(
             f"file: expected CleanRL's ppo_continuous_action.py (a make_env with {MAKE!r})"

@@ -23,13 +23,19 @@ import time
 from probe import one_run, seeds_main  # studies/probes/probe.py
 
 
+def config(lam: float, recipe: str = "ppo"):
+    """The recipe's config, one run per seed, with the env option ``lam`` in its training
+    env (the evaluation's env keeps the level's own reward)."""
+    cfg = one_run(None, base=recipe)
+    return dataclasses.replace(cfg, env_kwargs={**cfg.env_kwargs, "lam": lam})
+
+
 def run(seed: int, args) -> dict:
     from train.core.evaluate import validation_cost
     from train.core.sb3_train import train_sb3
     from train.scoring import score
 
-    cfg = one_run(None, base=args.recipe)
-    cfg = dataclasses.replace(cfg, env_kwargs={**cfg.env_kwargs, "lam": args.lam})
+    cfg = config(args.lam, args.recipe)
     t0 = time.perf_counter()
     policy, record = train_sb3(cfg, seed, args.env_id)
     wall = time.perf_counter() - t0

@@ -41,7 +41,7 @@ same order, so the same agent, in less wall time. By default such a trial takes 
 of the ``--num-cpus`` and the trials run one after another (``--algos ppo sac --seeds 7``
 on 2 CPUs: PPO's seed, then SAC's, each with two runs at once), so a seed's wall time is
 its own runs' whatever else the command trains; ``--cpus-per-trial 1`` runs two trials
-at a time instead, more seeds per hour and a longer wait for each (:func:`trial_workers`).
+at a time instead, more seeds per hour and a longer wait for each.
 """
 
 from __future__ import annotations
@@ -108,7 +108,15 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="YAML",
         help="further config files (e.g. the ablations); alone, only these run",
     )
-    p.add_argument("--seeds", nargs="+", type=arg_type(int, 0, MAX_SEED), default=[0, 1, 2, 3, 4])
+    p.add_argument(
+        "--seeds",
+        nargs="+",
+        type=arg_type(int, 0, MAX_SEED),
+        default=[0, 1, 2, 3, 4],
+        metavar="SEED",
+        help=f"the seeds, distinct integers in [0, {MAX_SEED}]: one trial per algorithm and "
+        "seed (default 0 1 2 3 4)",
+    )
     p.add_argument(
         "--timesteps",
         type=arg_type(int, 1, 10**12),

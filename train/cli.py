@@ -3,8 +3,8 @@
 ``ALGO`` names a recipe under ``train/recipes/`` (``ppo``, ``sac``, ``vrs``, ``ars``,
 ``tqc``); ``--config`` gives another file of the same schema (:class:`train.config.TrainConfig`,
 e.g. an ablation or the opt-in DAgger start ``train/recipes/ppo_dagger.yaml``). The run is
-exactly one trial of ``python -m train.benchmark`` (:func:`train.core.trials.run_trial`: the
-same env factory, training and evaluation), so ``python -m train ppo --seed N`` gives the
+exactly one trial of ``python -m train.benchmark`` (the same code builds the env, trains
+and evaluates), so ``python -m train ppo --seed N`` gives the
 agent that ``python -m train.benchmark --algos ppo --seeds N`` saves in
 ``<out>/agents/ppo-sN``, bit for bit on one machine.
 

@@ -8,9 +8,9 @@ in one line, as an agent of another level than ``--env-id``, before anything is 
 
 For each thesis load case (1, 2, 3) and a fixed held-out set of random loads (``case
 "random"``: the mean over the set; seeds disjoint from training), runs the level's
-references (:func:`reference_policies`: the thesis's delay-free LQR and SMC, the nominal
-MPC, ``mpc_reward``, the engineer's designs for the level's actuator, the plant oracle
-``mpc_oracle``; :mod:`baselines.marks`), every agent (labelled by how it was trained) and
+references (the thesis's delay-free LQR and SMC, the nominal MPC, ``mpc_reward``, the
+engineer's designs for the level's actuator and sensor, the plant oracle ``mpc_oracle``:
+the same marks on every level), every agent (labelled by how it was trained) and
 the bound through the level's env; prints peak [mm], 5 % settling [s], ISE [m^2 s] (and /
 LQR, / bound), max |V| [V], return, ms per step, the effort after settling
 (:mod:`baselines.analysis.effort`), and score v2 on the level's test set

@@ -48,10 +48,11 @@ __all__ = [
 
 def main(argv: list[str] | None = None) -> int:
     """``python -m train.core.report RESULTS.json [--write PAGE.md ...] [--plot FIG.png]``:
-    the benchmark's tables (:func:`markdown`) from a committed results file, printed, or
-    written into the generated blocks of each page (:func:`write_blocks`: the tables, the
-    headline; atomically, every page checked before any is written); ``--plot`` also draws
-    its learning curves (:func:`plot_curves`)."""
+    the benchmark's tables (Markdown) from a committed results file, printed, or with
+    ``--write`` put into each page between its generated-block markers (the tables and the
+    headline; every page is checked before any is written, and each is replaced
+    atomically); ``--plot`` also draws its learning curves (ISE / LQR against env steps)
+    to an image."""
     p = argparse.ArgumentParser(
         prog=prog("python -m train.core.report"),
         description=plain(main.__doc__),

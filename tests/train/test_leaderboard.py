@@ -17,6 +17,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from acld_gym.util.validate import run_main
+from tests.train.leaderboard_cli import PROG, run
 from train.leaderboard.cli import main
 from train.leaderboard.collect import merge, seed_stats, write_level
 from train.leaderboard.readme import END, START, readme_block, replace_block
@@ -25,18 +26,6 @@ from train.leaderboard.schema import CASES, EFFORT_CASES, check_level, empty_lev
 
 ROOT = Path(__file__).resolve().parents[2]
 RESULTS, PAGE, README = ROOT / "results", ROOT / "docs" / "leaderboard.md", ROOT / "README.md"
-PROG = "python -m train.leaderboard"
-
-
-def run(argv, capsys) -> tuple[int, str, str]:
-    """``main(argv)`` as the command runs it (:func:`acld_gym.util.validate.run_main`: one
-    line per bad file)."""
-    try:
-        code = run_main(lambda: main([str(a) for a in argv]), PROG)
-    except SystemExit as exc:  # argparse's usage errors
-        code = exc.code
-    out = capsys.readouterr()
-    return code, out.out, out.err
 
 
 # --- the committed data ------------------------------------------------------------

@@ -19,6 +19,7 @@ from acld_gym.util.validate import run_main
 from baselines.analysis.score import score_policies
 from baselines.policies import LQRPolicy, PassivePolicy
 from baselines.rollout import metrics_row, rollout
+from tests.train.leaderboard_cli import PROG, run
 from train.agent import TrainedAgent
 from train.core.trials import agent_dir, run_trials
 from train.leaderboard.cli import main
@@ -28,16 +29,6 @@ from train.scoring import score
 
 ENV_ID = "ACLDBeam-v1"
 EPISODES = 4
-PROG = "python -m train.leaderboard"
-
-
-def run(argv, capsys) -> tuple[int, str, str]:
-    try:
-        code = run_main(lambda: main([str(a) for a in argv]), PROG)
-    except SystemExit as exc:
-        code = exc.code
-    out = capsys.readouterr()
-    return code, out.out, out.err
 
 
 @pytest.fixture(scope="module")

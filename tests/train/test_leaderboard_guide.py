@@ -16,9 +16,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from acld_gym.util.validate import DataFileError, run_main
+from acld_gym.util.validate import DataFileError
 from baselines.evaluation.score import Score
-from train.leaderboard.cli import main
+from tests.train.leaderboard_cli import run
 from train.leaderboard.guide import (
     CLIENTS,
     GUIDE_FILE,
@@ -35,16 +35,6 @@ from train.scoring import PolicyScore
 
 ROOT = Path(__file__).resolve().parents[2]
 RESULTS, GUIDE = ROOT / "results", ROOT / "docs" / "any-library.md"
-PROG = "python -m train.leaderboard"
-
-
-def run(argv, capsys) -> tuple[int, str, str]:
-    try:
-        code = run_main(lambda: main([str(a) for a in argv]), PROG)
-    except SystemExit as exc:
-        code = exc.code
-    out = capsys.readouterr()
-    return code, out.out, out.err
 
 
 def _line(env_id="ACLDBeamLab-v1", n=100, iqm=0.7025, rel=(0.259, 0.261, 0.925, 0.605)) -> str:

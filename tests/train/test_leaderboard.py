@@ -89,7 +89,8 @@ def test_a_hand_edit_of_one_number_fails_the_check(tmp_path_factory, data):
 
 
 def main_check(argv) -> tuple[int, str, str]:
-    """:func:`run` without capsys (hypothesis runs many examples in one test)."""
+    """:func:`tests.train.leaderboard_cli.run` without capsys (hypothesis runs many
+    examples in one test)."""
     import contextlib
     import io
 

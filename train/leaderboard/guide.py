@@ -6,9 +6,11 @@ tables generated from that file beside each level's engineer (``results/<env id>
 (:data:`CLIENTS`: ``docs/examples/sb3_ppo.py``, ``docs/examples/sb3_sac.py`` or CleanRL's
 ``ppo_continuous_action.py`` patched with ``docs/examples/cleanrl_ppo.diff``), shows its
 output as it goes, times it, reads the score line it prints last
-(:class:`train.scoring.Score`'s ``str``) and merges one record into the file, replacing a
-record of the same client, level, seed and budget. ``python -m train.leaderboard render``
-writes the page's block (between :data:`START` and :data:`END`) from the file alone.
+(:class:`train.scoring.PolicyScore`'s ``str``) and merges one record into the file,
+replacing a record of the same client, level, seed and budget.
+``python -m train.leaderboard render`` writes the page's block (between
+:data:`train.leaderboard.guide_page.START` and :data:`train.leaderboard.guide_page.END`)
+from the file alone.
 
 The file (:data:`FORMAT` 1) is ``{"format": 1, "runs": [RUN, ...]}``, a run::
 

@@ -1,6 +1,8 @@
 """``benchmarks/single_file_ppo.py``: the edits it makes to a user's copy of CleanRL's PPO are
-the README's and nothing else, the README's line builds a ``check_env``-clean env, and the
-saved actor is evaluated on the same observation slots it was trained on."""
+the documented ones (docs/training.md, "Any library: the Gymnasium env, and what to add")
+and nothing else, its ``make_env``
+line builds a ``check_env``-clean env, and the saved actor is evaluated on the same
+observation slots it was trained on."""
 
 from pathlib import Path
 
@@ -38,7 +40,7 @@ if __name__ == "__main__":
 """
 
 
-def test_edits_are_the_readmes_and_nothing_else(tmp_path):
+def test_edits_are_the_documented_ones_and_nothing_else(tmp_path):
     out = tmp_path / "agent.pkl"
     text = sfp.edited_source(CLEANRL_LIKE, out)
     assert sfp.IMPORTS in text and sfp.EDIT in text and sfp.CLIP_OBS_1X in text
@@ -63,7 +65,7 @@ def test_other_files_are_refused():
         sfp.edited_source("print('hello')\n", Path("x.pkl"))
 
 
-def test_the_readme_line_builds_a_clean_env():
+def test_the_make_env_line_builds_a_clean_env():
     env_id = "ACLDBeam-v1"
     scope = {"gym": gym, "env_id": env_id, "ObserveModes": ObserveModes, "UnitAction": UnitAction}
     exec(sfp.EDIT, scope)

@@ -1,8 +1,7 @@
 """``benchmarks/single_file_ppo.py``: the edits it makes to a user's copy of CleanRL's PPO are
 the documented ones (docs/training.md, "Any library: the Gymnasium env, and what to add")
-and nothing else, its ``make_env``
-line builds a ``check_env``-clean env, and the saved actor is evaluated on the same
-observation slots it was trained on."""
+and nothing else, its ``make_env`` line builds a ``check_env``-clean env, and the saved
+actor is evaluated on the same observation slots it was trained on."""
 
 from pathlib import Path
 

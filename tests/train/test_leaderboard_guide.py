@@ -285,4 +285,4 @@ def test_the_block_names_every_client_and_level_it_has_runs_of(tmp_path):
     for client in CLIENTS.values():
         assert f"| {client.label}, " in block
     assert block.count("| `ACLDBeamHard-v1` | 3 |") == 3  # one row per run (seed 3)
-    assert "1.0-2.0" in block and "not run" in block  # the load; the levels without runs
+    assert "| 1.0, 2.0 |" in block and "not run" in block  # the load; the levels without runs

@@ -73,7 +73,7 @@ def _summary(runs: list[dict], levels: dict) -> list[str]:
                 cells.append("not run")
                 continue
             scores = sorted(r["score"]["iqm"] for r in mine)
-            span = f"{scores[0]:.3f}" + (f"-{scores[-1]:.3f}" if len(scores) > 1 else "")
+            span = f"{scores[0]:.3f}" + (f" to {scores[-1]:.3f}" if len(scores) > 1 else "")
             won = "-" if smc is None else str(sum(beats(r, smc) == [] for r in mine))
             short = " (reduced)" if any(_reduced(r) for r in mine) else ""
             cells.append(f"{won} of {len(mine)} seeds; score {span}{short}")
@@ -99,7 +99,7 @@ def _run_row(run: dict, levels: dict) -> str:
         score += f" (first {s['n_episodes']})"
     missed = beats(run, _smc(levels.get(run["env_id"])))
     verdict = "-" if missed is None else ("yes" if not missed else f"no ({', '.join(missed)})")
-    load = "-".join(f"{x:.1f}" for x in run["load"]) or "-"
+    load = ", ".join(f"{x:.1f}" for x in run["load"]) or "-"
     cells = [
         f"{run['client']}, {_steps(run['timesteps'])}",
         f"`{run['env_id']}`",

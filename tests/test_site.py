@@ -89,7 +89,8 @@ def test_sentences_in_type_slots_move_to_the_description():
         "dt : control period [s], > 0.\n"
         "A, B : state matrix (n x n), input (n x 1).\n"
         "x : float, optional\n    The value; see :class:`EnvConfig`.\n"
-        "config : :class:`EnvConfig`\n    Where.\n\n"
+        "config : :class:`EnvConfig`\n    Where.\n"
+        "env : gymnasium.vector.VectorEnv\n    A vector env.\n\n"
         "Returns\n-------\n"
         "T, Tinv : the transformation and its inverse (n x n).\n"
         "score : the policy's score on the level.\n"
@@ -102,6 +103,8 @@ def test_sentences_in_type_slots_move_to_the_description():
     assert out[6] == "x : float, optional"  # a type stays
     assert out[7] == "    The value; see [`EnvConfig`][acld_gym.envs.config.EnvConfig]."
     assert out[8] == "config : EnvConfig"  # a role as type: the name, for griffe to parse
+    assert out[10] == "env : gymnasium.vector.VectorEnv"  # a dotted path is one type
+    out = out[:10] + out[12:]
     assert out[13:15] == [":", "    `T, Tinv`: the transformation and its inverse (n x n)."]
     assert out[15:17] == ["score :", "    the policy's score on the level."]
     assert out[17:19] == [":", "    The score as a float, between 0 and 1."]

@@ -108,9 +108,9 @@ def design(
 
     Parameters
     ----------
-    model : a :class:`acld_gym.physics.plant.Plant`, a
-        :class:`acld_gym.physics.model.BeamModel` (its FE
-        model becomes the plant), or None to build one from ``model_kwargs``
+    model : Plant, BeamModel or None
+        A :class:`acld_gym.physics.plant.Plant`, a :class:`acld_gym.physics.model.BeamModel`
+        (its FE model becomes the plant), or None to build one from ``model_kwargs``
         (:func:`acld_gym.physics.model.build_model`'s arguments).
     order : reduced order (thesis: 6).
     smc_eps : the continuous SMC's boundary layer.

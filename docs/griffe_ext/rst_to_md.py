@@ -109,6 +109,10 @@ def _inline(line: str, resolve: Resolver) -> str:
     return INLINE.sub(convert, line)
 
 
+#: A dotted Python path (``gymnasium.spaces.Box``): a type, whatever its lowercase parts.
+DOTTED = re.compile(r"\b[A-Za-z_]\w*(?:\.[A-Za-z_]\w*)+\b")
+
+
 def _is_description(text: str) -> bool:
     """True when a numpydoc 'type' reads as a sentence rather than a type."""
     plain = ROLE.sub(lambda m: role_plain(m["content"]), text)
@@ -117,6 +121,7 @@ def _is_description(text: str) -> bool:
         return False
     if plain.endswith(".") and not plain.endswith("..."):
         return True
+    plain = DOTTED.sub(" ", plain)  # gymnasium.vector.VectorEnv: one type, not two words
     words = re.findall(r"[A-Za-z][A-Za-z_'-]*", re.sub(r"\([^)]*\)|\[[^\]]*\]", " ", plain))
     prose = [w for w in words if w.islower() and len(w) > 1 and w not in TYPE_WORDS]
     return len(prose) >= 2

@@ -123,7 +123,8 @@ def _script(folder: Path, name: str, body: str) -> Path:
 
 
 def test_guide_run_records_a_run_and_replaces_the_same_run(tmp_path, capsys):
-    script = _script(tmp_path, "sb3_ppo.py", f"print('training');print({_line()!r})\n")
+    body = f"import time; print('training'); time.sleep(0.3); print({_line()!r})\n"
+    script = _script(tmp_path, "sb3_ppo.py", body)
     argv = [sys.executable, script, "ACLDBeamLab-v1", "--seed", "5"]
     code, out, err = run(["guide-run", "--results", tmp_path / "r", "--", *argv], capsys)
     assert (code, err) == (0, ""), err
@@ -133,7 +134,7 @@ def test_guide_run_records_a_run_and_replaces_the_same_run(tmp_path, capsys):
         "SB3 PPO", "ACLDBeamLab-v1", 5, 2_000_000,
     )  # fmt: skip
     assert rec["command"] == f"python {script} ACLDBeamLab-v1 --seed 5"
-    assert rec["wall_seconds"] > 0 and len(rec["load"]) == 2
+    assert rec["wall_seconds"] >= 0.3 and len(rec["load"]) == 2  # timed: the sleep is in it
     # the same client, level, seed and budget again: replaced, not added
     _script(tmp_path, "sb3_ppo.py", f"print({_line(iqm=0.6)!r})\n")
     assert run(["guide-run", "--results", tmp_path / "r", "--", *argv], capsys)[0] == 0

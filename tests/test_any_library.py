@@ -31,16 +31,11 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from acld_gym.envs.presets import PRESETS, preset
+from train.scoring import SCORE_LINE
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "docs" / "examples"
 PAGE = ROOT / "docs" / "any-library.md"
-#: What train.scoring.PolicyScore prints: the score, its interval, ISE / LQR per case.
-SCORE_LINE = re.compile(
-    r"score v2 on (?P<id>\S+)/test-v\d+ \(first (?P<n>\d+) of \d+\): (?P<iqm>\S+) "
-    r"\[(?P<lo>\S+), (?P<hi>\S+)\]; ISE / thesis LQR 1: (?P<c1>\S+), 2: (?P<c2>\S+), "
-    r"3: (?P<c3>\S+), random: (?P<cr>\S+)$"
-)
 OTHER = "ACLDBeamHard-v1"  # observes the sensor: the scripts leave ObserveModes out
 
 

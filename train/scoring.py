@@ -31,6 +31,7 @@ statistics in its constructor callable.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -49,7 +50,7 @@ from baselines.evaluation.seeds import HELDOUT_SEEDS, evaluation_set
 
 from .scoring_inputs import as_policy, check_fits, wrap
 
-__all__ = ["PolicyScore", "score", "policy_ise"]
+__all__ = ["PolicyScore", "SCORE_LINE", "score", "policy_ise"]
 
 
 @dataclass(frozen=True)
@@ -115,6 +116,16 @@ class PolicyScore:
             f"score v{self.version} on {self.test_set}{reduced}: {self.iqm:.4f} "
             f"[{self.ci[0]:.4f}, {self.ci[1]:.4f}]; ISE / thesis LQR {rel}"
         )
+
+
+#: The line ``str(PolicyScore)`` prints, as a pattern: groups ``version``, ``id``, ``set``
+#: (``test-vN``), ``n`` (the episodes of a reduced score, else None), ``iqm``, ``lo``,
+#: ``hi`` and ``c1``, ``c2``, ``c3``, ``cr`` (ISE / thesis LQR on cases 1, 2, 3, random).
+SCORE_LINE = re.compile(
+    r"score v(?P<version>\d+) on (?P<id>[^/\s]+)/(?P<set>test-v\d+)"
+    r"(?: \(first (?P<n>\d+) of \d+\))?: (?P<iqm>\S+) \[(?P<lo>\S+), (?P<hi>\S+)\]; "
+    r"ISE / thesis LQR 1: (?P<c1>\S+), 2: (?P<c2>\S+), 3: (?P<c3>\S+), random: (?P<cr>\S+)$"
+)
 
 
 def policy_ise(policy, make: Callable[[], gym.Env], seeds: Sequence[int]) -> np.ndarray:

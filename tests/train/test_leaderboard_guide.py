@@ -29,8 +29,8 @@ from train.leaderboard.guide import (
     read_runs,
     record,
 )
-from train.leaderboard.guide_page import END, START, beats, guide_block
-from train.leaderboard.render import read_levels
+from train.leaderboard.guide_page import END, START, guide_block
+from train.leaderboard.render import beats, read_levels
 from train.scoring import PolicyScore
 
 ROOT = Path(__file__).resolve().parents[2]

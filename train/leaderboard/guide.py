@@ -29,7 +29,6 @@ import argparse
 import collections
 import contextlib
 import os
-import re
 import shlex
 import subprocess
 import sys
@@ -42,6 +41,7 @@ from acld_gym.test_sets import evaluation_set
 from acld_gym.util.atomic import write_json
 
 from ..core.records import read_json
+from ..scoring import SCORE_LINE
 from .schema import CASES, _Level
 
 __all__ = [
@@ -49,6 +49,7 @@ __all__ = [
     "CLIENTS",
     "GUIDE_FILE",
     "Client",
+    "client_order",
     "parse_command",
     "parse_score",
     "record",
@@ -84,12 +85,6 @@ CLIENTS = {
     "sb3_sac.py": Client("SB3 SAC", "--timesteps", 300_000, 0, True),
     "ppo_continuous_action.py": Client("CleanRL PPO", "--total-timesteps", 1_000_000, 1, False),
 }
-
-SCORE_LINE = re.compile(
-    r"score v(?P<version>\d+) on (?P<id>[^/\s]+)/(?P<set>test-v\d+)"
-    r"(?: \(first (?P<n>\d+) of \d+\))?: (?P<iqm>\S+) \[(?P<lo>\S+), (?P<hi>\S+)\]; "
-    r"ISE / thesis LQR 1: (?P<c1>\S+), 2: (?P<c2>\S+), 3: (?P<c3>\S+), random: (?P<cr>\S+)$"
-)
 
 
 def parse_command(argv: list[str]) -> tuple[Client, dict]:
@@ -218,6 +213,11 @@ def _locked(folder: Path):
         os.close(fd)
 
 
+def client_order(label: str) -> int:
+    """Where a client's runs go: the order of :data:`CLIENTS`."""
+    return [c.label for c in CLIENTS.values()].index(label)
+
+
 def _key(run: dict) -> tuple:
     return (run["client"], run["env_id"], run["seed"], run["timesteps"])
 
@@ -226,11 +226,15 @@ def merge_run(runs: list[dict], new: dict) -> list[dict]:
     """``runs`` with ``new`` replacing the run of its client, level, seed and budget,
     sorted by client, level and seed."""
     kept = [r for r in runs if _key(r) != _key(new)]
-    order = {c.label: i for i, c in enumerate(CLIENTS.values())}
     levels = list(PRESETS)
     return sorted(
         [*kept, new],
-        key=lambda r: (order[r["client"]], levels.index(r["env_id"]), r["timesteps"], r["seed"]),
+        key=lambda r: (
+            client_order(r["client"]),
+            levels.index(r["env_id"]),
+            r["timesteps"],
+            r["seed"],
+        ),
     )
 
 

@@ -11,15 +11,13 @@ from __future__ import annotations
 from acld_gym.envs.presets import PRESETS
 from acld_gym.test_sets import TEST_SETS
 
-from .guide import CLIENTS, GUIDE_FILE
-from .render import COMMAND, marks
+from .guide import GUIDE_FILE, client_order
+from .render import COMMAND, beats, marks
 
-__all__ = ["START", "END", "GOAL_CASES", "beats", "guide_block"]
+__all__ = ["START", "END", "guide_block"]
 
 START = "<!-- guide-runs:start -->"
 END = "<!-- guide-runs:end -->"
-#: The cases on which a run must beat the thesis LQR and SMC (ISE below both).
-GOAL_CASES = ("1", "2", "random")
 
 
 def _steps(n: int) -> str:
@@ -28,18 +26,14 @@ def _steps(n: int) -> str:
     return f"{n // 1000}k" if n % 1000 == 0 else str(n)
 
 
+def _policies(level: dict | None) -> dict:
+    """A level's reference entries by name (none without the level's file)."""
+    return ((level or {}).get("references") or {}).get("policies", {})
+
+
 def _smc(level: dict | None) -> dict | None:
-    refs = ((level or {}).get("references") or {}).get("policies", {})
+    refs = _policies(level)
     return refs["smc"]["ise_rel_lqr"] if "smc" in refs else None
-
-
-def beats(run: dict, smc: dict | None) -> list[str] | None:
-    """The goal cases on which ``run`` does not beat the thesis LQR and SMC (an empty list:
-    it beats both on all of them); None without the level's SMC."""
-    if smc is None:
-        return None
-    rel = run["ise_rel_lqr"]
-    return [c for c in GOAL_CASES if not rel[c] < min(1.0, smc[c])]
 
 
 def _reduced(run: dict) -> bool:
@@ -56,10 +50,12 @@ def _summary(runs: list[dict], levels: dict) -> list[str]:
         m = marks(level) if level else {"engineer": None}
         e = m["engineer"]
         eng.append("-" if e is None else f"{e[1]['score']['iqm']:.3f} (`{e[0]}`)")
-        refs = ((level or {}).get("references") or {}).get("policies", {})
+        refs = _policies(level)
         lqr.append(f"{refs['lqr']['score']['iqm']:.3f}" if "lqr" in refs else "-")
     rows += ["| " + " | ".join(eng) + " |", "| " + " | ".join(lqr) + " |"]
-    budgets = sorted({(r["client"], r["timesteps"]) for r in runs}, key=_client_order)
+    budgets = sorted(
+        {(r["client"], r["timesteps"]) for r in runs}, key=lambda k: (client_order(k[0]), k[1])
+    )
     for label, budget in budgets:
         cells = [f"{label}, {_steps(budget)} steps"]
         for env_id in PRESETS:
@@ -79,11 +75,6 @@ def _summary(runs: list[dict], levels: dict) -> list[str]:
             cells.append(f"{won} of {len(mine)} seeds; score {span}{short}")
         rows.append("| " + " | ".join(cells) + " |")
     return rows
-
-
-def _client_order(key: tuple[str, int]) -> tuple[int, int]:
-    order = [c.label for c in CLIENTS.values()]
-    return (order.index(key[0]), key[1])
 
 
 RUN_HEAD = (

@@ -23,12 +23,24 @@ from acld_gym.util.validate import file_error
 
 from .schema import CASES, EFFORT_CASES, read_level
 
-__all__ = ["COMMAND", "GOAL_MARGIN", "read_levels", "marks", "goal_lines", "section", "page"]
+__all__ = [
+    "COMMAND",
+    "GOAL_MARGIN",
+    "GOAL_CASES",
+    "read_levels",
+    "marks",
+    "beats",
+    "goal_lines",
+    "section",
+    "page",
+]
 
 #: The command that regenerates the page and the README block.
 COMMAND = "python -m train.leaderboard render"
 #: The mark an algorithm reaches on a level: its IQM at least the best engineer's score minus this.
 GOAL_MARGIN = 0.02
+#: The cases on which a seed must beat the thesis LQR and SMC (ISE below both).
+GOAL_CASES = ("1", "2", "random")
 ENGINEER = "engineer's design"
 ORACLE = "plant oracle"
 
@@ -135,6 +147,16 @@ SEED_HEAD = (
 )
 
 
+def beats(entry: dict, smc: dict | None) -> list[str] | None:
+    """The :data:`GOAL_CASES` on which ``entry`` (a seed, a run: its ``ise_rel_lqr``) does
+    not beat the thesis LQR and SMC (``smc``: SMC's ``ise_rel_lqr``); an empty list where it
+    beats both on all of them, None without the level's SMC."""
+    if smc is None:
+        return None
+    rel = entry["ise_rel_lqr"]
+    return [c for c in GOAL_CASES if not rel[c] < min(1.0, smc[c])]
+
+
 def goal_lines(level: dict) -> list[str]:
     """Per algorithm: does its IQM reach the best engineer's score minus
     :data:`GOAL_MARGIN`; how many seeds beat the thesis LQR and SMC on cases 1, 2, random."""
@@ -152,13 +174,7 @@ def goal_lines(level: dict) -> list[str]:
         verdict = "reaches it" if got >= target else f"does not reach it ({got - target:+.3f})"
         line = f"- `{name}`: IQM {got:.3f}, {verdict}"
         if smc is not None:
-            beat = sum(
-                all(
-                    s["ise_rel_lqr"][c] < min(1.0, smc["ise_rel_lqr"][c])
-                    for c in ("1", "2", "random")
-                )
-                for s in a["seeds"]
-            )
+            beat = sum(beats(s, smc["ise_rel_lqr"]) == [] for s in a["seeds"])
             line += (
                 f"; {beat} of {len(a['seeds'])} seeds beat the thesis LQR and SMC on "
                 "cases 1, 2 and random"

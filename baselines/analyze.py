@@ -1,8 +1,8 @@
 """Read a policy in control terms and score it between the passive beam and the clairvoyant
 bound.
 
-``python -m baselines.analyze POLICY [POLICY ...]`` (options: ``--help``; with agent
-directories, ``python -m train.analyze`` or ``acld-gym analyze``).
+``python -m baselines.analyze POLICY [POLICY ...]`` (options: ``--help``);
+``python -m train.analyze`` is the same command for agent directories too.
 
 POLICY is a reference of the level (:mod:`baselines.marks`: ``passive``; the thesis's
 delay-free ``lqr`` and ``smc`` and the nominal ``mpc``; the engineer's designs for the

@@ -17,7 +17,7 @@ from hypothesis import strategies as st
 
 from acld_gym.util.text import invoked_as, math_text, plain, prog
 from tests.core_only import run_core_only
-from train.console import COMMANDS, GROUPS, help_text, main
+from train.console import COMMANDS, GROUPS, help_text, main, module_names
 
 ROOT = Path(__file__).resolve().parents[1]
 #: reStructuredText left in a help text: a role, a literal, a directive, a literal-block mark.
@@ -218,6 +218,29 @@ def test_invoked_as_is_scoped():
     with invoked_as("acld-gym a"):
         assert prog("python -m a") == "acld-gym a"
     assert prog("python -m a") == "python -m a"
+
+
+def test_command_names_only_inside_the_command_and_only_whole_modules():
+    text = "python -m train.ship RUN; python -m train --seed 1; python -m train.shipx; python -m x"
+    names = {"train.ship": "acld-gym ship", "train": "acld-gym train"}
+    assert plain(text, width=200) == text  # outside acld-gym: unchanged
+    with invoked_as("acld-gym ship", names):
+        got = plain(text, width=200)
+    assert got == "acld-gym ship RUN; acld-gym train --seed 1; python -m train.shipx; python -m x"
+    assert plain(text, width=200) == text  # and scoped
+
+
+@pytest.mark.parametrize("name", [n for n, c in COMMANDS.items() if not c.lead])
+def test_a_subcommand_help_names_tools_by_their_command(name, capsys):
+    """Run as ``acld-gym NAME --help``, the help names no tool by a ``python -m`` form that
+    has an ``acld-gym`` command (the ship command's own text said 'python -m train.ship RUN
+    NAME' under 'usage: acld-gym ship')."""
+    code, out, _ = run([name, "--help"], capsys)
+    assert code == 0
+    for module in module_names():
+        assert not re.search(rf"python -m {re.escape(module)}(?![\w]|\.\w)", out), (module, out)
+    module = COMMANDS[name].module.removesuffix(".cli")
+    assert module_names()[module] == f"acld-gym {name}"
 
 
 @pytest.mark.parametrize("name", list(COMMANDS))

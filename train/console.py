@@ -21,7 +21,16 @@ import importlib.util
 import sys
 from dataclasses import dataclass
 
-__all__ = ["Command", "COMMANDS", "GROUPS", "EXTRA_MODULES", "help_text", "version", "main"]
+__all__ = [
+    "Command",
+    "COMMANDS",
+    "GROUPS",
+    "EXTRA_MODULES",
+    "module_names",
+    "help_text",
+    "version",
+    "main",
+]
 
 PROG = "acld-gym"
 
@@ -156,6 +165,18 @@ def _unknown(word: str) -> str:
     return f"{PROG}: error: unknown {kind} {word!r}{hint}; '{PROG} --help' lists the commands"
 
 
+def module_names() -> dict[str, str]:
+    """Each command's ``python -m`` module (a package's ``cli`` module is run as the package,
+    ``python -m train``) -> its ``acld-gym`` command; the thesis commands share one module
+    and are left out."""
+    out = {}
+    for name, c in COMMANDS.items():
+        if c.lead:
+            continue
+        out[c.module.removesuffix(".cli")] = f"{PROG} {name}"
+    return out
+
+
 def run(name: str, argv: list[str]) -> int:
     """Run command ``name`` (a key of :data:`COMMANDS`) with the arguments ``argv``."""
     from acld_gym.util.text import invoked_as
@@ -163,7 +184,7 @@ def run(name: str, argv: list[str]) -> int:
 
     command = COMMANDS[name]
     prog = f"{PROG} {name}"
-    with invoked_as(prog):
+    with invoked_as(prog, module_names()):
         try:
             module = importlib.import_module(command.module)
             return run_main(lambda: module.main([*command.lead, *argv]), prog)

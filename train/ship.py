@@ -26,7 +26,7 @@ from pathlib import Path
 
 from acld_gym.physics.loads import THESIS_CASES
 from acld_gym.util.atomic import check_directory
-from acld_gym.util.text import plain, prog
+from acld_gym.util.text import command_names, plain, prog
 from acld_gym.util.validate import os_error_line
 
 from .agent import CURVE_FILE, TrainedAgent
@@ -124,9 +124,10 @@ def main(argv: list[str] | None = None) -> int:
     )
     p.add_argument(
         "run",
-        help="an agent directory: the --out of python -m train, or "
-        "<out>/agents/<config>-s<seed> of python -m train.benchmark; "
-        "with --best, that <out>",
+        help=command_names(
+            "an agent directory: the --out of python -m train, or "
+            "<out>/agents/<config>-s<seed> of python -m train.benchmark; with --best, that <out>"
+        ),
     )
     p.add_argument(
         "--best",

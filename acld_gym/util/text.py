@@ -7,7 +7,9 @@ math becomes readable (``:math:`\\hat x^+``` -> ``x̂⁺``), a ``.. math::`` blo
 lines, ``Examples::`` keeps its example block, and paragraphs and list items are filled to
 the terminal's width. :func:`prog` is the program name a parser shows: ``acld-gym SUB``
 when the ``acld-gym`` command runs the tool (:func:`invoked_as`), else the tool's own
-``python -m`` form.
+``python -m`` form; run that way, :func:`plain` also names every tool the text mentions by
+its ``acld-gym`` command (``python -m train.ship`` -> ``acld-gym ship``), so a help text
+speaks of one command line.
 """
 
 from __future__ import annotations
@@ -20,9 +22,13 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
 
-__all__ = ["plain", "math_text", "prog", "invoked_as"]
+__all__ = ["plain", "math_text", "prog", "invoked_as", "command_names"]
 
 _INVOKED_AS: ContextVar[str | None] = ContextVar("acld_gym_invoked_as", default=None)
+#: ``python -m`` forms -> ``acld-gym`` commands, while the ``acld-gym`` command runs a tool.
+_COMMAND_NAMES: ContextVar[dict[str, str] | None] = ContextVar(
+    "acld_gym_command_names", default=None
+)
 
 #: LaTeX commands of one argument that only style it.
 _STYLES = r"mathrm|text|operatorname|mathbf|boldsymbol|mathit|mathcal|mathsf|rm|bf"
@@ -265,7 +271,7 @@ def plain(doc: str | None, width: int | None = None) -> str:
             if not block:
                 continue
         out.append(_prose(block, width))
-    return "\n\n".join(out).replace(_KEEP, " ")
+    return command_names("\n\n".join(out).replace(_KEEP, " "))
 
 
 def prog(default: str) -> str:
@@ -274,12 +280,29 @@ def prog(default: str) -> str:
     return _INVOKED_AS.get() or default
 
 
+def command_names(text: str) -> str:
+    """``text`` with each ``python -m MODULE`` that the running ``acld-gym`` command knows
+    as a subcommand written as that command (:func:`invoked_as`'s ``names``); unchanged
+    outside it. ``python -m train`` is not ``python -m train.ship``: a module name ends where
+    no letter, digit, ``_`` or ``.`` followed by one comes next."""
+    names = _COMMAND_NAMES.get()
+    if not names:
+        return text
+    pattern = "|".join(re.escape(m) for m in sorted(names, key=len, reverse=True))
+    found = re.compile(rf"python -m ({pattern})(?![\w]|\.\w)")
+    return found.sub(lambda m: names[m.group(1)], text)
+
+
 @contextmanager
-def invoked_as(name: str) -> Iterator[None]:
+def invoked_as(name: str, names: dict[str, str] | None = None) -> Iterator[None]:
     """Within the block, :func:`prog` returns ``name`` (the ``acld-gym`` command's
-    subcommand, e.g. ``"acld-gym evaluate"``)."""
+    subcommand, e.g. ``"acld-gym evaluate"``) and :func:`plain` writes the modules of
+    ``names`` (``{"train.ship": "acld-gym ship", ...}``) as their commands; without
+    ``names``, an enclosing block's stay (a command that runs another's ``main``)."""
     token = _INVOKED_AS.set(name)
+    names_token = _COMMAND_NAMES.set(dict(names) if names else _COMMAND_NAMES.get())
     try:
         yield
     finally:
+        _COMMAND_NAMES.reset(names_token)
         _INVOKED_AS.reset(token)

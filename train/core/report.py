@@ -13,7 +13,7 @@ import sys
 from pathlib import Path
 
 from acld_gym.util.atomic import write_texts
-from acld_gym.util.text import plain, prog
+from acld_gym.util.text import command_names, plain, prog
 from acld_gym.util.validate import check_figure_path, os_error_line, run_main
 
 from .records import DataFileError, read_results
@@ -58,7 +58,9 @@ def main(argv: list[str] | None = None) -> int:
         description=plain(main.__doc__),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("results", type=Path, help="a results.json of python -m train.benchmark")
+    p.add_argument(
+        "results", type=Path, help=command_names("a results.json of python -m train.benchmark")
+    )
     p.add_argument(
         "--write",
         type=Path,

@@ -40,7 +40,7 @@ import sys
 from pathlib import Path
 
 from acld_gym.util.atomic import check_directory, check_writable, write_texts
-from acld_gym.util.text import plain, prog
+from acld_gym.util.text import command_names, plain, prog
 from acld_gym.util.validate import arg_type, run_main
 
 __all__ = ["main", "build_parser", "collect", "guide_run", "render"]
@@ -58,7 +58,9 @@ def build_parser() -> argparse.ArgumentParser:
     c = sub.add_parser("collect", help="measure a level's references and agents into results/")
     c.add_argument("--env-id", required=True, help="a registered id of this package")
     c.add_argument("--references", action="store_true", help="the level's references and marks")
-    c.add_argument("--benchmark", metavar="DIR", help="a python -m train.benchmark folder")
+    c.add_argument(
+        "--benchmark", metavar="DIR", help=command_names("the output folder of python -m train.benchmark")
+    )
     c.add_argument("--algos", nargs="+", metavar="NAME", help="only these configs of DIR")
     c.add_argument(
         "--score-episodes",

@@ -59,7 +59,9 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--env-id", required=True, help="a registered id of this package")
     c.add_argument("--references", action="store_true", help="the level's references and marks")
     c.add_argument(
-        "--benchmark", metavar="DIR", help=command_names("the output folder of python -m train.benchmark")
+        "--benchmark",
+        metavar="DIR",
+        help=command_names("the output folder of python -m train.benchmark"),
     )
     c.add_argument("--algos", nargs="+", metavar="NAME", help="only these configs of DIR")
     c.add_argument(

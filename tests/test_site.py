@@ -83,6 +83,31 @@ def test_display_math_becomes_a_code_block():
     assert rewrite(".. math:: a = b\n\nafter", resolve).startswith("\n    a = b\n")
 
 
+def test_a_wrapped_table_cell_is_one_cell():
+    text = "| a | b | c |\n|---|---|---|\n| x | 1 | one and |\n| | | two |\n| | | three |\n| y | 2 | z |"
+    out = rewrite(text, resolve).split("\n")
+    assert out == [
+        "| a | b | c |",
+        "|---|---|---|",
+        "| x | 1 | one and two three |",
+        "| y | 2 | z |",
+    ]
+    # no table: a line of bars alone is not joined to prose
+    assert rewrite("prose\n| | | x |", resolve).split("\n") == ["prose", "| | | x |"]
+
+
+def test_the_env_arguments_table_has_no_row_of_empty_cells():
+    """The env's docstring wraps its long cells as rows of empty cells (for ``help()``); on
+    the site each argument is one row."""
+    from acld_gym.envs.beam_env import ACLDBeamEnv
+
+    out = rewrite(ACLDBeamEnv.__doc__, resolve)
+    rows = [line.strip() for line in out.split("\n") if line.strip().startswith("|")]
+    assert len(rows) > 20
+    assert not [r for r in rows if r.startswith("| |")], "a continued row was left"
+    assert any("`TipLoad` (pulses" in r and "`load_case`" in r for r in rows)
+
+
 def test_sentences_in_type_slots_move_to_the_description():
     doc = (
         "Parameters\n----------\n"

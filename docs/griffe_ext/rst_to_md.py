@@ -157,15 +157,38 @@ def _fix_types(line: str, kind: str) -> str:
     return names + sep + rest
 
 
+#: A Markdown table row whose cells before the last are empty: the last cell continues the
+#: row above (the docstrings wrap a long cell so, for a terminal's ``help()``).
+CONTINUED_ROW = re.compile(r"^(\s*)\|(?:\s*\|)+\s*(?P<text>[^|]*?)\s*\|\s*$")
+
+
+def merge_continued_rows(lines: list[str]) -> list[str]:
+    """Table rows that continue the row above (:data:`CONTINUED_ROW`) joined into it, so a
+    wrapped cell renders as one cell and not as rows of empty cells."""
+    out: list[str] = []
+    for line in lines:
+        m = CONTINUED_ROW.match(line)
+        prev = out[-1].rstrip() if out else ""
+        if m and prev.startswith(line[: len(m.group(1))] + "|") and prev.endswith("|"):
+            if not CONTINUED_ROW.match(prev) and set(prev.replace("|", "").strip()) <= set("-: "):
+                out.append(line)  # the row after the header's separator: a row of its own
+                continue
+            out[-1] = prev[:-1].rstrip() + " " + m.group("text") + " |"
+            continue
+        out.append(line)
+    return out
+
+
 def rewrite(text: str, resolve: Resolver) -> str:
     """A numpydoc docstring with its roles as autorefs or code, ready for mkdocstrings.
 
     Fenced code blocks, doctest lines (``>>>``, ``...`` and their output) and RST literal
     blocks (the indented lines after a line ending in ``::``) are left as they are.
     Entries of the typed sections (Parameters, Returns, ...) whose "type" is a sentence
-    are rewritten so the sentence lands in the description.
+    are rewritten so the sentence lands in the description; a table's wrapped cells are
+    joined (:func:`merge_continued_rows`).
     """
-    lines = text.split("\n")
+    lines = merge_continued_rows(text.split("\n"))
     out: list[tuple[bool, str]] = []  # (prose, line)
     fence: str | None = None
     doctest = False

@@ -84,7 +84,8 @@ def test_display_math_becomes_a_code_block():
 
 
 def test_a_wrapped_table_cell_is_one_cell():
-    text = "| a | b | c |\n|---|---|---|\n| x | 1 | one and |\n| | | two |\n| | | three |\n| y | 2 | z |"
+    rows = ["| a | b | c |", "|---|---|---|", "| x | 1 | one and |", "| | | two |", "| | | three |"]
+    text = "\n".join([*rows, "| y | 2 | z |"])
     out = rewrite(text, resolve).split("\n")
     assert out == [
         "| a | b | c |",

@@ -17,7 +17,7 @@ from train.scoring import score
 
 p = argparse.ArgumentParser()
 p.add_argument("env_id", nargs="?", default="ACLDBeam-v1", choices=list(PRESETS))
-p.add_argument("--timesteps", type=arg_type(int, 1), default=300_000)
+p.add_argument("--timesteps", type=arg_type(int, 10_001), default=300_000)  # > learning_starts
 p.add_argument("--seed", type=arg_type(int, 0, 2**32 - 1), default=0)  # numpy's range
 p.add_argument("--episodes", type=int, help="score on the first N test loads (default: all)")
 args = p.parse_args()

@@ -53,7 +53,7 @@ def test_role_over_a_line_break_and_math_and_literals():
         "a role over two lines [`acld_gym.envs.config.EnvConfig`][acld_gym.envs.config.EnvConfig]"
         " here"
     )
-    assert rewrite(r"cost :math:`x^T Q x` and ``dt``", resolve) == r"cost `x^T Q x` and `dt`"
+    assert rewrite(r"cost :math:`x^T Q x` and ``dt``", resolve) == r"cost \(x^T Q x\) and `dt`"
     # a literal holding backticks (and a role) keeps a double fence, its role untouched
     assert rewrite("(``:math:`x^+```) and ``a``", resolve) == "(`` :math:`x^+` ``) and `a`"
     assert rewrite("``:class:`EnvConfig``` :class:`EnvConfig`", resolve) == (
@@ -77,10 +77,17 @@ def test_code_doctest_and_literal_blocks_are_left_alone():
     assert out.endswith("After `numpy`.")
 
 
-def test_display_math_becomes_a_code_block():
-    out = rewrite("Intro\n\n.. math::\n\n    x_{k+1} = A x_k\n\nafter", resolve)
-    assert ".. math::" not in out and "\n    x_{k+1} = A x_k\n" in out
-    assert rewrite(".. math:: a = b\n\nafter", resolve).startswith("\n    a = b\n")
+def test_display_math_becomes_a_formula():
+    out = rewrite("Intro\n\n.. math::\n\n    x_{k+1} = A x_k\n      + B u_k\n\nafter", resolve)
+    assert ".. math::" not in out
+    assert "\n\\[\nx_{k+1} = A x_k\n+ B u_k\n\\]\n" in out and out.endswith("\nafter")
+    # the expression on the directive's line; indented, as in a Parameters entry
+    assert rewrite(".. math:: a = b\n\nafter", resolve).startswith("\n\\[\na = b\n\\]\n")
+    assert "\n    \\[\n    a\n    \\]\n" in rewrite("x\n    .. math:: a\ny", resolve)
+    # under a list item's text (2 deeper): at the list's own indentation
+    assert "\n\\[\na\n\\]\n" in rewrite("* item\n  text:\n\n  .. math:: a\n\nafter", resolve)
+    # at the end of the text
+    assert rewrite(".. math:: a", resolve).endswith("\\[\na\n\\]\n")
 
 
 def test_a_wrapped_table_cell_is_one_cell():
@@ -149,8 +156,10 @@ def test_no_role_survives_in_prose(parts):
     out = rewrite(text, lambda t: f"pkg.{t}" if t.startswith("a") else None)
     assert not re.search(r":(class|func|meth|mod|data|attr|math):`", out)
     for _, role, name in parts:
-        short = name if role == "math" else name.rsplit(".", 1)[-1]
-        assert f"`{short if role != 'math' else '~' + name}`" in out
+        if role == "math":  # arithmatex's inline math, for MathJax
+            assert f"\\(~{name}\\)" in out
+        else:
+            assert f"`{name.rsplit('.', 1)[-1]}`" in out
 
 
 ROLE_LEFT = re.compile(r":(?:class|func|mod|meth|data|attr|math|obj|exc):(?:`|<code>)")
@@ -171,6 +180,26 @@ def _outside_code(text: str) -> str:
     # the syntax); an unrendered role is the role's name before a <code> or a backtick
     text = re.sub(r"<pre.*?</pre>", "", text, flags=re.S)
     return re.sub(r"<code>.*?</code>", "<code></code>", text, flags=re.S)
+
+
+#: LaTeX commands the docstrings' math uses; outside a formula they are its source shown raw
+LATEX = re.compile(r"\\(frac|hat|sqrt|mathrm|sum|left|dot|tanh|log)\b")
+
+
+def test_api_math_is_marked_for_mathjax(site):
+    """Every docstring formula of the API pages reaches the page as arithmatex's markup
+    (MathJax typesets it; the page loads MathJax), and no LaTeX command is left outside a
+    formula or a code span (the site showed ~200, as code, before)."""
+    api = {k: v for k, v in site.items() if k.startswith("api/")}
+    marked = sum(v.count('class="arithmatex"') for v in api.values())
+    assert marked > 300, marked
+    for name, page in api.items():
+        assert "mathjax" in page.lower(), name
+        prose = re.sub(
+            r'<(span|div) class="arithmatex">.*?</\1>', "", _outside_code(page), flags=re.S
+        )
+        left = LATEX.search(prose)
+        assert left is None, (name, prose[max(0, left.start() - 80) : left.end() + 80])
 
 
 def test_site_has_no_unrendered_roles_or_literals(site):

@@ -78,10 +78,26 @@ def code(text: str) -> str:
     return f"`` {text} ``"
 
 
+def math_inline(tex: str) -> str:
+    """Inline LaTeX for pymdownx.arithmatex (``\\( ... \\)``, rendered by MathJax on the site)."""
+    return f"\\({' '.join(tex.split())}\\)"
+
+
+def math_block(tex_lines: list[str], indent: str) -> list[str]:
+    """A display formula for pymdownx.arithmatex: ``\\[``, the expression, ``\\]``, each on a line
+    of its own at ``indent`` rounded down to a multiple of 4 (Markdown's nesting step: the
+    formula's block is found only at its container's own indentation, and a directive
+    indented 2 under a list item's text is a paragraph after the list), a blank line
+    before and after."""
+    indent = " " * (len(indent.expandtabs(4)) // 4 * 4)
+    body = [line.strip() for line in tex_lines if line.strip()]
+    return ["", f"{indent}\\[", *(f"{indent}{line}" for line in body), f"{indent}\\]", ""]
+
+
 def role_markdown(role: str, content: str, resolve: Resolver) -> str:
     """The Markdown for one role: an autoref when the target resolves, else code."""
     if role == "math":
-        return code(content.strip())
+        return math_inline(content)
     if role not in OBJECT_ROLES:
         return code(content.strip())
     display, target, linkable = split_target(content)
@@ -193,6 +209,7 @@ def rewrite(text: str, resolve: Resolver) -> str:
     fence: str | None = None
     doctest = False
     literal_indent: int | None = None
+    math: tuple[int, str, list[str]] | None = None  # an open .. math:: block
     section: str | None = None
     section_indent = ""
     for i, line in enumerate(lines):
@@ -207,6 +224,12 @@ def rewrite(text: str, resolve: Resolver) -> str:
             fence = opened[1]
             out.append((False, line))
             continue
+        if math is not None:
+            if not stripped or indent_len > math[0]:
+                math[2].append(line)
+                continue
+            out.extend((False, m) for m in math_block(math[2], math[1]))
+            math = None
         if literal_indent is not None:
             if not stripped or indent_len > literal_indent:
                 out.append((False, line))
@@ -232,17 +255,16 @@ def rewrite(text: str, resolve: Resolver) -> str:
             out.append((False, _fix_types(line, section)))
             continue
         if stripped.startswith(".. math::"):
-            # the display math directive: its expression as an indented code block
-            literal_indent = indent_len
-            expr = stripped.removeprefix(".. math::").strip()
-            out.append((False, ""))
-            if expr:
-                out.append((False, f"{line[:indent_len]}    {expr}"))
+            # the display math directive: its lines (the first's rest, then the deeper ones)
+            # as one display formula
+            math = (indent_len, line[:indent_len], [stripped.removeprefix(".. math::")])
             continue
         if stripped.endswith("::") and not stripped.startswith(".."):
             literal_indent = indent_len
             line = line[: line.rstrip().rfind("::")] + (":" if stripped != "::" else "")
         out.append((bool(stripped), line))
+    if math is not None:
+        out.extend((False, m) for m in math_block(math[2], math[1]))
     # roles and literals may run over a line break: convert each run of prose lines at once
     result: list[str] = []
     run: list[str] = []

@@ -46,7 +46,6 @@ LAYERS: tuple[tuple[str, ...], ...] = (
         "acld_gym",
         "acld_gym.wrappers",
         "acld_gym.test_sets",
-        "acld_gym.benchmark",  # the deprecated alias of test_sets, for one version
         "acld_gym.thesis",
     ),
     ("baselines",),

@@ -46,3 +46,16 @@ def test_voltage_weight_changes_only_the_training_envs_weight():
         assert inner.config.lam == 0.03
     finally:
         venv.close()
+
+
+def test_ppo_settings_replaces_only_the_model_arguments_given():
+    ps = load_probe("ppo_settings")
+    base = na.one_run(None, base="ppo")
+    cfg = ps.config({"learning_rate": {"linear": [1.5e-3, 0.0]}, "n_epochs": 10})
+    assert cfg.model == {
+        **base.model,
+        "learning_rate": {"linear": [1.5e-3, 0.0]},
+        "n_epochs": 10,
+    }
+    assert cfg.env_kwargs == base.env_kwargs and cfg.restarts == 1
+    assert cfg.restart_above is None

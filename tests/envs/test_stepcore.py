@@ -294,6 +294,38 @@ def test_pure_python_switch_is_read_at_import():
     )
     assert out.stdout.strip() == "False"
     assert batch_module.COMPILED_STEP is (batch_module.BatchCore is not None)
+    assert "not built" not in out.stderr  # asked for: no warning
+
+
+#: A child process in which the compiled step cannot be imported (no C compiler at install).
+WITHOUT_COMPILED_STEP = """
+import sys, warnings
+class Block:
+    def find_spec(self, name, path=None, target=None):
+        if name == "acld_gym.envs._stepcore":
+            raise ImportError(name)
+sys.meta_path.insert(0, Block())
+warnings.simplefilter("always")
+import gymnasium as gym, acld_gym
+from acld_gym.envs import batch
+gym.make("ACLDBeam-v1").reset(seed=0)
+print(batch.COMPILED_STEP)
+"""
+
+
+def test_a_missing_compiled_step_is_said_once():
+    """An install without the built extension runs the numpy step and says so in one
+    warning at import, not silently (a new user's scores took 3-6x longer)."""
+    env = {k: v for k, v in os.environ.items() if k != "ACLD_GYM_PURE_PYTHON"}
+    out = subprocess.run(
+        [sys.executable, "-c", WITHOUT_COMPILED_STEP],
+        capture_output=True,
+        text=True,
+        check=True,
+        env=env,
+    )
+    assert out.stdout.strip() == "False"
+    assert out.stderr.count(batch_module.NOT_COMPILED) == 1, out.stderr
 
 
 @pytest.mark.parametrize("compiled", [True, False] if COMPILED_STEP else [False])

@@ -1,11 +1,16 @@
-"""A probe of the guide's SB3 PPO script (docs/examples/sb3_ppo.py) with its entropy
-coefficient and discount as arguments (``--ent``, default the script's 0.05; ``--gamma``,
-0.999); everything else is the script's. Not a test; ~1.5 min a run on one core::
+"""A probe of the guide's SB3 PPO script (docs/examples/sb3_ppo.py) with some of its
+settings as arguments, each defaulting to the script's value: the entropy coefficient
+(``--ent``, 0.05), the discount (``--gamma``, 0.999), the actor's hidden layers (``--pi``,
+JSON, ``[]``: a linear law), gSDE (``--no-sde``: plain Gaussian noise), the epochs
+(``--epochs``, 5) and the minibatch (``--batch``, 512); everything else is the script's.
+Not a test; ~1.5 min a run on one core::
 
-    python studies/probes/guide_ppo_entropy.py ACLDBeamHard-v1 --seed 101 --ent 0
+    python studies/probes/guide_ppo_settings.py ACLDBeamHard-v1 --seed 101 --ent 0
+    python studies/probes/guide_ppo_settings.py ACLDBeamHard-v1 --seed 7 --pi "[64, 64]"
 """
 
 import argparse
+import json
 from functools import partial
 
 import gymnasium as gym
@@ -27,6 +32,10 @@ p.add_argument("--seed", type=arg_type(int, 0, 2**32 - 1), default=0)  # numpy's
 p.add_argument("--episodes", type=int, help="score on the first N test loads (default: all)")
 p.add_argument("--ent", type=float, default=0.05)
 p.add_argument("--gamma", type=float, default=0.999)
+p.add_argument("--pi", type=json.loads, default=[])
+p.add_argument("--sde", action=argparse.BooleanOptionalAction, default=True)
+p.add_argument("--epochs", type=int, default=5)
+p.add_argument("--batch", type=int, default=512)
 args = p.parse_args()
 n_test = len(evaluation_set(args.env_id).seeds)  # checked now, not after training
 if args.episodes is not None and not 1 <= args.episodes <= n_test:
@@ -42,9 +51,9 @@ venv = VecNormalize(
     gamma=args.gamma,
 )
 model = PPO(
-    "MlpPolicy", venv, n_steps=64, batch_size=512, n_epochs=5, gamma=args.gamma, gae_lambda=0.98,
-    learning_rate=lambda progress: 3e-3 * progress, ent_coef=args.ent, use_sde=True,
-    policy_kwargs=dict(net_arch=dict(pi=[], vf=[64, 64]), log_std_init=-1.0), seed=args.seed,
+    "MlpPolicy", venv, n_steps=64, batch_size=args.batch, n_epochs=args.epochs, gamma=args.gamma, gae_lambda=0.98,  # noqa: E501
+    learning_rate=lambda progress: 3e-3 * progress, ent_coef=args.ent, use_sde=args.sde,
+    policy_kwargs=dict(net_arch=dict(pi=args.pi, vf=[64, 64]), log_std_init=-1.0), seed=args.seed,
 )  # fmt: skip
 model.learn(args.timesteps)
 wrappers = [UnitAction] + [partial(ObserveModes, modes=1)] * modes  # the same, one env

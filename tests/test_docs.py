@@ -97,7 +97,9 @@ def test_same_rows_tolerates_only_the_mpc_last_digit():
 def _sections() -> list[tuple[str, str]]:
     text = "\n".join((DOCS / page).read_text() for page in TABLE_PAGES)
     sections = re.findall(
-        r"`python -m baselines\.evaluate --env-id (\S+)`:\n\n```\n(.*?)```", text, flags=re.S
+        r"`(?:acld-gym evaluate|python -m baselines\.evaluate) --env-id (\S+)`:\n\n```\n(.*?)```",
+        text,
+        flags=re.S,
     )
     assert [env_id for env_id, _ in sections] == [
         "ACLDBeam-v1",

@@ -16,14 +16,13 @@ them per step. The sensor noise of an episode is tabulated at reset for both.
 
 from __future__ import annotations
 
-import os
-import warnings
 from typing import NamedTuple
 
 import numpy as np
 
 from acld_gym.design.discrete import SampledSystem
 from acld_gym.envs.checks import check_actions
+from acld_gym.envs.compiled import COMPILED_STEP, NOT_COMPILED, BatchCore  # noqa: F401
 from acld_gym.envs.config import EnvConfig
 from acld_gym.envs.episode import fixed_plant, passive_plant
 from acld_gym.envs.loadcode import LoadCodes
@@ -46,26 +45,6 @@ from acld_gym.envs.step import (
 )
 from acld_gym.physics.actuator import V_LIMIT
 from acld_gym.physics.loads import TipLoad
-
-#: What a user is told once when the compiled step is missing (not on request: the
-#: environment variable ACLD_GYM_PURE_PYTHON=1 asks for the numpy step, silently).
-NOT_COMPILED = (
-    "acld_gym: the compiled step (acld_gym.envs._stepcore) is not built, so the envs run "
-    "numpy's reference step, the same numbers 2-5x slower; install with a C compiler "
-    "present (pip install -e . or make install) to build it"
-)
-
-if os.environ.get("ACLD_GYM_PURE_PYTHON") == "1":  # debugging: numpy steps only
-    BatchCore = None
-else:
-    try:
-        from ._stepcore import BatchCore
-    except ImportError:  # built without a C compiler: the numpy reference step serves
-        BatchCore = None
-        warnings.warn(NOT_COMPILED, UserWarning, stacklevel=2)
-
-#: Whether the step runs compiled (``acld_gym.envs._stepcore``).
-COMPILED_STEP = BatchCore is not None
 
 __all__ = ["BatchStep", "StepResult", "COMPILED_STEP", "WHY"]
 

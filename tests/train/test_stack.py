@@ -153,8 +153,8 @@ def test_train_cli_is_a_benchmark_trial(algo, cpus, tmp_path, capsys, monkeypatc
 
 
 def _documented_commands(module: str) -> list[list[str]]:
-    """The arguments of every ``python -m <module> ...`` line of the README and the docs'
-    shell blocks (line continuations joined, comments dropped, brace lists expanded to
+    """The arguments of every ``python -m <module> ...`` line, or its ``acld-gym`` command's,
+    of the README and the docs' shell blocks (line continuations joined, comments dropped, brace lists expanded to
     their first item). The research record (``studies/studies.md``) is not among them: its
     commands ran on the versions it names, and some of its ablations set options since
     removed (studies/README.md lists them)."""
@@ -162,6 +162,9 @@ def _documented_commands(module: str) -> list[list[str]]:
     import shlex
     from pathlib import Path
 
+    from train.console import module_names
+
+    command = module_names()[module].removeprefix("acld-gym ")
     root = Path(__file__).resolve().parents[2]
     out = []
     pages = [root / "README.md", *sorted((root / "docs").rglob("*.md"))]
@@ -172,6 +175,8 @@ def _documented_commands(module: str) -> list[list[str]]:
                 words = shlex.split(line, comments=True)
                 if words[:3] == ["python", "-m", module]:
                     out.append(words[3:])
+                elif words[:2] == ["acld-gym", command]:
+                    out.append(words[2:])
     return out
 
 

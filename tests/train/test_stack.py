@@ -155,9 +155,9 @@ def test_train_cli_is_a_benchmark_trial(algo, cpus, tmp_path, capsys, monkeypatc
 def _documented_commands(module: str) -> list[list[str]]:
     """The arguments of every ``python -m <module> ...`` line, or its ``acld-gym`` command's,
     of the README and the docs' shell blocks (line continuations joined, comments dropped,
-    brace lists expanded to their first item). The research record (``studies/studies.md``) is not among them: its
-    commands ran on the versions it names, and some of its ablations set options since
-    removed (studies/README.md lists them)."""
+    brace lists expanded to their first item). The research record (``studies/studies.md``)
+    is not among them: its commands ran on the versions it names, and some of its ablations
+    set options since removed (studies/README.md lists them)."""
     import re
     import shlex
     from pathlib import Path

@@ -1,6 +1,8 @@
 """A probe of PPO's settings on one level: the PPO recipe (one run per seed, no retry) with
-some of its model keyword arguments replaced (``--model``, JSON), scored as every agent is
-(score v2 on the level's test set, ISE / thesis LQR) beside its validation cost (the env's
+some of its model keyword arguments replaced (``--model``, JSON; its policy's:
+``--policy-kwargs``; ``--recipe sac``: SAC's recipe, its checkpoint selection kept),
+scored as every agent is (score v2 on the level's test set, ISE / thesis LQR) beside its
+validation cost (the env's
 reward per load on the validation loads of :func:`train.core.evaluate.validation_cost`'s
 default seeds, 64 loads: not the recipe's 256, so its values sit ~0.012 above the retry
 messages' on the lab rig).
@@ -27,11 +29,14 @@ import time
 from probe import one_run, seeds_main  # studies/probes/probe.py
 
 
-def config(model: dict, recipe: str = "ppo"):
+def config(model: dict, recipe: str = "ppo", policy_kwargs: dict | None = None):
     """The recipe's config, one run per seed, its model keyword arguments updated by
-    ``model``."""
+    ``model`` and its policy's by ``policy_kwargs``."""
     cfg = one_run(None, base=recipe)
-    return dataclasses.replace(cfg, model={**cfg.model, **model})
+    new = {**cfg.model, **model}
+    if policy_kwargs:
+        new["policy_kwargs"] = {**cfg.model.get("policy_kwargs", {}), **policy_kwargs}
+    return dataclasses.replace(cfg, model=new)
 
 
 def run(seed: int, args) -> dict:
@@ -40,7 +45,8 @@ def run(seed: int, args) -> dict:
     from train.scoring import score
 
     model = json.loads(args.model)
-    cfg = config(model, args.recipe)
+    policy_kwargs = json.loads(args.policy_kwargs)
+    cfg = config(model, args.recipe, policy_kwargs)
     t0 = time.perf_counter()
     policy, _ = train_sb3(cfg, seed, args.env_id)
     wall = time.perf_counter() - t0
@@ -48,7 +54,9 @@ def run(seed: int, args) -> dict:
     return {
         "seed": seed,
         "env_id": args.env_id,
+        "recipe": args.recipe,
         "model": model,
+        "policy_kwargs": policy_kwargs,
         "train_wall_s": round(wall),
         "score_v2": round(got.iqm, 4),
         "ise_rel_lqr": {str(k): round(float(v), 3) for k, v in got.ise_rel_lqr.items()},
@@ -59,7 +67,8 @@ def run(seed: int, args) -> dict:
 def add_arguments(p) -> None:
     p.add_argument("--env-id", default="ACLDBeamLab-v1")
     p.add_argument("--model", default="{}", help="PPO keyword arguments to replace (JSON)")
-    p.add_argument("--recipe", default="ppo")
+    p.add_argument("--policy-kwargs", default="{}", help="policy keyword arguments (JSON)")
+    p.add_argument("--recipe", default="ppo", help="the recipe changed (ppo or sac)")
 
 
 if __name__ == "__main__":

@@ -59,3 +59,12 @@ def test_ppo_settings_replaces_only_the_model_arguments_given():
     }
     assert cfg.env_kwargs == base.env_kwargs and cfg.restarts == 1
     assert cfg.restart_above is None
+
+
+def test_ppo_settings_updates_the_policy_arguments_it_is_given_only():
+    ps = load_probe("ppo_settings")
+    base = na.one_run(None, base="sac")
+    cfg = ps.config({}, "sac", {"log_std_min": -2.3})
+    kwargs = {**base.model["policy_kwargs"], "log_std_min": -2.3}
+    assert cfg.model == {**base.model, "policy_kwargs": kwargs}
+    assert cfg.select == base.select and cfg.restarts == 1

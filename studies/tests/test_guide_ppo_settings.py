@@ -35,3 +35,16 @@ def test_the_probe_is_the_script_at_its_defaults():
             line = line.replace(f"args.{name}", value)
         at_defaults.append(line)
     assert at_defaults == _body(ROOT / "docs/examples/sb3_ppo.py")
+
+
+def test_the_sac_probe_is_the_script_at_its_defaults():
+    probe = _body(ROOT / "studies/probes/guide_sac_settings.py")
+    ent = 'type=lambda s: s if s.startswith("auto") else float(s), default="auto"'
+    added = f'p.add_argument("--ent", {ent})'
+    assert added in probe
+    at_defaults = [
+        line.replace(" ent_coef=args.ent,", "").removesuffix("  # noqa: E501")
+        for line in probe
+        if line != added
+    ]
+    assert at_defaults == _body(ROOT / "docs/examples/sb3_sac.py")

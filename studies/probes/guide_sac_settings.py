@@ -1,0 +1,52 @@
+"""A probe of the guide's SB3 SAC script (docs/examples/sb3_sac.py) with its entropy
+coefficient as an argument (``--ent``: ``auto``, the script's SAC default, or a fixed
+number; the package's SAC recipe fixes it at 1e-3); everything else is the script's. Not a
+test; ~4.5 min a run on one core::
+
+    python studies/probes/guide_sac_settings.py ACLDBeam-v1 --seed 7 --ent 0.001
+"""
+
+import argparse
+from functools import partial
+
+import gymnasium as gym
+import torch
+from stable_baselines3 import SAC
+from stable_baselines3.common.vec_env import VecNormalize
+
+from acld_gym.envs import SB3VecEnv
+from acld_gym.envs.presets import PRESETS, preset
+from acld_gym.test_sets import evaluation_set
+from acld_gym.util.validate import arg_type
+from acld_gym.wrappers import ObserveModes, UnitAction, vector
+from train.scoring import score
+
+p = argparse.ArgumentParser()
+p.add_argument("env_id", nargs="?", default="ACLDBeam-v1", choices=list(PRESETS))
+p.add_argument("--timesteps", type=arg_type(int, 10_001), default=300_000)  # > learning_starts
+p.add_argument("--seed", type=arg_type(int, 0, 2**32 - 1), default=0)  # numpy's range
+p.add_argument("--ent", type=lambda s: s if s.startswith("auto") else float(s), default="auto")
+p.add_argument("--episodes", type=int, help="score on the first N test loads (default: all)")
+args = p.parse_args()
+n_test = len(evaluation_set(args.env_id).seeds)  # checked now, not after training
+if args.episodes is not None and not 1 <= args.episodes <= n_test:
+    p.error(f"argument --episodes: expected an integer in [1, {n_test}], got {args.episodes}")
+torch.set_num_threads(1)  # torch's default threads make SB3 15-25x slower on 2 cores
+
+modes = preset(args.env_id).obs_mode == "estimate"  # mode 1 and the tip, where observed
+venv = VecNormalize(
+    SB3VecEnv(
+        venv=gym.make_vec(args.env_id, 16, load_case="random", reward_scale="passive"),
+        wrappers=[partial(vector.UnitAction, headroom=3.0)]
+        + [partial(vector.ObserveModes, modes=1)] * modes,
+    ),
+    gamma=0.995,
+)
+model = SAC(
+    "MlpPolicy", venv, buffer_size=300_000, batch_size=1024, learning_starts=10_000,
+    gamma=0.995, n_steps=5, learning_rate=1e-3, gradient_steps=2, ent_coef=args.ent,
+    policy_kwargs=dict(net_arch=dict(pi=[], qf=[64, 64])), seed=args.seed,
+)  # fmt: skip
+model.learn(args.timesteps)
+wrappers = [partial(UnitAction, headroom=3.0)] + [partial(ObserveModes, modes=1)] * modes
+print(score(model, args.env_id, wrappers=wrappers, episodes=args.episodes))

@@ -22,7 +22,7 @@ import numpy as np
 
 from acld_gym.design.discrete import SampledSystem
 from acld_gym.envs.checks import check_actions
-from acld_gym.envs.compiled import COMPILED_STEP, NOT_COMPILED, BatchCore  # noqa: F401
+from acld_gym.envs.compiled import COMPILED_STEP, BatchCore
 from acld_gym.envs.config import EnvConfig
 from acld_gym.envs.episode import fixed_plant, passive_plant
 from acld_gym.envs.loadcode import LoadCodes

@@ -24,9 +24,8 @@ from __future__ import annotations
 import dataclasses
 import json
 import sys
-import time
 
-from probe import one_run, seeds_main  # studies/probes/probe.py
+from probe import one_run, seeds_main, train_and_score  # studies/probes/probe.py
 
 
 def config(model: dict, recipe: str = "ppo", policy_kwargs: dict | None = None):
@@ -41,16 +40,11 @@ def config(model: dict, recipe: str = "ppo", policy_kwargs: dict | None = None):
 
 def run(seed: int, args) -> dict:
     from train.core.evaluate import validation_cost
-    from train.core.sb3_train import train_sb3
-    from train.scoring import score
 
     model = json.loads(args.model)
     policy_kwargs = json.loads(args.policy_kwargs)
     cfg = config(model, args.recipe, policy_kwargs)
-    t0 = time.perf_counter()
-    policy, _ = train_sb3(cfg, seed, args.env_id)
-    wall = time.perf_counter() - t0
-    got = score(policy, args.env_id)
+    policy, got, wall = train_and_score(cfg, seed, args.env_id)
     return {
         "seed": seed,
         "env_id": args.env_id,

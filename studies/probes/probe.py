@@ -107,3 +107,16 @@ def seeds_main(
     for seed in args.seeds:
         print(json.dumps(run(seed, args)), flush=True)
     return 0
+
+
+def train_and_score(cfg, seed: int, env_id: str):
+    """Train one run of ``cfg`` for ``seed`` on ``env_id`` and score it as every agent is:
+    ``(policy, score, training wall time [s])``, the score a
+    :class:`train.scoring.PolicyScore` (score v2 on the level's test set, ISE / thesis LQR)."""
+    from train.core.sb3_train import train_sb3
+    from train.scoring import score
+
+    t0 = time.perf_counter()
+    policy, _ = train_sb3(cfg, seed, env_id)
+    wall = time.perf_counter() - t0
+    return policy, score(policy, env_id), wall

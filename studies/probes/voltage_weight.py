@@ -18,9 +18,8 @@ from __future__ import annotations
 
 import dataclasses
 import sys
-import time
 
-from probe import one_run, seeds_main  # studies/probes/probe.py
+from probe import one_run, seeds_main, train_and_score  # studies/probes/probe.py
 
 
 def config(lam: float, recipe: str = "ppo"):
@@ -32,14 +31,9 @@ def config(lam: float, recipe: str = "ppo"):
 
 def run(seed: int, args) -> dict:
     from train.core.evaluate import validation_cost
-    from train.core.sb3_train import train_sb3
-    from train.scoring import score
 
     cfg = config(args.lam, args.recipe)
-    t0 = time.perf_counter()
-    policy, record = train_sb3(cfg, seed, args.env_id)
-    wall = time.perf_counter() - t0
-    got = score(policy, args.env_id)
+    policy, got, wall = train_and_score(cfg, seed, args.env_id)
     return {
         "seed": seed,
         "env_id": args.env_id,

@@ -18,6 +18,7 @@ import pytest
 
 from acld_gym.envs import batch as batch_module
 from acld_gym.envs.beam_env import COMPILED_STEP, ACLDBeamEnv
+from acld_gym.envs.compiled import NOT_COMPILED
 from acld_gym.envs.step import INFO_KEYS
 
 needs_core = pytest.mark.skipif(not COMPILED_STEP, reason="ACLD_GYM_PURE_PYTHON=1 was set")
@@ -325,7 +326,7 @@ def test_a_missing_compiled_step_is_said_once():
         env=env,
     )
     assert out.stdout.strip() == "False"
-    assert out.stderr.count(batch_module.NOT_COMPILED) == 1, out.stderr
+    assert out.stderr.count(NOT_COMPILED) == 1, out.stderr
 
 
 @pytest.mark.parametrize("compiled", [True, False] if COMPILED_STEP else [False])

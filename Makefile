@@ -29,25 +29,26 @@ install: $(STAMP)
 RUN_SCORE_EPISODES ?= 20
 run: $(STAMP)
 	$(BIN)/acld-gym reproduce --json results/table2.json --plots results/figures
-	$(BIN)/python -m baselines.evaluate --score-episodes $(RUN_SCORE_EPISODES) --json results/baselines.json --plots results/figures
-	$(BIN)/python -m train.compare --score-episodes $(RUN_SCORE_EPISODES) --json results/compare.json --plots results/figures
+	$(BIN)/acld-gym evaluate --score-episodes $(RUN_SCORE_EPISODES) --json results/baselines.json --plots results/figures
+	$(BIN)/acld-gym compare --score-episodes $(RUN_SCORE_EPISODES) --json results/compare.json --plots results/figures
 
 ## The README's slower studies: mesh convergence and the thesis mesh against the converged
 ## plant, the baselines' stability at every corner of the parameter box, and every policy
 ## in control terms with its score (modes, peaks, margins, effort; ~4 min).
 studies: $(STAMP)
 	$(BIN)/acld-gym mesh --json results/mesh.json
-	$(BIN)/python -m baselines.robustness
-	$(BIN)/python -m train.analyze passive lqr smc mpc $(dir $(wildcard train/agents/*/metadata.json)) --json results/analysis.json --markdown results/analysis.md --plots results/figures
+	$(BIN)/acld-gym robustness
+	$(BIN)/acld-gym analyze passive lqr smc mpc $(dir $(wildcard train/agents/*/metadata.json)) --json results/analysis.json --markdown results/analysis.md --plots results/figures
 
-## Retrain the shipped agents, from scratch (no teacher): the benchmark's runs of vrs, ppo and
-## sac (5 seeds each, resumable), then ship vrs seed 0 and the ppo and sac seeds that are best
-## on the thesis cases (docs/training.md, "Reinforcement learning from scratch").
+## Retrain the repository's shipped ACLDBeam-v1 agents (train/agents/vrs, ppo, sac), from
+## scratch (no teacher): the benchmark's runs of vrs, ppo and sac (5 seeds each, resumable),
+## then ship vrs seed 0 and the ppo and sac seeds that are best on the thesis cases over the
+## ones in train/agents (docs/training.md, "Reinforcement learning from scratch").
 agents: $(STAMP)
-	$(BIN)/python -m train.benchmark --algos vrs ppo sac --seeds 0 1 2 3 4 --resume --out runs/benchmark/v1
-	$(BIN)/python -m train.ship runs/benchmark/v1/agents/vrs-s0 vrs
-	$(BIN)/python -m train.ship runs/benchmark/v1 ppo --best ppo
-	$(BIN)/python -m train.ship runs/benchmark/v1 sac --best sac
+	$(BIN)/acld-gym benchmark --algos vrs ppo sac --seeds 0 1 2 3 4 --resume --out runs/benchmark/v1
+	$(BIN)/acld-gym ship runs/benchmark/v1/agents/vrs-s0 vrs --agents train/agents --force
+	$(BIN)/acld-gym ship runs/benchmark/v1 ppo --best ppo --agents train/agents --force
+	$(BIN)/acld-gym ship runs/benchmark/v1 sac --best sac --agents train/agents --force
 
 ## ruff: lint, and the format check (`make format` applies it).
 lint: $(STAMP)

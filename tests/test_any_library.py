@@ -20,6 +20,7 @@ import subprocess
 import sys
 import types
 from collections import OrderedDict
+from functools import partial
 from pathlib import Path
 
 import gymnasium as gym
@@ -117,9 +118,34 @@ def _check_score(stdout: str, env_id: str, episodes: int) -> None:
     "script, steps, env_id", [("sb3_ppo.py", 16_384, "ACLDBeam-v1"), ("sb3_sac.py", 12_000, OTHER)]
 )
 def test_sb3_script_runs_on_a_tiny_budget(script, steps, env_id, tmp_path, monkeypatch, capsys):
+    """The script trains, scores and, with ``--save DIR``, keeps the model and its
+    ``VecNormalize`` statistics, which score the same once loaded (the page's way to score
+    a saved model)."""
+    from stable_baselines3 import PPO, SAC
+
+    from acld_gym.wrappers import ObserveModes, UnitAction
+    from train.scoring import score
+
+    saved = tmp_path / "kept" / "run"
     args = [str(EXAMPLES / script), env_id, "--timesteps", str(steps), "--episodes", "2"]
-    out = _run_here(args, tmp_path, monkeypatch, capsys)
+    out = _run_here([*args, "--save", str(saved)], tmp_path, monkeypatch, capsys)
     _check_score(out, env_id, 2)
+    algo, headroom = (PPO, 1.0) if script == "sb3_ppo.py" else (SAC, 3.0)
+    wrappers = [partial(UnitAction, headroom=headroom)]
+    if env_id != "ACLDBeamHard-v1":
+        wrappers.append(partial(ObserveModes, modes=1))
+    if script == "sb3_ppo.py":  # the page's block on this folder, on the script's level
+        block = PAGE.read_text().split('```py title="score a saved model"\n')[1].split("```")[0]
+        block = block.replace("runs/ppo-v1", str(saved)).replace('"ACLDBeam-v1"', repr(env_id))
+        block = block.replace("wrappers=wrappers,", "wrappers=wrappers, episodes=2,")
+        capsys.readouterr()
+        exec(compile(block, "any-library.md", "exec"), {})
+        assert capsys.readouterr().out.strip() == out.strip().splitlines()[-1]
+    model = algo.load(saved / "model.zip", device="cpu")
+    again = score(
+        model, env_id, wrappers=wrappers, episodes=2, vec_normalize=saved / "vecnormalize.pkl"
+    )
+    assert str(again) == out.strip().splitlines()[-1]
 
 
 # -- bad arguments: one line, before anything is trained or loaded -----------------------------
@@ -187,6 +213,10 @@ def refused(monkeypatch, capsys):
 
 
 BAD_ARGS = [
+    (
+        ["--save", "/dev/null/x"],
+        "argument --save: expected a folder that can hold files, got '/dev/null/x' (",
+    ),
     (["ACLDBeam-v9"], "argument env_id: invalid choice: 'ACLDBeam-v9'"),
     (["--episodes", "0"], "argument --episodes: expected an integer in [1, 100], got 0"),
     (

@@ -18,9 +18,11 @@ share a folder), atomically:
   SMC, MPC and bound levels;
 * ``trials/<name>-s<seed>.json`` (one per run) and ``references-<env id>.json``.
 
-Runs go through Ray Tune when it is installed (``--backend ray``: one trial per CPU,
-local with ``--num-cpus`` or on a cluster with ``--address``), else one after the
-other (``--backend local``).
+A command of several trials runs them through Ray Tune when it is installed
+(``--backend ray``: one trial per CPU, local with ``--num-cpus`` or on a cluster with
+``--address``), else one after the other (``--backend local``); a single trial (one
+config, one seed) runs here, without Ray, unless ``--backend ray`` or ``--address`` asks
+for it.
 
 Examples::
 
@@ -145,7 +147,8 @@ def build_parser() -> argparse.ArgumentParser:
         "--backend",
         choices=("auto", "ray", "local"),
         default="auto",
-        help="ray: Ray Tune trials; local: one after the other; auto: ray if installed",
+        help="ray: Ray Tune trials; local: one after the other; auto (default): ray if "
+        "installed and the command has several trials or an --address, else local",
     )
     p.add_argument(
         "--num-cpus",
@@ -205,11 +208,26 @@ def trial_workers(cpus_per_trial: int | None, num_cpus: int, address: str | None
     return 1 if address else num_cpus
 
 
+def auto_backend(n_trials: int, address: str | None, installed: bool) -> str:
+    """``--backend auto``: ``"ray"`` where Ray Tune is ``installed`` and it has something to
+    spread (more than one of the command's ``n_trials``, or a cluster's ``address``), else
+    ``"local"``. One trial gains nothing from Ray and would pay for its start (a few
+    seconds, its log lines, its files under ``~/.ray``)."""
+    return "ray" if installed and (n_trials > 1 or address is not None) else "local"
+
+
 def check_outputs(out: Path, trials: list[dict], backend: str, env_id: str) -> None:
     """``ValueError`` naming ``--out`` unless every file the command writes there can be
     written (the tables, the figure, the references, each trial's record and agent folder,
     Ray's storage): called before anything is computed."""
     check_directory(out, "--out")
+    held = [n for n in ("policy.npz", "metadata.json") if (out / n).exists()]
+    if held:  # an agent's folder (acld-gym train's --out, or a shipped agent)
+        raise ValueError(
+            f"--out: {str(out)!r} holds an agent ({', '.join(held)}), the --out of acld-gym "
+            "train or a shipped one; a benchmark writes its tables and agents/ into a folder "
+            "of its own: choose another"
+        )
     names = ["results.md", "results.json", "learning_curves.png", f"references-{env_id}.json"]
     for t in trials:
         names.append(str(trial_path(Path(), t["name"], t["seed"])))
@@ -279,9 +297,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.no_train and not args.resume:
         parser.error("--no-train needs --resume")
     backend = args.backend
-    if backend == "auto":
-        backend = "ray" if ray_available() else "local"
-    elif backend == "ray" and not ray_available():
+    if backend == "ray" and not ray_available():
         parser.error('Ray Tune is not installed: pip install -e ".[sweep]" (or --backend local)')
     specs = list(args.algos or ([] if args.config else DEFAULT_ALGOS)) + list(args.config)
     try:
@@ -314,6 +330,8 @@ def main(argv: list[str] | None = None) -> int:
                     "quiet": args.quiet,
                 }
             )
+    if backend == "auto":
+        backend = auto_backend(len(planned), args.address, ray_available())
     try:
         check_outputs(out, planned, backend, args.env_id)
     except ValueError as exc:

@@ -4,12 +4,12 @@ A policy trained with any library on a level of this benchmark is scored the way
 package scores its own agents and references:
 
 * its **score** (score v2, :mod:`baselines.evaluation.score`): the interquartile mean over
-  the level's published test set (:data:`baselines.evaluation.seeds.TEST_SETS`) of
+  the level's published test set (:data:`acld_gym.test_sets.TEST_SETS`) of
   :math:`(ISE_{passive} - ISE) / (ISE_{passive} - ISE_{bound})` per episode, with its 95 %
   bootstrap interval (passive 0, the clairvoyant bound 1);
 * its **ISE relative to the thesis LQR** (the thesis-facing view of ``python -m
   train.compare``, :mod:`baselines.evaluation.ise`): the thesis cases 1, 2, 3
-  (seed 0) and the held-out random loads (:data:`baselines.evaluation.seeds.HELDOUT_SEEDS`), the
+  (seed 0) and the held-out random loads (:data:`acld_gym.test_sets.HELDOUT_SEEDS`), the
   mean ISE per case divided by the LQR's designed on the same level.
 
 The policy may be a stable-baselines3 model (with its ``VecNormalize`` statistics: the

@@ -146,6 +146,23 @@ def arg_type(kind: type, low=None, high=None, *, low_open: bool = False):
     return parse
 
 
+def arg_dir(text: str) -> str:
+    """An argparse ``type=`` for an output folder: ``text`` if it is (or can be made) a
+    folder that accepts files (:func:`acld_gym.util.atomic.check_directory`), checked when
+    the command line is parsed, before anything is computed."""
+    from .atomic import check_directory
+
+    try:
+        check_directory(text, "folder")
+    except ValueError as exc:
+        why = str(exc).removeprefix("folder: ")
+        why = why[why.rindex("(") :] if why.endswith(")") and "(" in why else f"({why})"
+        raise argparse.ArgumentTypeError(
+            f"expected a folder that can hold files, got {text!r} {why}"
+        ) from None
+    return text
+
+
 class closed_pipe_is_fine:  # noqa: N801 (a context manager used like a function)
     """Context manager for a command's output: a reader that closes the pipe early
     (``acld-gym params | head -1``) ends the command quietly instead of with a

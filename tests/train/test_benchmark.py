@@ -422,6 +422,65 @@ def test_a_multi_run_trial_takes_every_cpu_by_default(tmp_path, monkeypatch, fla
     assert benchmark.trial_workers(3, 2, None) == 3
 
 
+@pytest.mark.parametrize(
+    "argv, installed, expected",
+    [
+        (["--algos", "vrs", "--seeds", "0"], True, "local"),  # one trial: nothing to spread
+        (["--algos", "vrs", "--seeds", "0", "1"], True, "ray"),
+        (["--algos", "vrs", "ppo", "--seeds", "0"], True, "ray"),
+        (["--algos", "vrs", "--seeds", "0", "--address", "ray://head:10001"], True, "ray"),
+        (["--algos", "vrs", "--seeds", "0", "1"], False, "local"),  # Ray not installed
+        (["--algos", "vrs", "--seeds", "0", "--backend", "ray"], True, "ray"),  # as asked
+        (["--algos", "vrs", "--seeds", "0", "1", "--backend", "local"], True, "local"),
+    ],
+)
+def test_auto_backend_uses_ray_only_with_several_trials(
+    tmp_path, monkeypatch, argv, installed, expected
+):
+    """``--backend auto`` (the default) starts Ray Tune only where it has trials to spread
+    (or a cluster's address): the README's one-seed command runs here, without Ray's start,
+    log lines and files."""
+    import train.benchmark as benchmark
+
+    seen = []
+
+    class Stop(Exception):
+        pass
+
+    def fake_run_trials(trials, out, backend, num_cpus, address, w):
+        seen.append(backend)
+        raise Stop
+
+    monkeypatch.setattr(benchmark, "ray_available", lambda: installed)
+    monkeypatch.setattr(benchmark, "resumed_references", lambda *a, **k: {})
+    monkeypatch.setattr(benchmark, "run_trials", fake_run_trials)
+    with pytest.raises(Stop):
+        benchmark.main([*argv, "--out", str(tmp_path), "--num-cpus", "2"])
+    assert seen == [expected]
+    assert benchmark.auto_backend(1, None, True) == "local"
+    assert benchmark.auto_backend(3, None, False) == "local"
+
+
+@pytest.mark.parametrize("held", ["policy.npz", "metadata.json"])
+def test_benchmark_refuses_an_agents_folder_as_its_out(tmp_path, capsys, held):
+    """``--out`` a folder of ``acld-gym train`` (an agent beside its ``trial.json``): one
+    line naming it, before anything is computed, and the folder left as it was (``acld-gym
+    train`` refuses a benchmark's folder the same way)."""
+    from train.benchmark import main
+
+    run = tmp_path / "runs" / "vrs"
+    run.mkdir(parents=True)
+    (run / held).write_bytes(b"x")
+    (run / "trial.json").write_text("{}")
+    before = sorted(p.name for p in run.iterdir())
+    with pytest.raises(SystemExit) as stop:
+        main(["--algos", "vrs", "--seeds", "0", "--backend", "local", "--out", str(run)])
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert stop.value.code == 2 and "Traceback" not in err
+    assert f"--out: {str(run)!r} holds an agent ({held})" in err
+    assert sorted(p.name for p in run.iterdir()) == before
+
+
 @pytest.mark.slow
 def test_benchmark_through_ray_tune(tmp_path):
     pytest.importorskip("ray", reason="Ray Tune is the optional extra .[sweep]")

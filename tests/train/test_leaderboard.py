@@ -47,6 +47,22 @@ def test_the_committed_data_hold_the_references_of_the_seeded_levels():
             assert all(bound <= e["ise_rel_lqr"][c] * (1 + 1e-9) for e in refs.values())
 
 
+def test_render_reads_the_levels_files_only_beside_make_runs_outputs(tmp_path):
+    """``make run`` writes ``baselines.json``, ``compare.json`` and ``table2.json`` into
+    ``results/`` beside the levels' files: the leaderboard reads ``<env id>.json`` of the
+    registered ids and nothing else (it had refused ``baselines.json``, a list, after a
+    ``make run``)."""
+    for env_id in ("ACLDBeam-v1", "ACLDBeamLab-v1"):
+        shutil.copy(RESULTS / f"{env_id}.json", tmp_path)
+    (tmp_path / "baselines.json").write_text('[{"case": 1, "policy": "passive"}]')
+    (tmp_path / "compare.json").write_text("{}")
+    (tmp_path / "ACLDBeam-v9.json").write_text("{}")  # no such id: not a level
+    assert sorted(read_levels(tmp_path)) == ["ACLDBeam-v1", "ACLDBeamLab-v1"]
+    assert read_levels(tmp_path) == {
+        k: v for k, v in read_levels(RESULTS).items() if k in ("ACLDBeam-v1", "ACLDBeamLab-v1")
+    }
+
+
 def test_render_regenerates_the_committed_page_and_readme_block_exactly(capsys):
     levels = read_levels(RESULTS)
     assert page(levels) == PAGE.read_text(encoding="utf-8")

@@ -55,3 +55,37 @@ def test_agents_dir_overrides_and_the_function_default_is_the_working_directory(
     assert ship(AGENTS_DIR / "ppo", "other").resolve() == (tmp_path / "agents/other").resolve()
     assert TrainedAgent.load(tmp_path / "agents" / "other").metadata["algo"] == "ppo"
     assert _tree(AGENTS_DIR) == before
+
+
+def _make_recipe(target: str) -> list[list[str]]:
+    """The command lines of a Makefile target (``$(BIN)/`` dropped), split into words."""
+    import re
+    import shlex
+
+    make = (Path(__file__).resolve().parents[2] / "Makefile").read_text()
+    body = re.search(rf"^{target}:.*\n((?:\t.*\n)+)", make, flags=re.M)
+    assert body, f"the Makefile has no target {target!r}"
+    return [shlex.split(line.strip().replace("$(BIN)/", "")) for line in body[1].splitlines()]
+
+
+def test_make_agents_retrains_the_repositorys_shipped_agents(tmp_path, monkeypatch):
+    """``make agents`` says it retrains the shipped agents: its ship lines replace
+    ``train/agents/<name>`` (``--agents train/agents --force``, so a second run replaces them
+    too), from the folder its benchmark line writes, and the two commands parse."""
+    from train.benchmark import build_parser
+
+    lines = _make_recipe("agents")
+    bench = [w for w in lines if w[:2] == ["acld-gym", "benchmark"]]
+    ships = [w for w in lines if w[:2] == ["acld-gym", "ship"]]
+    assert len(bench) == 1 and len(ships) == 3
+    out = build_parser().parse_args(bench[0][2:]).out
+    root = Path(__file__).resolve().parents[2]
+    names = []
+    for words in ships:
+        args = words[2:]
+        assert args[args.index("--agents") + 1] == "train/agents" and "--force" in args
+        assert (root / "train" / "agents").resolve() == AGENTS_DIR.resolve()
+        assert args[0].startswith(out)
+        names.append(args[1])
+    assert sorted(names) == ["ppo", "sac", "vrs"]
+    assert all((AGENTS_DIR / n / POLICY_FILE).is_file() for n in names)

@@ -243,6 +243,28 @@ def test_arg_type_says_what_it_expected():
         arg_type(int, 1, 5)("6")
 
 
+def test_arg_dir_takes_a_folder_that_can_hold_files_and_names_why_not(tmp_path):
+    """``arg_dir`` (the guide scripts' ``--save``): a folder to be made, or one there, is
+    returned as given and nothing is written into it; a file, or a path under one, is
+    refused with the reason, never the name of its internal probe file."""
+    import argparse
+
+    from acld_gym.util.validate import arg_dir
+
+    (tmp_path / "there").mkdir()
+    for ok in (tmp_path / "new" / "deeper", tmp_path / "there"):
+        assert arg_dir(str(ok)) == str(ok)
+    assert list((tmp_path / "there").iterdir()) == []
+    (tmp_path / "file").write_text("x")
+    for bad, why in (("file", "exists and is not a directory"), ("file/x", "is not a directory")):
+        path = str(tmp_path / bad)
+        with pytest.raises(argparse.ArgumentTypeError) as err:
+            arg_dir(path)
+        line = str(err.value)
+        assert line.startswith(f"expected a folder that can hold files, got {path!r} (")
+        assert why in line and "probe" not in line
+
+
 @pytest.mark.parametrize("size", [10, 100_000])  # flushed at the end / written in main
 @pytest.mark.parametrize("unbuffered", ["", "1"])
 def test_a_full_disk_under_stdout_redirection_is_one_line_naming_it(tmp_path, size, unbuffered):

@@ -128,7 +128,7 @@ def guide_block(runs: list[dict], levels: dict[str, dict]) -> str:
     """The block, markers included (no runs: the block says so)."""
     lead = (
         f"Generated from `results/{GUIDE_FILE.as_posix()}` and `results/<env id>.json` by "
-        f"`{COMMAND}`; each run measured by `python -m train.leaderboard guide-run -- "
+        f"`{COMMAND}`; each run measured by `acld-gym leaderboard guide-run -- "
         "COMMAND` (its command in the last column). ISE / LQR: on cases 1, 2, 3 (seed 0) and "
         "the held-out random loads; a run beats the thesis LQR and SMC where its ISE is below "
         "both on cases 1, 2 and the random loads. Wall time: the command's, training and the "

@@ -36,7 +36,7 @@ __all__ = [
 ]
 
 #: The command that regenerates the page and the README block.
-COMMAND = "python -m train.leaderboard render"
+COMMAND = "acld-gym leaderboard render"
 #: The mark an algorithm reaches on a level: its IQM at least the best engineer's score minus this.
 GOAL_MARGIN = 0.02
 #: The cases on which a seed must beat the thesis LQR and SMC (ISE below both).
@@ -46,15 +46,18 @@ ORACLE = "plant oracle"
 
 
 def read_levels(results: str | Path) -> dict[str, dict]:
-    """``{env id: level}`` of every ``results/*.json`` (each checked:
-    :func:`train.leaderboard.schema.read_level`)."""
+    """``{env id: level}`` of every ``results/<env id>.json`` of a registered id (each
+    checked: :func:`train.leaderboard.schema.read_level`). The folder's other files are not
+    the leaderboard's: ``make run`` writes its own (``baselines.json``, ``compare.json``,
+    ``table2.json``, ...) into ``results/`` too."""
     folder = Path(results)
     if not folder.is_dir():
         raise file_error(folder, None, "not a folder of results (results/<env id>.json)")
     levels = {}
-    for path in sorted(folder.glob("*.json")):
-        level = read_level(path)
-        levels[level["env_id"]] = level
+    for env_id in sorted(PRESETS):
+        path = folder / f"{env_id}.json"
+        if path.is_file():
+            levels[env_id] = read_level(path)
     return levels
 
 
@@ -242,9 +245,11 @@ INTRO = f"""# Leaderboard
 Every reference and trained agent of each level, generated from the committed data
 (`results/<env id>.json`, one file per level) by `{COMMAND}`; do not edit this page by
 hand (`{COMMAND} --check` fails on any difference, and the tests run it). Data are
-collected with `python -m train.leaderboard collect --env-id ID --references` (the
-references of `python -m baselines.evaluate`) and `python -m train.leaderboard collect
---env-id ID --benchmark DIR` (the agents of a `python -m train.benchmark` folder).
+collected with `acld-gym leaderboard collect --env-id ID --references` (the
+references of `acld-gym evaluate`) and `acld-gym leaderboard collect --env-id ID
+--benchmark DIR` (the agents of an `acld-gym benchmark` folder); each is the `python -m`
+module of its command (`python -m train.leaderboard`, `python -m baselines.evaluate`,
+`python -m train.benchmark`), the form the recorded commands below keep.
 
 - **score v2**: on the level's test set of random loads, the interquartile mean of
   (ISE_passive - ISE) / (ISE_passive - ISE_bound), passive 0 and the clairvoyant bound 1,

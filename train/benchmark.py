@@ -79,6 +79,7 @@ __all__ = [
     "CONFIG_DIR",
     "DEFAULT_ALGOS",
     "agent_dir",
+    "auto_backend",
     "read_config",
     "policy_program",
     "run_trial",

@@ -15,7 +15,7 @@ holds the tools.
 
 from acld_gym.envs.registration import register_presets
 
-__version__ = "0.25.0"
+__version__ = "0.26.0"
 
 #: The current environment id.
 ENV_ID = "ACLDBeam-v1"

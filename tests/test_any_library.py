@@ -587,7 +587,7 @@ def test_page_states_its_measured_runs_from_the_data():
     on; every registered level is named."""
     text = PAGE.read_text()
     assert text.count("<!-- guide-runs:start -->") == 1
-    assert "guide-run -- COMMAND" in text and "python -m train.leaderboard render" in text
+    assert "guide-run -- COMMAND" in text and "acld-gym leaderboard render" in text
     for env_id in PRESETS:
         assert env_id in text
 

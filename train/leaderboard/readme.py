@@ -53,7 +53,7 @@ def readme_block(levels: dict[str, dict]) -> str:
         rows.append("| " + " | ".join(cells) + " |")
     lead = (
         "- **The leaderboard of every level** ([docs/leaderboard.md](docs/leaderboard.md), "
-        f"generated from `results/*.json` by `{COMMAND}`): score v2, the IQM on each "
+        f"generated from `results/<env id>.json` by `{COMMAND}`): score v2, the IQM on each "
         "level's test set (passive 0, clairvoyant bound 1; an algorithm's is the IQM over "
         "its seeds); every policy with its interval, ISE relative to the thesis LQR, effort "
         "and training time is on the page."

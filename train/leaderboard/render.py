@@ -1,4 +1,4 @@
-"""The leaderboard page and the README's block, generated from ``results/*.json`` only.
+"""The leaderboard page and the README's block, generated from ``results/<env id>.json`` only.
 
 :func:`page` writes one section per level (every id of
 :data:`acld_gym.envs.presets.PRESETS`, "not run yet" where a level has no file): a table of

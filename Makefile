@@ -43,12 +43,16 @@ studies: $(STAMP)
 ## Retrain the repository's shipped ACLDBeam-v1 agents (train/agents/vrs, ppo, sac), from
 ## scratch (no teacher): the benchmark's runs of vrs, ppo and sac (5 seeds each, resumable),
 ## then ship vrs seed 0 and the ppo and sac seeds that are best on the thesis cases over the
-## ones in train/agents (docs/training.md, "Reinforcement learning from scratch").
+## ones in train/agents (docs/training.md, "Reinforcement learning from scratch"), and write
+## their comparison, train/agents/compare.json and .md, which tests/train/test_agents.py
+## checks them against. The pages that quote those agents (docs/training.md, the README's
+## score table) are then to be brought up to date: the tests say where they differ.
 agents: $(STAMP)
 	$(BIN)/acld-gym benchmark --algos vrs ppo sac --seeds 0 1 2 3 4 --resume --out runs/benchmark/v1
 	$(BIN)/acld-gym ship runs/benchmark/v1/agents/vrs-s0 vrs --agents train/agents --force
 	$(BIN)/acld-gym ship runs/benchmark/v1 ppo --best ppo --agents train/agents --force
 	$(BIN)/acld-gym ship runs/benchmark/v1 sac --best sac --agents train/agents --force
+	$(BIN)/acld-gym compare --json train/agents/compare.json --markdown train/agents/compare.md
 
 ## ruff: lint, and the format check (`make format` applies it).
 lint: $(STAMP)

@@ -215,7 +215,8 @@ def refused(monkeypatch, capsys):
 BAD_ARGS = [
     (
         ["--save", "/dev/null/x"],
-        "argument --save: expected a folder that can hold files, got '/dev/null/x' (",
+        "argument --save: expected a folder that can hold files, got '/dev/null/x': "
+        "'/dev/null' is not a folder",
     ),
     (["ACLDBeam-v9"], "argument env_id: invalid choice: 'ACLDBeam-v9'"),
     (["--episodes", "0"], "argument --episodes: expected an integer in [1, 100], got 0"),

@@ -298,8 +298,14 @@ def main(argv: list[str] | None = None) -> int:
     if args.no_train and not args.resume:
         parser.error("--no-train needs --resume")
     backend = args.backend
-    if backend == "ray" and not ray_available():
+    installed = backend != "local" and ray_available()
+    if backend == "ray" and not installed:
         parser.error('Ray Tune is not installed: pip install -e ".[sweep]" (or --backend local)')
+    if args.address is not None and not installed:  # a cluster is reached through Ray only
+        parser.error(
+            "--address needs Ray Tune: --backend ray or auto, with Ray installed "
+            '(pip install -e ".[sweep]")'
+        )
     specs = list(args.algos or ([] if args.config else DEFAULT_ALGOS)) + list(args.config)
     try:
         configs = [(config_path(s), *read_config(s)) for s in specs]
@@ -331,10 +337,9 @@ def main(argv: list[str] | None = None) -> int:
                     "quiet": args.quiet,
                 }
             )
-    if backend == "auto":
-        backend = auto_backend(len(planned), args.address, ray_available())
-    try:
-        check_outputs(out, planned, backend, args.env_id)
+    may_use = backend if backend != "auto" else auto_backend(len(planned), args.address, installed)
+    try:  # Ray's storage checked wherever Ray may run (auto decides on the trials left, below)
+        check_outputs(out, planned, may_use, args.env_id)
     except ValueError as exc:
         parser.error(str(exc))
     trials, records = [], []
@@ -344,6 +349,8 @@ def main(argv: list[str] | None = None) -> int:
             records.append(rec)
         else:
             trials.append(t)
+    if backend == "auto":  # on the trials left to train: the reused ones need no Ray
+        backend = auto_backend(len(trials), args.address, installed)
     if args.no_train:
         for t in trials:
             print(f"  missing: {t['name']} seed {t['seed']} (not trained: --no-train)")

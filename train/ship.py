@@ -33,7 +33,7 @@ from .agent import CURVE_FILE, TrainedAgent
 from .agent_files import check_replaceable, curve_rows
 from .agent_schema import is_real
 
-__all__ = ["DEFAULT_AGENTS", "best_seed", "ship", "main"]
+__all__ = ["DEFAULT_AGENTS", "best_seed", "ship", "build_parser", "main"]
 
 #: The cases the shipping rule looks at, as results.json keys them: the thesis's (the held-out
 #: random loads take no part).
@@ -116,7 +116,8 @@ def ship(
     return agent.save(dst, {CURVE_FILE: curve} if curve is not None else None)
 
 
-def main(argv: list[str] | None = None) -> int:
+def build_parser() -> argparse.ArgumentParser:
+    """The command line of ``python -m train.ship`` (``acld-gym ship``)."""
     p = argparse.ArgumentParser(
         prog=prog("python -m train.ship"),
         description=plain(__doc__),
@@ -143,6 +144,11 @@ def main(argv: list[str] | None = None) -> int:
         help="destination folder of agents (default: ./agents, in the current directory)",
     )
     p.add_argument("--force", action="store_true", help="replace an existing agent of that name")
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = build_parser()
     args = p.parse_args(argv)
     try:
         check_name(args.name)

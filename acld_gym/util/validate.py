@@ -12,6 +12,7 @@ import numbers
 import os
 import stat
 import sys
+from pathlib import Path
 
 import numpy as np
 
@@ -28,6 +29,7 @@ __all__ = [
     "DataFileError",
     "file_error",
     "arg_type",
+    "arg_dir",
     "closed_pipe_is_fine",
     "os_error_line",
     "check_figure_path",
@@ -147,19 +149,24 @@ def arg_type(kind: type, low=None, high=None, *, low_open: bool = False):
 
 
 def arg_dir(text: str) -> str:
-    """An argparse ``type=`` for an output folder: ``text`` if it is (or can be made) a
-    folder that accepts files (:func:`acld_gym.util.atomic.check_directory`), checked when
-    the command line is parsed, before anything is computed."""
-    from .atomic import check_directory
+    """An argparse ``type=`` for an output folder: ``text`` if it is a folder, or can be made
+    as one under the nearest folder on its path that exists and is writable; checked when
+    the command line is parsed, before anything is computed, and nothing is created (a
+    later refusal of another argument leaves no folder behind)."""
+    path = Path(text)
 
-    try:
-        check_directory(text, "folder")
-    except ValueError as exc:
-        why = str(exc).removeprefix("folder: ")
-        why = why[why.rindex("(") :] if why.endswith(")") and "(" in why else f"({why})"
+    def refuse(why: str):
         raise argparse.ArgumentTypeError(
-            f"expected a folder that can hold files, got {text!r} {why}"
-        ) from None
+            f"expected a folder that can hold files, got {text!r}: {why}"
+        )
+
+    if path.exists() and not path.is_dir():
+        refuse("it exists and is not a folder")
+    existing = next(p for p in (path, *path.parents) if p.exists())
+    if not existing.is_dir():
+        refuse(f"{str(existing)!r} is not a folder")
+    if not os.access(existing, os.W_OK | os.X_OK):
+        refuse(f"{str(existing)!r} is not writable")
     return text
 
 

@@ -21,8 +21,9 @@ from stable_baselines3.common.vec_env import VecNormalize
 from acld_gym.envs import SB3VecEnv
 from acld_gym.envs.presets import PRESETS, preset
 from acld_gym.test_sets import evaluation_set
-from acld_gym.util.validate import arg_dir, arg_type
+from acld_gym.util.validate import arg_type
 from acld_gym.wrappers import ObserveModes, UnitAction, vector
+from train.sb3_save import arg_save_dir, save_run
 from train.scoring import score
 
 p = argparse.ArgumentParser()
@@ -30,7 +31,7 @@ p.add_argument("env_id", nargs="?", default="ACLDBeam-v1", choices=list(PRESETS)
 p.add_argument("--timesteps", type=arg_type(int, 1), default=2_000_000)
 p.add_argument("--seed", type=arg_type(int, 0, 2**32 - 1), default=0)  # numpy's range
 p.add_argument("--episodes", type=int, help="score on the first N test loads (default: all)")
-p.add_argument("--save", type=arg_dir, metavar="DIR", help="keep the model and VecNormalize")
+p.add_argument("--save", type=arg_save_dir, metavar="DIR", help="keep the model and VecNormalize")
 p.add_argument("--ent", type=float, default=0.05)
 p.add_argument("--gamma", type=float, default=0.999)
 p.add_argument("--pi", type=json.loads, default=[])
@@ -58,7 +59,6 @@ model = PPO(
 )  # fmt: skip
 model.learn(args.timesteps)
 if args.save is not None:  # score later: score(PPO.load(...), ..., vec_normalize=the .pkl)
-    model.save(f"{args.save}/model.zip")
-    venv.save(f"{args.save}/vecnormalize.pkl")
+    save_run(model, args.save)
 wrappers = [UnitAction] + [partial(ObserveModes, modes=1)] * modes  # the same, one env
 print(score(model, args.env_id, wrappers=wrappers, episodes=args.episodes))

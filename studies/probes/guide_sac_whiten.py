@@ -3,7 +3,8 @@ whitening of ``guide_ppo_whiten.py`` (:func:`guide_ppo_whiten.whitening_transfor
 ``VecNormalize``. Everything else is the script's. The script learns next to nothing on
 ``ACLDBeamHard-v1`` (score -0.03 to 0.03 on seeds 101-103, docs/any-library.md), whose
 observation is a window of 8 tip measurements, nearly collinear at 1 kHz, on which a linear
-actor's gradient is badly conditioned. Not a test; ~5 min a run on one core::
+actor's gradient is badly conditioned. Not a test; ~9 min a run on one core (515 s on
+2026-12-08's host)::
 
     python studies/probes/guide_sac_whiten.py ACLDBeamHard-v1 --seed 7
 """

@@ -459,6 +459,28 @@ def test_auto_backend_uses_ray_only_with_several_trials(
     assert seen == [expected]
     assert benchmark.auto_backend(1, None, True) == "local"
     assert benchmark.auto_backend(3, None, False) == "local"
+    assert benchmark.auto_backend(0, None, True) == "local"  # everything reused
+    if expected == "local":  # Ray's storage is checked (and made) only where Ray may run
+        assert not (tmp_path / "ray").exists()
+
+
+@pytest.mark.parametrize(
+    "flags, installed",
+    [(["--backend", "local"], True), ([], False), (["--backend", "auto"], False)],
+)
+def test_an_address_without_ray_is_one_line(tmp_path, capsys, monkeypatch, flags, installed):
+    """``--address`` reaches a cluster through Ray only: with ``--backend local``, or Ray
+    not installed, it is refused in one line before anything is read or computed (it was
+    silently ignored)."""
+    import train.benchmark as benchmark
+
+    monkeypatch.setattr(benchmark, "ray_available", lambda: installed)
+    argv = ["--algos", "vrs", "--seeds", "0", "--address", "ray://head:10001", *flags]
+    with pytest.raises(SystemExit) as stop:
+        benchmark.main([*argv, "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert stop.value.code == 2 and "--address needs Ray Tune" in err
+    assert not (tmp_path / "out").exists()
 
 
 @pytest.mark.parametrize("held", ["policy.npz", "metadata.json"])

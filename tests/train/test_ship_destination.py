@@ -71,21 +71,31 @@ def _make_recipe(target: str) -> list[list[str]]:
 def test_make_agents_retrains_the_repositorys_shipped_agents(tmp_path, monkeypatch):
     """``make agents`` says it retrains the shipped agents: its ship lines replace
     ``train/agents/<name>`` (``--agents train/agents --force``, so a second run replaces them
-    too), from the folder its benchmark line writes, and the two commands parse."""
+    too), from the folder its benchmark line writes, and its last line rewrites the
+    comparison the agents are tested against; every line parses as its command's."""
     from train.benchmark import build_parser
 
     lines = _make_recipe("agents")
+    from train.compare import build_parser as compare_parser
+    from train.ship import build_parser as ship_parser
+
     bench = [w for w in lines if w[:2] == ["acld-gym", "benchmark"]]
     ships = [w for w in lines if w[:2] == ["acld-gym", "ship"]]
-    assert len(bench) == 1 and len(ships) == 3
-    out = build_parser().parse_args(bench[0][2:]).out
+    compares = [w for w in lines if w[:2] == ["acld-gym", "compare"]]
+    assert len(bench) == 1 and len(ships) == 3 and len(compares) == 1
+    assert lines[-1] == compares[0]  # after the agents it compares are shipped
+    out = Path(build_parser().parse_args(bench[0][2:]).out)
     root = Path(__file__).resolve().parents[2]
+    assert (root / "train" / "agents").resolve() == AGENTS_DIR.resolve()
     names = []
     for words in ships:
-        args = words[2:]
-        assert args[args.index("--agents") + 1] == "train/agents" and "--force" in args
-        assert (root / "train" / "agents").resolve() == AGENTS_DIR.resolve()
-        assert args[0].startswith(out)
-        names.append(args[1])
+        args = ship_parser().parse_args(words[2:])
+        assert Path(args.agents) == Path("train/agents") and args.force
+        assert out == Path(args.run) or out in Path(args.run).parents
+        names.append(args.name)
     assert sorted(names) == ["ppo", "sac", "vrs"]
     assert all((AGENTS_DIR / n / POLICY_FILE).is_file() for n in names)
+    written = compare_parser().parse_args(compares[0][2:])
+    assert Path(written.json) == Path("train/agents/compare.json")
+    assert Path(written.markdown) == Path("train/agents/compare.md")
+    assert written.agents in (None, str(AGENTS_DIR)) or Path(written.agents) == AGENTS_DIR

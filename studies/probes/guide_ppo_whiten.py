@@ -22,10 +22,10 @@ from acld_gym.wrappers import ObserveModes, UnitAction, WhitenObservation, vecto
 from train.scoring import score
 
 
-def whitening_transform(env_id: str, modes: bool, n_modes: int = 1, noise: float = 0.1):
-    """T from 64 episodes with a random voltage (uniform, +/- ``noise`` of the limit), random
-    loads, in the observation the scripts' policy sees (``UnitAction``, ``ObserveModes``
-    where ``modes``)."""
+def sample_directions(env_id: str, modes: bool, n_modes: int = 1, noise: float = 0.1):
+    """The directions z/|z| (rows) of the observations of 64 episodes with a random voltage
+    (uniform, +/- ``noise`` of the limit), random loads, as the scripts' policy sees them
+    (``UnitAction``, ``ObserveModes`` where ``modes``); zero observations left out."""
     venv0 = gym.make_vec(env_id, 64, load_case="random")
     venv0 = vector.UnitAction(venv0)
     if modes:
@@ -39,7 +39,12 @@ def whitening_transform(env_id: str, modes: bool, n_modes: int = 1, noise: float
     venv0.close()
     z = np.concatenate(zs)
     z = z[np.linalg.norm(z, axis=1) > 0]
-    return whitening(z / np.linalg.norm(z, axis=1, keepdims=True))
+    return z / np.linalg.norm(z, axis=1, keepdims=True)
+
+
+def whitening_transform(env_id: str, modes: bool, n_modes: int = 1, noise: float = 0.1):
+    """T, the ZCA whitening of :func:`sample_directions`."""
+    return whitening(sample_directions(env_id, modes, n_modes, noise))
 
 
 def main() -> None:
